@@ -1,0 +1,179 @@
+//! The sparsity pattern of all global matrices, built once from the connectivity.
+//!
+//! Storage is node-blocked compressed columns over all dofs (full symmetric storage):
+//! column `2n+j` (node `n`, component `j`) holds, for each neighbour `m` of `n` in
+//! ascending order, the rows `2m` and `2m+1`. Row indices are therefore never stored:
+//! they follow from the node adjacency, and the position of `(2m+i, 2n+j)` is
+//! `col_ptr[2n+j] + 2k + i` with `k` the rank of `m` among the neighbours of `n`.
+//! Mass and stiffness share one pattern.
+
+use rayon::prelude::*;
+
+use crate::mesh::Mesh;
+
+/// Node-blocked sparsity pattern shared by the mass and stiffness matrices.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    /// Number of nodes.
+    pub n_nodes: usize,
+    /// Offsets into `adj` per node (`n_nodes + 1`).
+    pub adj_ptr: Vec<usize>,
+    /// Sorted neighbour lists (each node is its own neighbour).
+    pub adj: Vec<u32>,
+}
+
+impl Pattern {
+    /// Builds the node adjacency of every element block of `mesh`.
+    pub fn new(mesh: &Mesh) -> Self {
+        let n = mesh.n_nodes();
+        // node -> elements' nodes, via counting.
+        let mut count = vec![0usize; n + 1];
+        for b in &mesh.blocks {
+            let nn = b.elements.kind.nodes();
+            for &v in &b.elements.conn {
+                count[v + 1] += nn;
+            }
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut raw = vec![0u32; count[n]];
+        for b in &mesh.blocks {
+            let nn = b.elements.kind.nodes();
+            for el in b.elements.conn.chunks_exact(nn) {
+                for &v in el {
+                    for &w in el {
+                        raw[fill[v]] = w as u32;
+                        fill[v] += 1;
+                    }
+                }
+            }
+        }
+        let lists: Vec<Vec<u32>> = (0..n)
+            .into_par_iter()
+            .map(|v| {
+                let mut l = raw[count[v]..count[v + 1]].to_vec();
+                l.push(v as u32);
+                l.sort_unstable();
+                l.dedup();
+                l
+            })
+            .collect();
+        let mut adj_ptr = Vec::with_capacity(n + 1);
+        adj_ptr.push(0);
+        let mut adj = Vec::with_capacity(lists.iter().map(Vec::len).sum());
+        for l in &lists {
+            adj.extend_from_slice(l);
+            adj_ptr.push(adj.len());
+        }
+        Pattern {
+            n_nodes: n,
+            adj_ptr,
+            adj,
+        }
+    }
+
+    /// Number of dofs.
+    pub fn n_dofs(&self) -> usize {
+        2 * self.n_nodes
+    }
+
+    /// Number of stored entries (full symmetric storage).
+    pub fn nnz(&self) -> usize {
+        4 * self.adj.len()
+    }
+
+    /// Start of column `2n + j`.
+    #[inline]
+    pub fn col_start(&self, n: usize, j: usize) -> usize {
+        4 * self.adj_ptr[n] + 2 * j * (self.adj_ptr[n + 1] - self.adj_ptr[n])
+    }
+
+    /// Rank of node `m` among the neighbours of `n` (panics if not a neighbour).
+    #[inline]
+    pub fn rank(&self, n: usize, m: usize) -> usize {
+        let l = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
+        l.iter()
+            .position(|&x| x as usize == m)
+            .expect("node pair outside the sparsity pattern")
+    }
+
+    /// Position of entry `(2m+i, 2n+j)` in a value array.
+    #[inline]
+    pub fn position(&self, m: usize, i: usize, n: usize, j: usize) -> usize {
+        self.col_start(n, j) + 2 * self.rank(n, m) + i
+    }
+
+    /// `y = A x` for a matrix stored on this pattern (symmetric, full storage),
+    /// in parallel over nodes.
+    pub fn matvec(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
+        y.par_chunks_mut(2).enumerate().for_each(|(n, yn)| {
+            let nbrs = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
+            for (j, out) in yn.iter_mut().enumerate() {
+                let c = self.col_start(n, j);
+                let col = &a[c..c + 2 * nbrs.len()];
+                let mut acc = 0.0;
+                for (k, &m) in nbrs.iter().enumerate() {
+                    let m = m as usize;
+                    acc += col[2 * k] * x[2 * m] + col[2 * k + 1] * x[2 * m + 1];
+                }
+                *out = acc;
+            }
+        });
+    }
+
+    /// `y = A x` and `z = B w` in one pass over the pattern (saves reading the
+    /// adjacency twice when both products are needed each step).
+    pub fn matvec2(
+        &self,
+        a: &[f64],
+        x: &[f64],
+        y: &mut [f64],
+        b: &[f64],
+        w: &[f64],
+        z: &mut [f64],
+    ) {
+        y.par_chunks_mut(2)
+            .zip(z.par_chunks_mut(2))
+            .enumerate()
+            .for_each(|(n, (yn, zn))| {
+                let nbrs = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
+                for j in 0..2 {
+                    let c = self.col_start(n, j);
+                    let ca = &a[c..c + 2 * nbrs.len()];
+                    let cb = &b[c..c + 2 * nbrs.len()];
+                    let (mut s, mut t) = (0.0, 0.0);
+                    for (k, &m) in nbrs.iter().enumerate() {
+                        let m = m as usize;
+                        s += ca[2 * k] * x[2 * m] + ca[2 * k + 1] * x[2 * m + 1];
+                        t += cb[2 * k] * w[2 * m] + cb[2 * k + 1] * w[2 * m + 1];
+                    }
+                    yn[j] = s;
+                    zn[j] = t;
+                }
+            });
+    }
+}
+
+/// Greedy colouring of the elements of one block so that no two elements of a colour
+/// share a node: elements of one colour can be scattered in parallel without races.
+pub fn colour_elements(conn: &[usize], nn: usize, n_nodes: usize) -> Vec<Vec<usize>> {
+    let n_el = conn.len() / nn;
+    let mut node_mask = vec![0u64; n_nodes];
+    let mut colours: Vec<Vec<usize>> = Vec::new();
+    for e in 0..n_el {
+        let nodes = &conn[e * nn..(e + 1) * nn];
+        let used = nodes.iter().fold(0u64, |acc, &v| acc | node_mask[v]);
+        let c = (!used).trailing_zeros() as usize;
+        assert!(c < 64, "element colouring needs more than 64 colours");
+        if c == colours.len() {
+            colours.push(Vec::new());
+        }
+        colours[c].push(e);
+        for &v in nodes {
+            node_mask[v] |= 1 << c;
+        }
+    }
+    colours
+}

@@ -1,0 +1,63 @@
+//! One error type for the whole crate.
+//!
+//! Invalid input and broken invariants are errors that carry the place and the value
+//! (a scenario field path, an element index, a pivot). A solve that ran and did not
+//! converge is not an error but an outcome the caller acts on (see `time`).
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in rothe, each variant naming where.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A scenario or material file field is missing, unknown or out of range.
+    #[error("{field}: {message}")]
+    Config {
+        /// Dotted path of the field, e.g. `materials.concrete.nu`.
+        field: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The mesh is unusable: an inverted or degenerate element, a bad set, a bad file.
+    #[error("mesh: {0}")]
+    Mesh(String),
+    /// The linear solver failed (e.g. the matrix is not positive definite).
+    #[error("linear solver ({backend}): {message}")]
+    Solver {
+        /// Backend name.
+        backend: &'static str,
+        /// What failed.
+        message: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file involved.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The time integration could not continue.
+    #[error("time stepping: {0}")]
+    Stepping(String),
+}
+
+impl Error {
+    /// Shorthand for a configuration error at `field`.
+    pub fn config(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Config {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for an I/O error on `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// Result with the crate's error.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,33 @@
+//! # rothe
+//!
+//! A finite-element solver for the dynamics of deformable bodies, built to account for
+//! where the energy goes. In space: plane-stress or plane-strain elements (Quad4,
+//! Tri3) and bars; in time: the Rothe method, i.e. backward Euler in displacement
+//! form (eqs. 8-10 of the paper in `../shared/paper`),
+//!
+//! `M (u_s − 2u_{s−1} + u_{s−2})/h² + C (u_s − u_{s−1})/h + f_int(u_s) = f_ext(t_s)`,
+//!
+//! with an energy ledger ([`energy`]) whose balance closes to round-off for linear
+//! problems because it books the scheme's own numerical loss as its own line.
+//!
+//! Data flows one way: scenario file ([`config`]) → validated [`model::Model`] →
+//! time loop ([`time`]) → ledger ([`energy`]) and output ([`output`]). The pieces:
+//! [`mesh`] (nodes, blocks, sets, generators, Gmsh), [`fe`] (reference elements,
+//! element matrices), [`material`] (constitutive models), [`assembly`] (pattern,
+//! parallel scatter, loads), [`linsolve`] (faer and CHOLMOD Cholesky behind one
+//! trait). [`run`] ties them together the way the `rothe` command does.
+
+pub mod assembly;
+pub mod config;
+pub mod energy;
+pub mod error;
+pub mod fe;
+pub mod linsolve;
+pub mod material;
+pub mod mesh;
+pub mod model;
+pub mod output;
+pub mod run;
+pub mod time;
+
+pub use error::{Error, Result};

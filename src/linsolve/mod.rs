@@ -1,0 +1,116 @@
+//! Sparse symmetric positive-definite solvers behind one trait.
+//!
+//! The contract is "symbolic once, numeric many": [`SymmetricSolver::analyze`] orders
+//! and analyses a sparsity pattern once, [`SymmetricSolver::factorize`] refactorises
+//! when the values change, [`SymmetricSolver::solve_in_place`] solves as often as
+//! needed. Matrices come as the lower triangle in CSC form ([`LowerCsc`]).
+//! Backends: [`faer_backend::FaerCholesky`] (default, pure Rust) and, with the
+//! `cholmod` feature, [`cholmod_backend::CholmodCholesky`] (SuiteSparse).
+
+pub mod faer_backend;
+
+#[cfg(feature = "cholmod")]
+pub mod cholmod_backend;
+
+use crate::error::{Error, Result};
+
+/// Lower triangle (diagonal included) of a symmetric matrix in compressed sparse
+/// columns, rows sorted within each column.
+#[derive(Clone, Debug, Default)]
+pub struct LowerCsc {
+    /// Dimension.
+    pub n: usize,
+    /// Column pointers, `n + 1` entries.
+    pub col_ptr: Vec<usize>,
+    /// Row indices, sorted in each column, all `>=` the column index.
+    pub row_idx: Vec<usize>,
+    /// Values, one per row index.
+    pub values: Vec<f64>,
+}
+
+impl LowerCsc {
+    /// `y = A x` using the lower triangle as a symmetric matrix.
+    pub fn sym_matvec(&self, x: &[f64], y: &mut [f64]) {
+        y.fill(0.0);
+        for j in 0..self.n {
+            let mut acc = 0.0;
+            for p in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let i = self.row_idx[p];
+                let a = self.values[p];
+                y[i] += a * x[j];
+                if i != j {
+                    acc += a * x[i];
+                }
+            }
+            y[j] += acc;
+        }
+    }
+}
+
+/// Which backend to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Backend {
+    /// faer's sparse Cholesky (pure Rust, default).
+    #[default]
+    Faer,
+    /// SuiteSparse CHOLMOD (cargo feature `cholmod`).
+    Cholmod,
+}
+
+impl std::str::FromStr for Backend {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "faer" => Ok(Backend::Faer),
+            "cholmod" => Ok(Backend::Cholmod),
+            _ => Err(format!("unknown backend `{s}` (expected faer or cholmod)")),
+        }
+    }
+}
+
+impl Backend {
+    /// Name as written in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Faer => "faer",
+            Backend::Cholmod => "cholmod",
+        }
+    }
+
+    /// A fresh solver of this backend, or an error if it was not compiled in.
+    pub fn solver(self) -> Result<Box<dyn SymmetricSolver>> {
+        match self {
+            Backend::Faer => Ok(Box::new(faer_backend::FaerCholesky::new())),
+            #[cfg(feature = "cholmod")]
+            Backend::Cholmod => Ok(Box::new(cholmod_backend::CholmodCholesky::new()?)),
+            #[cfg(not(feature = "cholmod"))]
+            Backend::Cholmod => Err(Error::Solver {
+                backend: "cholmod",
+                message: "this build has no CHOLMOD backend; rebuild with `--features cholmod`"
+                    .into(),
+            }),
+        }
+    }
+}
+
+/// A sparse symmetric positive-definite direct solver.
+pub trait SymmetricSolver: Send {
+    /// Backend name.
+    fn name(&self) -> &'static str;
+    /// Orders and analyses the pattern of `a` (values are not read).
+    fn analyze(&mut self, a: &LowerCsc) -> Result<()>;
+    /// Numeric factorisation of `a`, whose pattern must be the analysed one.
+    fn factorize(&mut self, a: &LowerCsc) -> Result<()>;
+    /// Overwrites `rhs` with `A⁻¹ rhs`.
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()>;
+    /// Number of nonzeros of the factor `L`, once analysed.
+    fn factor_nnz(&self) -> Option<usize>;
+}
+
+pub(crate) fn not_analysed(backend: &'static str) -> Error {
+    Error::Solver {
+        backend,
+        message: "factorize/solve called before analyze".into(),
+    }
+}

@@ -1,0 +1,139 @@
+//! Constitutive models with history at the Gauss points.
+//!
+//! A material update is a pure function of the last committed Gauss-point state and
+//! the strain at the new step: it returns the stress, the consistent tangent, the
+//! stored energy density and the step's dissipation by mechanism
+//! ([`PointResponse`]), and writes the trial state. The caller commits trial states
+//! only when a step is accepted ([`store::StateStore`]), so iterations and step
+//! cuts leave no trace. Every model shares the isotropic elasticity `C(E, ν)` of
+//! the plane idealisation chosen for the run.
+
+pub mod elastic;
+pub mod store;
+
+use crate::fe::{elasticity, Plane};
+
+/// Dissipation increments of one step at one point, per unit volume.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Dissipation {
+    /// Viscous (dashpot) dissipation.
+    pub viscous: f64,
+    /// Damage dissipation.
+    pub damage: f64,
+    /// Plastic dissipation.
+    pub plastic: f64,
+    /// The time scheme's own algorithmic loss at the point:
+    /// `σ_{n+1}:Δε − Δψ − (viscous + damage + plastic)`.
+    pub numerical: f64,
+}
+
+/// What one material update returns.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointResponse {
+    /// Stress `[σ_xx, σ_yy, σ_xy]` at the new step.
+    pub sigma: [f64; 3],
+    /// Consistent tangent `∂σ_{n+1}/∂ε_{n+1}`.
+    pub tangent: [[f64; 3]; 3],
+    /// Stored (free) energy density at the new step.
+    pub psi: f64,
+    /// Dissipation increments of the step.
+    pub dissipation: Dissipation,
+}
+
+/// The strain step a material point is asked to take.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StrainStep {
+    /// Strain at the last committed step.
+    pub eps_n: [f64; 3],
+    /// Strain at the new step.
+    pub eps: [f64; 3],
+    /// Time step size.
+    pub dt: f64,
+}
+
+/// Constitutive model with its parameters (beyond the elastic `E, ν, ρ`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Model {
+    /// Linear elasticity `σ = C ε`.
+    Elastic,
+}
+
+/// A material: elastic constants, density and constitutive model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name as given in the scenario.
+    pub name: String,
+    /// Young's modulus.
+    pub e: f64,
+    /// Poisson's ratio.
+    pub nu: f64,
+    /// Mass density.
+    pub rho: f64,
+    /// The constitutive model.
+    pub model: Model,
+}
+
+impl Material {
+    /// A linear elastic material.
+    pub fn elastic(name: &str, e: f64, nu: f64, rho: f64) -> Self {
+        Material {
+            name: name.into(),
+            e,
+            nu,
+            rho,
+            model: Model::Elastic,
+        }
+    }
+
+    /// Elasticity matrix `C` in the plane idealisation `plane`.
+    pub fn c(&self, plane: Plane) -> [[f64; 3]; 3] {
+        elasticity(self.e, self.nu, plane)
+    }
+
+    /// True when the stress is `C ε` with no history: the stiffness is constant and
+    /// the global force is `K u`, so no Gauss-point loop is needed per step.
+    pub fn is_linear_elastic(&self) -> bool {
+        matches!(self.model, Model::Elastic)
+    }
+
+    /// Number of history values stored per Gauss point.
+    pub fn n_state(&self) -> usize {
+        match self.model {
+            Model::Elastic => 0,
+        }
+    }
+
+    /// Initial history values.
+    pub fn init_state(&self, state: &mut [f64]) {
+        state.fill(0.0);
+    }
+
+    /// The material update (see the module docs).
+    pub fn update(
+        &self,
+        plane: Plane,
+        step: &StrainStep,
+        _state_n: &[f64],
+        _state: &mut [f64],
+    ) -> PointResponse {
+        match self.model {
+            Model::Elastic => elastic::update(&self.c(plane), step),
+        }
+    }
+}
+
+/// `a · b` for Voigt vectors.
+#[inline]
+pub fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `C x` for a 3x3 matrix.
+#[inline]
+pub fn mul3(c: &[[f64; 3]; 3], x: &[f64; 3]) -> [f64; 3] {
+    [
+        c[0][0] * x[0] + c[0][1] * x[1] + c[0][2] * x[2],
+        c[1][0] * x[0] + c[1][1] * x[1] + c[1][2] * x[2],
+        c[2][0] * x[0] + c[2][1] * x[1] + c[2][2] * x[2],
+    ]
+}

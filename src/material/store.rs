@@ -1,0 +1,35 @@
+//! Gauss-point storage: committed and trial history, committed strain.
+
+/// Per-Gauss-point history, committed and trial, for one element block.
+#[derive(Clone, Debug, Default)]
+pub struct StateStore {
+    /// History values per point.
+    pub n_state: usize,
+    /// Committed history (`n_points * n_state`).
+    pub committed: Vec<f64>,
+    /// Trial history of the step being solved.
+    pub trial: Vec<f64>,
+    /// Committed strain per point (`n_points * 3`).
+    pub eps: Vec<f64>,
+    /// Trial strain per point.
+    pub eps_trial: Vec<f64>,
+}
+
+impl StateStore {
+    /// Storage for `n_points` points with `n_state` values each, all zero.
+    pub fn new(n_points: usize, n_state: usize) -> Self {
+        StateStore {
+            n_state,
+            committed: vec![0.0; n_points * n_state],
+            trial: vec![0.0; n_points * n_state],
+            eps: vec![0.0; n_points * 3],
+            eps_trial: vec![0.0; n_points * 3],
+        }
+    }
+
+    /// Accepts the step: trial becomes committed.
+    pub fn commit(&mut self) {
+        self.committed.copy_from_slice(&self.trial);
+        self.eps.copy_from_slice(&self.eps_trial);
+    }
+}

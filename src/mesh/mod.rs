@@ -1,0 +1,262 @@
+//! Meshes: nodes, blocks of elements of one kind, and named node and edge sets.
+//!
+//! A [`Part`] is the geometry of one body as a generator or a Gmsh file produces it;
+//! a [`Mesh`] is the union of all parts of a model (node numbers offset, set names
+//! prefixed by the body name, `beam.left`), plus the bar elements that share the
+//! continuum's nodes. Start with [`structured::rectangle`] and [`Mesh::add_part`].
+
+pub mod gmsh;
+pub mod structured;
+
+use std::collections::BTreeMap;
+
+use crate::error::{Error, Result};
+
+/// The element types rothe knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ElementKind {
+    /// Bilinear quadrilateral, nodes counter-clockwise, 2x2 Gauss.
+    Quad4,
+    /// Linear (constant-strain) triangle, nodes counter-clockwise, 1 Gauss point.
+    Tri3,
+    /// Two-node bar (truss) carrying axial force only.
+    Bar2,
+}
+
+impl ElementKind {
+    /// Number of nodes of one element.
+    pub fn nodes(self) -> usize {
+        match self {
+            ElementKind::Quad4 => 4,
+            ElementKind::Tri3 => 3,
+            ElementKind::Bar2 => 2,
+        }
+    }
+
+    /// Number of Gauss points used for the stiffness and internal force.
+    pub fn gauss_points(self) -> usize {
+        match self {
+            ElementKind::Quad4 => 4,
+            ElementKind::Tri3 => 1,
+            ElementKind::Bar2 => 1,
+        }
+    }
+}
+
+/// Elements of one kind with flattened connectivity (`nodes()` indices per element).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Elements {
+    /// Element kind of every element in the block.
+    pub kind: ElementKind,
+    /// Node indices, `kind.nodes()` per element.
+    pub conn: Vec<usize>,
+}
+
+impl Elements {
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.conn.len() / self.kind.nodes()
+    }
+
+    /// True when the block has no element.
+    pub fn is_empty(&self) -> bool {
+        self.conn.is_empty()
+    }
+
+    /// Node indices of element `e`.
+    pub fn element(&self, e: usize) -> &[usize] {
+        let n = self.kind.nodes();
+        &self.conn[e * n..(e + 1) * n]
+    }
+}
+
+/// The geometry of one body: nodes, continuum elements and named sets.
+#[derive(Clone, Debug, Default)]
+pub struct Part {
+    /// Node coordinates.
+    pub coords: Vec<[f64; 2]>,
+    /// Element blocks (one per element kind present).
+    pub blocks: Vec<Elements>,
+    /// Named node sets.
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    /// Named boundary edge sets (node pairs, oriented with the body on the left).
+    pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
+}
+
+/// What an element block is made of and how thick it is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// The elements.
+    pub elements: Elements,
+    /// Index of the body the block belongs to.
+    pub body: usize,
+    /// Index of the material in the model's material table.
+    pub material: usize,
+    /// Thickness for continuum elements, cross-section area for bars.
+    pub section: f64,
+}
+
+/// The whole model's mesh: all bodies' nodes and element blocks.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Node coordinates.
+    pub coords: Vec<[f64; 2]>,
+    /// Body index of every node.
+    pub node_body: Vec<usize>,
+    /// Element blocks.
+    pub blocks: Vec<Block>,
+    /// Node sets, named `body.set`.
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    /// Edge sets, named `body.set`.
+    pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
+}
+
+impl Mesh {
+    /// Number of nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.coords.len()
+    }
+
+    /// Number of degrees of freedom (two per node).
+    pub fn n_dofs(&self) -> usize {
+        2 * self.coords.len()
+    }
+
+    /// Number of elements over all blocks.
+    pub fn n_elements(&self) -> usize {
+        self.blocks.iter().map(|b| b.elements.len()).sum()
+    }
+
+    /// Adds a body's part; its sets become `body_name.set`. Returns the node offset.
+    pub fn add_part(
+        &mut self,
+        part: &Part,
+        body: usize,
+        body_name: &str,
+        material: usize,
+        thickness: f64,
+    ) -> usize {
+        let off = self.coords.len();
+        self.coords.extend_from_slice(&part.coords);
+        self.node_body
+            .extend(std::iter::repeat_n(body, part.coords.len()));
+        for b in &part.blocks {
+            self.blocks.push(Block {
+                elements: Elements {
+                    kind: b.kind,
+                    conn: b.conn.iter().map(|&n| n + off).collect(),
+                },
+                body,
+                material,
+                section: thickness,
+            });
+        }
+        for (name, nodes) in &part.node_sets {
+            self.node_sets.insert(
+                format!("{body_name}.{name}"),
+                nodes.iter().map(|&n| n + off).collect(),
+            );
+        }
+        for (name, edges) in &part.edge_sets {
+            self.edge_sets.insert(
+                format!("{body_name}.{name}"),
+                edges.iter().map(|e| [e[0] + off, e[1] + off]).collect(),
+            );
+        }
+        let all: Vec<usize> = (off..off + part.coords.len()).collect();
+        self.node_sets.insert(format!("{body_name}.all"), all);
+        off
+    }
+
+    /// Nodes of `body` lying on the segment `a`-`b` (within `tol`), ordered from `a`.
+    pub fn nodes_on_segment(&self, body: usize, a: [f64; 2], b: [f64; 2], tol: f64) -> Vec<usize> {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len2 = d[0] * d[0] + d[1] * d[1];
+        let mut hits: Vec<(f64, usize)> = Vec::new();
+        for (n, x) in self.coords.iter().enumerate() {
+            if self.node_body[n] != body {
+                continue;
+            }
+            let r = [x[0] - a[0], x[1] - a[1]];
+            let s = (r[0] * d[0] + r[1] * d[1]) / len2;
+            let dist2 = (r[0] - s * d[0]).powi(2) + (r[1] - s * d[1]).powi(2);
+            if dist2 <= tol * tol && s >= -tol / len2.sqrt() && s <= 1.0 + tol / len2.sqrt() {
+                hits.push((s, n));
+            }
+        }
+        hits.sort_by(|p, q| p.0.total_cmp(&q.0));
+        hits.into_iter().map(|(_, n)| n).collect()
+    }
+
+    /// The node nearest to `x`.
+    pub fn nearest_node(&self, x: [f64; 2]) -> Option<usize> {
+        self.coords
+            .iter()
+            .enumerate()
+            .map(|(n, c)| (n, (c[0] - x[0]).powi(2) + (c[1] - x[1]).powi(2)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(n, _)| n)
+    }
+
+    /// Checks every continuum element for positive Jacobian at its Gauss points and
+    /// every bar for positive length: an inverted or degenerate element is an error
+    /// that names the block, the element and its nodes.
+    pub fn check_elements(&self) -> Result<()> {
+        for (bi, block) in self.blocks.iter().enumerate() {
+            for e in 0..block.elements.len() {
+                let nodes = block.elements.element(e);
+                let x: Vec<[f64; 2]> = nodes.iter().map(|&n| self.coords[n]).collect();
+                let ok = match block.elements.kind {
+                    ElementKind::Bar2 => {
+                        let l = ((x[1][0] - x[0][0]).powi(2) + (x[1][1] - x[0][1]).powi(2)).sqrt();
+                        l > 0.0
+                    }
+                    kind => crate::fe::min_jacobian(kind, &x) > 0.0,
+                };
+                if !ok {
+                    return Err(Error::Mesh(format!(
+                        "block {bi}, element {e} (nodes {nodes:?}) is inverted or degenerate \
+                         (non-positive Jacobian or zero length); continuum nodes must run \
+                         counter-clockwise"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Smallest characteristic length per element block (used by the CFL estimate):
+    /// for a triangle its smallest altitude, for a quadrilateral its area over its
+    /// longest diagonal, for a bar its length.
+    pub fn element_length(&self, block: usize, e: usize) -> f64 {
+        let b = &self.blocks[block];
+        let x: Vec<[f64; 2]> = b
+            .elements
+            .element(e)
+            .iter()
+            .map(|&n| self.coords[n])
+            .collect();
+        let dist =
+            |p: [f64; 2], q: [f64; 2]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+        match b.elements.kind {
+            ElementKind::Bar2 => dist(x[0], x[1]),
+            ElementKind::Tri3 => {
+                let area = 0.5
+                    * ((x[1][0] - x[0][0]) * (x[2][1] - x[0][1])
+                        - (x[2][0] - x[0][0]) * (x[1][1] - x[0][1]))
+                        .abs();
+                let lmax = dist(x[0], x[1]).max(dist(x[1], x[2])).max(dist(x[2], x[0]));
+                2.0 * area / lmax
+            }
+            ElementKind::Quad4 => {
+                let area = 0.5
+                    * ((x[2][0] - x[0][0]) * (x[3][1] - x[1][1])
+                        - (x[3][0] - x[1][0]) * (x[2][1] - x[0][1]))
+                        .abs();
+                let dmax = dist(x[0], x[2]).max(dist(x[1], x[3]));
+                area / dmax
+            }
+        }
+    }
+}

@@ -1,0 +1,209 @@
+//! The validated model a run works on: mesh, materials, supports, loads, probes and
+//! analysis settings. Built from a scenario file by [`crate::config`] or directly in
+//! code (tests, benches).
+
+use crate::fe::Plane;
+use crate::material::Material;
+use crate::mesh::Mesh;
+
+/// A scalar function of time that scales a load or a prescribed displacement.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum TimeFunction {
+    /// 1 for all times.
+    Constant,
+    /// 0 before `at`, 1 from `at` on.
+    Step {
+        /// Switch-on time.
+        at: f64,
+    },
+    /// 0 before `t0`, linear to 1 at `t1`, 1 after.
+    Ramp {
+        /// Start of the ramp.
+        t0: f64,
+        /// End of the ramp.
+        t1: f64,
+    },
+    /// Piecewise linear through `[t, value]` points, constant outside.
+    Table {
+        /// Points `[t, value]` with increasing `t`.
+        points: Vec<[f64; 2]>,
+    },
+    /// `sin(2π f t + phase)`.
+    Harmonic {
+        /// Frequency in Hz.
+        frequency: f64,
+        /// Phase in radians.
+        #[serde(default)]
+        phase: f64,
+    },
+}
+
+impl TimeFunction {
+    /// Value at time `t`.
+    pub fn at(&self, t: f64) -> f64 {
+        match self {
+            TimeFunction::Constant => 1.0,
+            TimeFunction::Step { at } => {
+                if t >= *at {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            TimeFunction::Ramp { t0, t1 } => {
+                if t <= *t0 {
+                    0.0
+                } else if t >= *t1 {
+                    1.0
+                } else {
+                    (t - t0) / (t1 - t0)
+                }
+            }
+            TimeFunction::Table { points } => {
+                let first = points[0];
+                let last = points[points.len() - 1];
+                if t <= first[0] {
+                    return first[1];
+                }
+                if t >= last[0] {
+                    return last[1];
+                }
+                let i = points.partition_point(|p| p[0] <= t);
+                let (a, b) = (points[i - 1], points[i]);
+                a[1] + (b[1] - a[1]) * (t - a[0]) / (b[0] - a[0])
+            }
+            TimeFunction::Harmonic { frequency, phase } => {
+                (2.0 * std::f64::consts::PI * frequency * t + phase).sin()
+            }
+        }
+    }
+}
+
+/// A displacement component held at `value * function(t)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Constraint {
+    /// Global dof index (`2 node + component`).
+    pub dof: usize,
+    /// Amplitude.
+    pub value: f64,
+    /// Time function.
+    pub function: TimeFunction,
+}
+
+impl Constraint {
+    /// Prescribed displacement at `t`.
+    pub fn at(&self, t: f64) -> f64 {
+        if self.value == 0.0 {
+            0.0
+        } else {
+            self.value * self.function.at(t)
+        }
+    }
+}
+
+/// A fixed spatial force pattern scaled by a time function.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Load {
+    /// Label for messages.
+    pub label: String,
+    /// Nonzero entries `(dof, force)` of the pattern.
+    pub entries: Vec<(usize, f64)>,
+    /// Time function.
+    pub function: TimeFunction,
+}
+
+/// Named output point: one node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe {
+    /// Name (column prefix in `history.csv`).
+    pub name: String,
+    /// Node index.
+    pub node: usize,
+}
+
+/// A body: a named group of element blocks with an initial velocity.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Name (prefix of its sets).
+    pub name: String,
+    /// Initial velocity of all its nodes.
+    pub velocity: [f64; 2],
+    /// Thickness of its continuum elements.
+    pub thickness: f64,
+}
+
+/// Static or dynamic analysis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum AnalysisKind {
+    /// Backward-Euler dynamics (the paper's eq. 9).
+    #[default]
+    Dynamic,
+    /// Equilibrium `K u = f` at each load step (no inertia).
+    Static,
+}
+
+/// Time stepping and damping settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analysis {
+    /// Static or dynamic.
+    pub kind: AnalysisKind,
+    /// Step size `h`.
+    pub dt: f64,
+    /// End time `T`.
+    pub t_end: f64,
+    /// Lumped (row-sum) instead of consistent mass.
+    pub lumped_mass: bool,
+    /// Mass damping factor `zeta` of eq. (4): `C = zeta M`.
+    pub zeta: f64,
+    /// Rayleigh damping `C += a_m M + a_k K`.
+    pub rayleigh: [f64; 2],
+    /// Write VTK every this many steps (0: never).
+    pub vtk_every: usize,
+}
+
+impl Analysis {
+    /// Number of steps `m = round(T / h)`.
+    pub fn n_steps(&self) -> usize {
+        (self.t_end / self.dt).round().max(1.0) as usize
+    }
+}
+
+/// Everything a run needs.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// Material table (blocks refer to it by index).
+    pub materials: Vec<Material>,
+    /// Plane stress or plane strain.
+    pub plane: Plane,
+    /// Bodies.
+    pub bodies: Vec<Body>,
+    /// Prescribed displacement components (fixed supports have value 0).
+    pub constraints: Vec<Constraint>,
+    /// Loads.
+    pub loads: Vec<Load>,
+    /// Gravity acceleration, applied as `M g` (constant in time).
+    pub gravity: Option<[f64; 2]>,
+    /// Output probes.
+    pub probes: Vec<Probe>,
+    /// Analysis settings.
+    pub analysis: Analysis,
+}
+
+impl Model {
+    /// Initial velocity field (per dof) from the bodies' velocities.
+    pub fn initial_velocity(&self) -> Vec<f64> {
+        let mut v = vec![0.0; self.mesh.n_dofs()];
+        for (n, &b) in self.mesh.node_body.iter().enumerate() {
+            v[2 * n] = self.bodies[b].velocity[0];
+            v[2 * n + 1] = self.bodies[b].velocity[1];
+        }
+        for c in &self.constraints {
+            v[c.dof] = 0.0;
+        }
+        v
+    }
+}

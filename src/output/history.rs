@@ -1,0 +1,78 @@
+//! `history.csv`: one row per step, flushed as it is written.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::energy::Ledger;
+use crate::error::{Error, Result};
+
+/// The fixed ledger columns.
+pub const LEDGER_COLUMNS: [&str; 12] = [
+    "t",
+    "E_kin",
+    "E_int",
+    "W_ext",
+    "E_el",
+    "D_viscous",
+    "D_damage",
+    "D_plastic",
+    "D_contact",
+    "D_mass",
+    "D_num",
+    "residual",
+];
+
+/// Writer of `history.csv`.
+pub struct History {
+    path: PathBuf,
+    out: BufWriter<File>,
+}
+
+impl History {
+    /// Creates the file and writes the header (ledger columns, solver columns, then
+    /// `<probe>_ux, <probe>_uy` per probe).
+    pub fn create(path: &Path, probes: &[String]) -> Result<Self> {
+        let file = File::create(path).map_err(|e| Error::io(path, e))?;
+        let mut h = History {
+            path: path.into(),
+            out: BufWriter::new(file),
+        };
+        let mut cols: Vec<String> = LEDGER_COLUMNS.iter().map(|s| s.to_string()).collect();
+        cols.push("iterations".into());
+        cols.push("nl_residual".into());
+        for p in probes {
+            cols.push(format!("{p}_ux"));
+            cols.push(format!("{p}_uy"));
+        }
+        writeln!(h.out, "{}", cols.join(",")).map_err(|e| Error::io(&h.path, e))?;
+        h.flush()?;
+        Ok(h)
+    }
+
+    /// Appends one row and flushes it.
+    pub fn row(
+        &mut self,
+        t: f64,
+        l: &Ledger,
+        iterations: usize,
+        nl_residual: f64,
+        probes: &[[f64; 2]],
+    ) -> Result<()> {
+        let d = &l.dissipated;
+        let mut line = format!(
+            "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
+            l.kinetic, l.internal, l.external_work, l.elastic, d.viscous, d.damage, d.plastic,
+            d.contact, d.mass, d.numerical, l.residual
+        );
+        for p in probes {
+            line.push_str(&format!(",{:.12e},{:.12e}", p[0], p[1]));
+        }
+        writeln!(self.out, "{line}").map_err(|e| Error::io(&self.path, e))?;
+        self.flush()
+    }
+
+    fn flush(&mut self) -> Result<()> {
+        self.out.flush().map_err(|e| Error::io(&self.path, e))
+    }
+}

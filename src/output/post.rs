@@ -1,0 +1,51 @@
+//! Post-processing fields from a displacement vector.
+
+use crate::fe::{element, kinematics, stiffness_rule, strain};
+use crate::material::StrainStep;
+use crate::mesh::ElementKind;
+use crate::model::Model;
+
+/// Element-averaged stress `[σ_xx, σ_yy, σ_xy]` of every element, blocks in order
+/// (bars: axial stress in the first slot) for a linear elastic model.
+pub fn cell_stress(model: &Model, u: &[f64]) -> Vec<[f64; 3]> {
+    let mut out = Vec::with_capacity(model.mesh.n_elements());
+    for block in &model.mesh.blocks {
+        let mat = &model.materials[block.material];
+        let kind = block.elements.kind;
+        let nn = kind.nodes();
+        for e in 0..block.elements.len() {
+            let nodes = block.elements.element(e);
+            let x: Vec<[f64; 2]> = nodes.iter().map(|&n| model.mesh.coords[n]).collect();
+            let ue: Vec<f64> = nodes
+                .iter()
+                .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
+                .collect();
+            if kind == ElementKind::Bar2 {
+                out.push([mat.e * element::bar_strain(&x, &ue), 0.0, 0.0]);
+                continue;
+            }
+            let rule = stiffness_rule(kind);
+            let mut avg = [0.0; 3];
+            let mut st = [0.0; 0];
+            for &(xi, _) in rule {
+                let k = kinematics(kind, &x, xi);
+                let eps = strain(&k, nn, &ue);
+                let r = mat.update(
+                    model.plane,
+                    &StrainStep {
+                        eps_n: eps,
+                        eps,
+                        dt: 1.0,
+                    },
+                    &[],
+                    &mut st,
+                );
+                for i in 0..3 {
+                    avg[i] += r.sigma[i] / rule.len() as f64;
+                }
+            }
+            out.push(avg);
+        }
+    }
+    out
+}

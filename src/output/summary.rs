@@ -1,0 +1,150 @@
+//! `summary.json`: the run's totals, extremes, timings and solver facts.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::energy::Ledger;
+use crate::error::{Error, Result};
+use crate::time::Timing;
+
+/// Extremes of one probe's vertical displacement.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ProbeSummary {
+    /// `max |u_y|`.
+    pub max_abs_uy: f64,
+    /// `min u_y`.
+    pub min_uy: f64,
+    /// `max u_y`.
+    pub max_uy: f64,
+}
+
+impl Default for ProbeSummary {
+    fn default() -> Self {
+        ProbeSummary {
+            max_abs_uy: 0.0,
+            min_uy: f64::INFINITY,
+            max_uy: f64::NEG_INFINITY,
+        }
+    }
+}
+
+impl ProbeSummary {
+    /// Takes one sample.
+    pub fn sample(&mut self, uy: f64) {
+        self.max_abs_uy = self.max_abs_uy.max(uy.abs());
+        self.min_uy = self.min_uy.min(uy);
+        self.max_uy = self.max_uy.max(uy);
+    }
+}
+
+/// Energy totals.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct EnergySummary {
+    /// Initial kinetic energy.
+    pub kinetic_0: f64,
+    /// Final kinetic energy.
+    pub kinetic: f64,
+    /// Work of internal forces.
+    pub internal: f64,
+    /// Work of external forces.
+    pub external_work: f64,
+    /// Stored elastic energy.
+    pub elastic: f64,
+    /// Dissipation by mechanism.
+    pub dissipated: crate::energy::Dissipated,
+    /// Final balance residual.
+    pub balance_residual: f64,
+    /// Largest `|residual|` over the run relative to the largest energy.
+    pub balance_residual_rel: f64,
+}
+
+impl From<&Ledger> for EnergySummary {
+    fn from(l: &Ledger) -> Self {
+        EnergySummary {
+            kinetic_0: l.kinetic_0,
+            kinetic: l.kinetic,
+            internal: l.internal,
+            external_work: l.external_work,
+            elastic: l.elastic,
+            dissipated: l.dissipated,
+            balance_residual: l.residual,
+            balance_residual_rel: l.relative_residual(),
+        }
+    }
+}
+
+/// Timings in seconds.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct TimingSummary {
+    /// Assembly.
+    pub assembly_s: f64,
+    /// Symbolic + numeric factorisation.
+    pub factorization_s: f64,
+    /// Triangular solves.
+    pub solve_s: f64,
+    /// Wall clock of the whole run.
+    pub total_s: f64,
+}
+
+impl TimingSummary {
+    /// From the integrator's timing and the total.
+    pub fn new(t: &Timing, total_s: f64) -> Self {
+        TimingSummary {
+            assembly_s: t.assembly_s,
+            factorization_s: t.factorization_s,
+            solve_s: t.solve_s,
+            total_s,
+        }
+    }
+}
+
+/// Solver facts.
+#[derive(Clone, Debug, Serialize)]
+pub struct SolverSummary {
+    /// Backend name.
+    pub backend: String,
+    /// Numeric factorisations.
+    pub factorizations: usize,
+    /// Linear solves (iterations) over the run.
+    pub iterations: usize,
+    /// Nonzeros of the Cholesky factor.
+    pub factor_nnz: Option<usize>,
+}
+
+/// The whole summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// `completed` or `failed`.
+    pub status: String,
+    /// The error, when failed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// Number of dofs.
+    pub dofs: usize,
+    /// Number of elements.
+    pub elements: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Time reached.
+    pub t_end: f64,
+    /// Step size.
+    pub dt: f64,
+    /// Probe extremes.
+    pub probes: BTreeMap<String, ProbeSummary>,
+    /// Energies.
+    pub energy: EnergySummary,
+    /// Timings.
+    pub timing: TimingSummary,
+    /// Solver facts.
+    pub solver: SolverSummary,
+}
+
+impl Summary {
+    /// Writes pretty JSON to `path`.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let text = serde_json::to_string_pretty(self).expect("summary serialises");
+        std::fs::write(path, text).map_err(|e| Error::io(path, e))
+    }
+}

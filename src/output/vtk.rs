@@ -1,0 +1,132 @@
+//! VTK XML output: one `.vtu` per saved step under `vtk/`, and `result.pvd` listing
+//! them with their times (rewritten after every file, so it is always valid).
+
+use std::path::{Path, PathBuf};
+
+use vtkio::model::{
+    Attribute, Attributes, ByteOrder, CellType, Cells, DataArray, DataSet, ElementType, IOBuffer,
+    UnstructuredGridPiece, Version, VertexNumbers, Vtk,
+};
+
+use crate::error::{Error, Result};
+use crate::mesh::{ElementKind, Mesh};
+
+/// Writes the VTK series of a run.
+pub struct VtkSeries {
+    dir: PathBuf,
+    entries: Vec<(f64, String)>,
+    connectivity: Vec<u64>,
+    offsets: Vec<u64>,
+    types: Vec<CellType>,
+    points: Vec<f64>,
+}
+
+impl VtkSeries {
+    /// Prepares `dir/vtk/` and the cell tables of `mesh`.
+    pub fn new(dir: &Path, mesh: &Mesh) -> Result<Self> {
+        let sub = dir.join("vtk");
+        std::fs::create_dir_all(&sub).map_err(|e| Error::io(&sub, e))?;
+        let mut connectivity = Vec::new();
+        let mut offsets = Vec::new();
+        let mut types = Vec::new();
+        for b in &mesh.blocks {
+            let t = match b.elements.kind {
+                ElementKind::Quad4 => CellType::Quad,
+                ElementKind::Tri3 => CellType::Triangle,
+                ElementKind::Bar2 => CellType::Line,
+            };
+            for e in 0..b.elements.len() {
+                connectivity.extend(b.elements.element(e).iter().map(|&n| n as u64));
+                offsets.push(connectivity.len() as u64);
+                types.push(t);
+            }
+        }
+        let points = mesh.coords.iter().flat_map(|c| [c[0], c[1], 0.0]).collect();
+        Ok(VtkSeries {
+            dir: dir.into(),
+            entries: Vec::new(),
+            connectivity,
+            offsets,
+            types,
+            points,
+        })
+    }
+
+    /// Writes step `step` at time `t` with nodal `u`, `v` and cell `stress`.
+    pub fn write(
+        &mut self,
+        step: usize,
+        t: f64,
+        u: &[f64],
+        v: &[f64],
+        stress: &[[f64; 3]],
+    ) -> Result<()> {
+        let vec3 = |x: &[f64]| -> IOBuffer {
+            x.chunks_exact(2)
+                .flat_map(|p| [p[0], p[1], 0.0])
+                .collect::<Vec<f64>>()
+                .into()
+        };
+        let piece = UnstructuredGridPiece {
+            points: self.points.clone().into(),
+            cells: Cells {
+                cell_verts: VertexNumbers::XML {
+                    connectivity: self.connectivity.clone(),
+                    offsets: self.offsets.clone(),
+                },
+                types: self.types.clone(),
+            },
+            data: Attributes {
+                point: vec![
+                    Attribute::DataArray(DataArray {
+                        name: "displacement".into(),
+                        elem: ElementType::Vectors,
+                        data: vec3(u),
+                    }),
+                    Attribute::DataArray(DataArray {
+                        name: "velocity".into(),
+                        elem: ElementType::Vectors,
+                        data: vec3(v),
+                    }),
+                ],
+                cell: vec![Attribute::DataArray(DataArray {
+                    name: "stress".into(),
+                    elem: ElementType::Generic(3),
+                    data: stress
+                        .iter()
+                        .flatten()
+                        .copied()
+                        .collect::<Vec<f64>>()
+                        .into(),
+                })],
+            },
+        };
+        let name = format!("step_{step:07}.vtu");
+        let path = self.dir.join("vtk").join(&name);
+        let vtk = Vtk {
+            version: Version::new((1, 0)),
+            title: format!("rothe t = {t:e}"),
+            byte_order: ByteOrder::LittleEndian,
+            data: DataSet::inline(piece),
+            file_path: None,
+        };
+        vtk.export(&path)
+            .map_err(|e| Error::io(&path, std::io::Error::other(format!("{e:?}"))))?;
+        self.entries.push((t, format!("vtk/{name}")));
+        self.write_pvd()
+    }
+
+    fn write_pvd(&self) -> Result<()> {
+        let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n");
+        for (t, f) in &self.entries {
+            s.push_str(&format!(
+                "    <DataSet timestep=\"{t:.9e}\" group=\"\" part=\"0\" file=\"{f}\"/>\n"
+            ));
+        }
+        s.push_str("  </Collection>\n</VTKFile>\n");
+        let path = self.dir.join("result.pvd");
+        let tmp = self.dir.join("result.pvd.tmp");
+        std::fs::write(&tmp, s).map_err(|e| Error::io(&tmp, e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, e))
+    }
+}

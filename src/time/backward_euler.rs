@@ -1,0 +1,318 @@
+//! Backward Euler (Rothe) dynamics in displacement form, eq. (9) of the paper:
+//!
+//! `M (u_s − 2u_{s−1} + u_{s−2})/h² + C (u_s − u_{s−1})/h + f_int(u_s) = f_ext(t_s)`,
+//! `C = (zeta + a_m) M + a_k K`, with `v_s = (u_s − u_{s−1})/h` carried as state so
+//! `u_{−1} = u_0 − h v_0` holds for an initial velocity `v_0`.
+//!
+//! For linear elasticity `f_int = K u` and the step is one solve with the effective
+//! matrix `K_eff = (1/h² + (zeta+a_m)/h) M + (1 + a_k/h) K`, factorised once:
+//! `K_eff Δu = f_ext − f_int(u_{s−1}) + M v_{s−1}/h` on the free dofs, with prescribed
+//! displacements moved to the right-hand side. Per step it costs one triangular
+//! solve and one fused pass `K Δu, M v_s` over the pattern; `f_int`, `M v` are
+//! carried from step to step. See `theory/scheme.md` and `theory/energy.md`.
+
+use std::time::Instant;
+
+use super::system::{DofMap, ReducedMatrix};
+use super::{external_force, gravity_force, Timing};
+use crate::assembly::{Assembler, Mass};
+use crate::energy::{Ledger, StepIncrements};
+use crate::error::{Error, Result};
+use crate::linsolve::{Backend, SymmetricSolver};
+use crate::material::Dissipation;
+use crate::model::Model;
+
+/// The state of a dynamic run after a step.
+#[derive(Clone, Debug)]
+pub struct DynState {
+    /// Time.
+    pub t: f64,
+    /// Steps taken.
+    pub step: usize,
+    /// Displacements.
+    pub u: Vec<f64>,
+    /// Velocities `(u_s − u_{s−1})/h`.
+    pub v: Vec<f64>,
+    /// `M v`.
+    pub mv: Vec<f64>,
+    /// Internal forces `f_int(u)`.
+    pub fint: Vec<f64>,
+    /// External forces including support reactions.
+    pub fext: Vec<f64>,
+    /// Energy ledger.
+    pub ledger: Ledger,
+}
+
+/// What a step reports besides the new state.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StepReport {
+    /// Linear solves taken.
+    pub iterations: usize,
+    /// `|r_free| / max(|f_ext|, |f_int|, |M a|)` at the end of the step.
+    pub nl_residual: f64,
+}
+
+/// Backward Euler integrator: matrices, solver and scratch.
+pub struct BackwardEuler<'m> {
+    model: &'m Model,
+    /// Step size.
+    pub h: f64,
+    /// Assembly data (pattern, colours).
+    pub asm: Assembler,
+    /// Free-dof numbering.
+    pub dofs: DofMap,
+    /// Elastic stiffness on the pattern.
+    pub k: Vec<f64>,
+    /// Mass matrix.
+    pub mass: Mass,
+    gravity: Option<Vec<f64>>,
+    reduced: ReducedMatrix,
+    solver: Box<dyn SymmetricSolver>,
+    c_m: f64,
+    c_k: f64,
+    damp_m: f64,
+    damp_k: f64,
+    /// Phase timings.
+    pub timing: Timing,
+    /// Numeric factorisations done.
+    pub factorizations: usize,
+    f1: Vec<f64>,
+    du: Vec<f64>,
+    kdu: Vec<f64>,
+    v1: Vec<f64>,
+    mv1: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+impl<'m> BackwardEuler<'m> {
+    /// Assembles `K`, `M`, the effective matrix, analyses and factorises it.
+    pub fn new(model: &'m Model, backend: Backend) -> Result<Self> {
+        if model.materials.iter().any(|m| !m.is_linear_elastic()) {
+            return Err(Error::Stepping(
+                "materials with history are not supported by the linear integrator".into(),
+            ));
+        }
+        let a = &model.analysis;
+        let h = a.dt;
+        let t0 = Instant::now();
+        let asm = Assembler::new(&model.mesh);
+        let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+        let mass = asm.mass(&model.mesh, &model.materials, a.lumped_mass);
+        let gravity = gravity_force(model, &mass, &asm.pattern);
+        let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+        let mut reduced = ReducedMatrix::new(&asm.pattern, &dofs);
+        let damp_m = a.zeta + a.rayleigh[0];
+        let damp_k = a.rayleigh[1];
+        let c_m = 1.0 / (h * h) + damp_m / h;
+        let c_k = 1.0 + damp_k / h;
+        reduced.fill(&dofs, c_m, &mass, &[(c_k, &k)]);
+        let assembly_s = t0.elapsed().as_secs_f64();
+
+        let t1 = Instant::now();
+        let mut solver = backend.solver()?;
+        solver.analyze(&reduced.csc)?;
+        solver.factorize(&reduced.csc)?;
+        let factorization_s = t1.elapsed().as_secs_f64();
+        let n = model.mesh.n_dofs();
+        Ok(BackwardEuler {
+            model,
+            h,
+            asm,
+            dofs,
+            k,
+            mass,
+            gravity,
+            reduced,
+            solver,
+            c_m,
+            c_k,
+            damp_m,
+            damp_k,
+            timing: Timing {
+                assembly_s,
+                factorization_s,
+                ..Default::default()
+            },
+            factorizations: 1,
+            f1: vec![0.0; n],
+            du: vec![0.0; n],
+            kdu: vec![0.0; n],
+            v1: vec![0.0; n],
+            mv1: vec![0.0; n],
+            rhs: Vec::with_capacity(n),
+        })
+    }
+
+    /// Solver backend name.
+    pub fn backend(&self) -> &'static str {
+        self.solver.name()
+    }
+
+    /// Number of nonzeros of the Cholesky factor.
+    pub fn factor_nnz(&self) -> Option<usize> {
+        self.solver.factor_nnz()
+    }
+
+    /// The state at `t = 0`: prescribed displacements, bodies' initial velocities.
+    pub fn initial_state(&self) -> DynState {
+        let model = self.model;
+        let n = model.mesh.n_dofs();
+        let mut u = vec![0.0; n];
+        for c in &model.constraints {
+            u[c.dof] = c.at(0.0);
+        }
+        let v = model.initial_velocity();
+        let mut mv = vec![0.0; n];
+        let mut fint = vec![0.0; n];
+        self.asm.pattern.matvec(&self.k, &u, &mut fint);
+        self.mass.matvec(&self.asm.pattern, &v, &mut mv);
+        let mut fext = vec![0.0; n];
+        external_force(model, self.gravity.as_deref(), 0.0, &mut fext);
+        let e_kin0 = 0.5 * dot(&v, &mv);
+        let e_el0 = 0.5 * dot(&u, &fint);
+        DynState {
+            t: 0.0,
+            step: 0,
+            u,
+            v,
+            mv,
+            fint,
+            fext,
+            ledger: Ledger::new(e_kin0, e_el0),
+        }
+    }
+
+    /// Advances `s` by one step `h`.
+    pub fn step(&mut self, s: &mut DynState) -> Result<StepReport> {
+        let t_start = Instant::now();
+        let h = self.h;
+        let t1 = s.t + h;
+        let n = s.u.len();
+        external_force(self.model, self.gravity.as_deref(), t1, &mut self.f1);
+
+        // Prescribed increments on constrained dofs, zero elsewhere.
+        self.du.fill(0.0);
+        let mut moving = false;
+        for c in &self.model.constraints {
+            let d = c.at(t1) - s.u[c.dof];
+            if d != 0.0 {
+                self.du[c.dof] = d;
+                moving = true;
+            }
+        }
+        // r = K_eff Δu_c − M v/h + f_int − f_ext¹, wanted on the free dofs only.
+        if moving {
+            self.asm.pattern.matvec(&self.k, &self.du, &mut self.kdu);
+            self.mass.matvec(&self.asm.pattern, &self.du, &mut self.mv1);
+        }
+        self.rhs.clear();
+        for &d in &self.dofs.free {
+            let mut r = -s.mv[d] / h + s.fint[d] - self.f1[d];
+            if moving {
+                r += self.c_m * self.mv1[d] + self.c_k * self.kdu[d];
+            }
+            self.rhs.push(-r);
+        }
+        let t_solve = Instant::now();
+        self.solver.solve_in_place(&mut self.rhs)?;
+        let solve_s = t_solve.elapsed().as_secs_f64();
+        self.timing.solve_s += solve_s;
+        for (eq, &d) in self.dofs.free.iter().enumerate() {
+            self.du[d] = self.rhs[eq];
+        }
+
+        // New velocity, M v¹ and K Δu in one pass.
+        for (v, du) in self.v1.iter_mut().zip(&self.du) {
+            *v = du / h;
+        }
+        let (v1, mv1) = (&self.v1, &mut self.mv1);
+        match &self.mass {
+            Mass::Consistent(m) => {
+                self.asm
+                    .pattern
+                    .matvec2(&self.k, &self.du, &mut self.kdu, m, v1, mv1)
+            }
+            Mass::Lumped(_) => {
+                self.asm.pattern.matvec(&self.k, &self.du, &mut self.kdu);
+                self.mass.matvec(&self.asm.pattern, v1, mv1);
+            }
+        }
+        let mv1 = &self.mv1;
+
+        // Residual of the step equation; on constrained dofs it is the reaction.
+        let mut inc = StepIncrements::default();
+        let (mut r2, mut f2) = (0.0, 0.0);
+        let mut e_el = 0.0;
+        let mut mat_num = 0.0;
+        for i in 0..n {
+            let fint1 = s.fint[i] + self.kdu[i];
+            let cv1 = self.damp_m * mv1[i] + self.damp_k * self.kdu[i] / h;
+            let inertia = (mv1[i] - s.mv[i]) / h;
+            let res = inertia + cv1 + fint1 - self.f1[i];
+            let fext1 = if self.dofs.eq[i] == usize::MAX {
+                self.f1[i] + res
+            } else {
+                r2 += res * res;
+                f2 += self.f1[i].powi(2) + fint1.powi(2) + inertia.powi(2);
+                self.f1[i]
+            };
+            let du = self.du[i];
+            let u1 = s.u[i] + du;
+            inc.kinetic += 0.5 * v1[i] * mv1[i];
+            inc.internal_work += 0.5 * du * (s.fint[i] + fint1);
+            inc.external_work += 0.5 * du * (s.fext[i] + fext1);
+            inc.load_jump += 0.5 * du * (fext1 - s.fext[i]);
+            inc.mass_damping += du * cv1;
+            inc.kinetic_loss += 0.5 * (v1[i] - s.v[i]) * (mv1[i] - s.mv[i]);
+            e_el += 0.5 * u1 * fint1;
+            mat_num += 0.5 * du * self.kdu[i];
+            s.u[i] = u1;
+            s.fint[i] = fint1;
+            s.fext[i] = fext1;
+        }
+        inc.elastic = e_el;
+        inc.material = Dissipation {
+            numerical: mat_num,
+            ..Default::default()
+        };
+        std::mem::swap(&mut s.v, &mut self.v1);
+        std::mem::swap(&mut s.mv, &mut self.mv1);
+        s.t = t1;
+        s.step += 1;
+        s.ledger.record(&inc);
+        let total = t_start.elapsed().as_secs_f64();
+        self.timing.step_other_s += total - solve_s;
+        Ok(StepReport {
+            iterations: 1,
+            nl_residual: if f2 > 0.0 {
+                (r2 / f2).sqrt()
+            } else {
+                r2.sqrt()
+            },
+        })
+    }
+
+    /// Effective-matrix coefficients `(c_M, c_K)`.
+    pub fn coefficients(&self) -> (f64, f64) {
+        (self.c_m, self.c_k)
+    }
+
+    /// Refactorises after a change of `h` (same pattern, new values).
+    pub fn set_step(&mut self, h: f64) -> Result<()> {
+        self.h = h;
+        self.c_m = 1.0 / (h * h) + self.damp_m / h;
+        self.c_k = 1.0 + self.damp_k / h;
+        let t = Instant::now();
+        self.reduced
+            .fill(&self.dofs, self.c_m, &self.mass, &[(self.c_k, &self.k)]);
+        self.solver.factorize(&self.reduced.csc)?;
+        self.factorizations += 1;
+        self.timing.factorization_s += t.elapsed().as_secs_f64();
+        Ok(())
+    }
+}
+
+/// Dot product.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

@@ -1,0 +1,116 @@
+//! Free and constrained dofs, and the effective matrix restricted to the free dofs.
+
+use crate::assembly::{Mass, Pattern};
+use crate::linsolve::LowerCsc;
+
+/// Numbering of the free dofs; constrained dofs get `usize::MAX`.
+#[derive(Clone, Debug)]
+pub struct DofMap {
+    /// Equation number of each dof.
+    pub eq: Vec<usize>,
+    /// Free dofs in equation order.
+    pub free: Vec<usize>,
+}
+
+impl DofMap {
+    /// Numbers the dofs not in `constrained`, keeping their natural order.
+    pub fn new(n_dofs: usize, constrained: impl IntoIterator<Item = usize>) -> Self {
+        let mut eq = vec![0usize; n_dofs];
+        for d in constrained {
+            eq[d] = usize::MAX;
+        }
+        let mut free = Vec::with_capacity(n_dofs);
+        for (d, e) in eq.iter_mut().enumerate() {
+            if *e != usize::MAX {
+                *e = free.len();
+                free.push(d);
+            }
+        }
+        DofMap { eq, free }
+    }
+
+    /// Number of free dofs.
+    pub fn n_free(&self) -> usize {
+        self.free.len()
+    }
+}
+
+/// The lower triangle of `Σ c_i A_i` on the free dofs, with the map from its entries to
+/// the shared full pattern, so refills cost one pass.
+pub struct ReducedMatrix {
+    /// The matrix handed to the solver.
+    pub csc: LowerCsc,
+    /// Position in the full pattern of each entry.
+    src: Vec<usize>,
+    /// Free dof of each column (for lumped-mass diagonals).
+    diag_pos: Vec<usize>,
+}
+
+impl ReducedMatrix {
+    /// Builds the free-dof lower pattern of `pattern`.
+    pub fn new(pattern: &Pattern, dofs: &DofMap) -> Self {
+        let nf = dofs.n_free();
+        let mut col_ptr = Vec::with_capacity(nf + 1);
+        col_ptr.push(0);
+        let mut row_idx = Vec::new();
+        let mut src = Vec::new();
+        let mut diag_pos = Vec::with_capacity(nf);
+        for n in 0..pattern.n_nodes {
+            let nbrs = &pattern.adj[pattern.adj_ptr[n]..pattern.adj_ptr[n + 1]];
+            for j in 0..2 {
+                let ec = dofs.eq[2 * n + j];
+                if ec == usize::MAX {
+                    continue;
+                }
+                let c0 = pattern.col_start(n, j);
+                for (k, &m) in nbrs.iter().enumerate() {
+                    for i in 0..2 {
+                        let er = dofs.eq[2 * m as usize + i];
+                        if er != usize::MAX && er >= ec {
+                            if er == ec {
+                                diag_pos.push(row_idx.len());
+                            }
+                            row_idx.push(er);
+                            src.push(c0 + 2 * k + i);
+                        }
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        let nnz = row_idx.len();
+        ReducedMatrix {
+            csc: LowerCsc {
+                n: nf,
+                col_ptr,
+                row_idx,
+                values: vec![0.0; nnz],
+            },
+            src,
+            diag_pos,
+        }
+    }
+
+    /// Refills the values with `c_m M + Σ (c_i, A_i)` restricted to the free dofs.
+    pub fn fill(&mut self, dofs: &DofMap, c_m: f64, mass: &Mass, terms: &[(f64, &[f64])]) {
+        let v = &mut self.csc.values;
+        for (p, out) in v.iter_mut().enumerate() {
+            let s = self.src[p];
+            *out = terms.iter().map(|(c, a)| c * a[s]).sum();
+        }
+        match mass {
+            Mass::Consistent(m) => {
+                if c_m != 0.0 {
+                    for (p, out) in v.iter_mut().enumerate() {
+                        *out += c_m * m[self.src[p]];
+                    }
+                }
+            }
+            Mass::Lumped(d) => {
+                for (eq, &p) in self.diag_pos.iter().enumerate() {
+                    v[p] += c_m * d[dofs.free[eq]];
+                }
+            }
+        }
+    }
+}
