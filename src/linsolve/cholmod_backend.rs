@@ -1,35 +1,424 @@
-//! SuiteSparse CHOLMOD backend (feature `cholmod`). Placeholder until implemented.
+//! SuiteSparse CHOLMOD backend (cargo feature `cholmod`): supernodal `L Lᵀ` through
+//! the `cholmod_l_*` (64-bit index) interface of `suitesparse_sys`.
+//!
+//! Same contract as [`super::faer_backend::FaerCholesky`]: [`CholmodCholesky::analyze`]
+//! runs `cholmod_l_analyze` once per pattern, [`CholmodCholesky::factorize`] copies
+//! the new values into a buffer owned here and runs `cholmod_l_factorize` into the
+//! same factor, [`CholmodCholesky::solve_in_place`] runs `cholmod_l_solve2`, whose
+//! solution and workspaces (`X`, `Y`, `E`) CHOLMOD allocates on the first solve and
+//! reuses afterwards, so a solve does not allocate.
+//!
+//! Ordering: CHOLMOD's default tries AMD and then METIS/NESDIS and keeps the best.
+//! Here `nmethods = 1` with `method[0].ordering = CHOLMOD_AMD`, so this backend and
+//! faer both use AMD and their timings compare the factorisation codes rather than
+//! the orderings. The factorisation is always supernodal (`CHOLMOD_SUPERNODAL`); its
+//! dense kernels run on the system BLAS (OpenBLAS if installed).
+//!
+//! CHOLMOD's own messages are silenced (`print = 0`): failures come back as
+//! [`Error::Solver`] with backend `"cholmod"`.
 
-use super::{LowerCsc, SymmetricSolver};
+use std::ffi::c_void;
+use std::ptr;
+
+use suitesparse_sys::{
+    cholmod_common, cholmod_dense, cholmod_factor, cholmod_l_analyze, cholmod_l_factorize,
+    cholmod_l_finish, cholmod_l_free_dense, cholmod_l_free_factor, cholmod_l_solve2,
+    cholmod_l_start, cholmod_sparse, CHOLMOD_A, CHOLMOD_AMD, CHOLMOD_DOUBLE, CHOLMOD_LONG,
+    CHOLMOD_NOT_POSDEF, CHOLMOD_OK, CHOLMOD_REAL, CHOLMOD_SUPERNODAL,
+};
+
+use super::{not_analysed, LowerCsc, SymmetricSolver};
 use crate::error::{Error, Result};
 
-/// CHOLMOD supernodal Cholesky.
-pub struct CholmodCholesky;
+const NAME: &str = "cholmod";
+
+// CHOLMOD's `long` integer arrays (itype CHOLMOD_LONG) are `SuiteSparse_long`, which is
+// 64 bits on the targets we build for; the index copies below are `i64`.
+const _: () = assert!(std::mem::size_of::<std::os::raw::c_long>() == 8);
+
+fn err(message: impl Into<String>) -> Error {
+    Error::Solver {
+        backend: NAME,
+        message: message.into(),
+    }
+}
+
+/// Name of a CHOLMOD `common.status` code, for messages.
+fn status_name(status: i32) -> &'static str {
+    match status {
+        0 => "ok",
+        -1 => "method not installed",
+        -2 => "out of memory",
+        -3 => "integer overflow",
+        -4 => "invalid input",
+        -5 => "GPU error",
+        1 => "not positive definite",
+        2 => "tiny diagonal entry",
+        _ => "unknown status",
+    }
+}
+
+/// CHOLMOD supernodal Cholesky with a persistent factor and solve workspaces.
+pub struct CholmodCholesky {
+    /// CHOLMOD's workspace and parameters; boxed because CHOLMOD keeps no pointer to it
+    /// but it must stay at one address between `cholmod_l_start` and `cholmod_l_finish`.
+    common: Box<cholmod_common>,
+    /// The factor (symbolic after `analyze`, numeric after `factorize`), or null.
+    factor: *mut cholmod_factor,
+    /// Solution and workspaces of `cholmod_l_solve2`, allocated by CHOLMOD on the first
+    /// solve and reused, or null.
+    x: *mut cholmod_dense,
+    y: *mut cholmod_dense,
+    e: *mut cholmod_dense,
+    /// Dimension of the analysed matrix.
+    n: usize,
+    /// Column pointers of the analysed pattern as CHOLMOD longs.
+    col_ptr: Vec<i64>,
+    /// Row indices of the analysed pattern as CHOLMOD longs.
+    row_idx: Vec<i64>,
+    /// Values of the matrix handed to CHOLMOD (refilled by every `factorize`).
+    values: Vec<f64>,
+    /// Right-hand side copy wrapped as the dense `B` of `cholmod_l_solve2`.
+    b: Vec<f64>,
+    /// Whether the factor holds a successful numeric factorisation.
+    factorized: bool,
+}
+
+// SAFETY: the raw pointers are owned exclusively by this struct (CHOLMOD objects
+// allocated through `common`, which is also owned); nothing is shared with another
+// value or thread and CHOLMOD keeps no thread-local state tied to them. The solver is
+// used from one thread at a time (`&mut self` for every call that touches CHOLMOD), so
+// moving it to another thread is sound.
+unsafe impl Send for CholmodCholesky {}
 
 impl CholmodCholesky {
-    /// A new solver.
+    /// A solver with nothing analysed yet: starts CHOLMOD and sets its parameters
+    /// (supernodal, AMD only, silent).
     pub fn new() -> Result<Self> {
-        Err(Error::Solver {
-            backend: "cholmod",
-            message: "not implemented yet".into(),
+        // SAFETY: `cholmod_common` is a plain C struct of integers, floats, raw pointers
+        // and an optional function pointer, for all of which all-zero bytes are valid.
+        let mut common: Box<cholmod_common> =
+            unsafe { Box::<cholmod_common>::new_zeroed().assume_init() };
+        // SAFETY: `common` points to a valid, exclusively owned `cholmod_common` on the
+        // heap, which does not move until `cholmod_l_finish` in `Drop`.
+        let ok = unsafe { cholmod_l_start(&mut *common) };
+        if ok == 0 {
+            return Err(err(format!(
+                "cholmod_l_start failed (status {})",
+                common.status
+            )));
+        }
+        common.print = 0;
+        common.supernodal = CHOLMOD_SUPERNODAL as i32;
+        common.nmethods = 1;
+        common.method[0].ordering = CHOLMOD_AMD as i32;
+        common.postorder = 1;
+        Ok(CholmodCholesky {
+            common,
+            factor: ptr::null_mut(),
+            x: ptr::null_mut(),
+            y: ptr::null_mut(),
+            e: ptr::null_mut(),
+            n: 0,
+            col_ptr: Vec::new(),
+            row_idx: Vec::new(),
+            values: Vec::new(),
+            b: Vec::new(),
+            factorized: false,
         })
+    }
+
+    /// Frees the factor and the solve workspaces (null pointers are left alone).
+    fn free_all(&mut self) {
+        for d in [&mut self.x, &mut self.y, &mut self.e] {
+            if !d.is_null() {
+                // SAFETY: `*d` was allocated by CHOLMOD with this `common` in
+                // `cholmod_l_solve2` and is freed once: CHOLMOD nulls it.
+                unsafe { cholmod_l_free_dense(d, &mut *self.common) };
+                *d = ptr::null_mut();
+            }
+        }
+        if !self.factor.is_null() {
+            // SAFETY: the factor was returned by `cholmod_l_analyze` with this `common`
+            // and is freed once: CHOLMOD nulls the pointer.
+            unsafe { cholmod_l_free_factor(&mut self.factor, &mut *self.common) };
+            self.factor = ptr::null_mut();
+        }
+        self.factorized = false;
+    }
+
+    /// A `cholmod_sparse` header over the owned pattern and value buffers: lower
+    /// triangle (`stype = -1`), long indices, real double, sorted and packed. The
+    /// buffers are not resized while a factor exists, so the pointers stay valid for
+    /// the CHOLMOD call the header is built for.
+    fn sparse_header(&mut self) -> cholmod_sparse {
+        cholmod_sparse {
+            nrow: self.n,
+            ncol: self.n,
+            nzmax: self.row_idx.len(),
+            p: self.col_ptr.as_mut_ptr() as *mut c_void,
+            i: self.row_idx.as_mut_ptr() as *mut c_void,
+            nz: ptr::null_mut(),
+            x: self.values.as_mut_ptr() as *mut c_void,
+            z: ptr::null_mut(),
+            stype: -1,
+            itype: CHOLMOD_LONG as i32,
+            xtype: CHOLMOD_REAL as i32,
+            dtype: CHOLMOD_DOUBLE as i32,
+            sorted: 1,
+            packed: 1,
+        }
+    }
+
+    /// Checks that `a` is a well-formed lower CSC matrix (CHOLMOD reads the arrays
+    /// without bounds checks, so a bad index must not reach it).
+    fn check_pattern(a: &LowerCsc) -> Result<()> {
+        let n = a.n;
+        if a.col_ptr.len() != n + 1 {
+            return Err(err(format!(
+                "col_ptr has {} entries, expected n + 1 = {}",
+                a.col_ptr.len(),
+                n + 1
+            )));
+        }
+        if a.col_ptr[0] != 0 || a.col_ptr[n] != a.row_idx.len() {
+            return Err(err(format!(
+                "col_ptr must run from 0 to nnz = {} (got {} .. {})",
+                a.row_idx.len(),
+                a.col_ptr[0],
+                a.col_ptr[n]
+            )));
+        }
+        if a.values.len() != a.row_idx.len() {
+            return Err(err(format!(
+                "{} values for {} row indices",
+                a.values.len(),
+                a.row_idx.len()
+            )));
+        }
+        for j in 0..n {
+            let (start, end) = (a.col_ptr[j], a.col_ptr[j + 1]);
+            if start > end {
+                return Err(err(format!("col_ptr decreases at column {j}")));
+            }
+            let mut prev = None;
+            for &i in &a.row_idx[start..end] {
+                if i < j || i >= n {
+                    return Err(err(format!(
+                        "row index {i} in column {j} is outside the lower triangle of a \
+                         {n}x{n} matrix"
+                    )));
+                }
+                if prev.is_some_and(|p| i <= p) {
+                    return Err(err(format!(
+                        "row indices of column {j} are not strictly increasing"
+                    )));
+                }
+                prev = Some(i);
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether `a` has exactly the analysed pattern.
+    fn same_pattern(&self, a: &LowerCsc) -> bool {
+        a.n == self.n
+            && a.col_ptr.len() == self.col_ptr.len()
+            && a.row_idx.len() == self.row_idx.len()
+            && a.values.len() == self.row_idx.len()
+            && a.col_ptr
+                .iter()
+                .zip(&self.col_ptr)
+                .all(|(&x, &y)| x as i64 == y)
+            && a.row_idx
+                .iter()
+                .zip(&self.row_idx)
+                .all(|(&x, &y)| x as i64 == y)
+    }
+}
+
+impl Drop for CholmodCholesky {
+    fn drop(&mut self) {
+        self.free_all();
+        // SAFETY: `common` was started in `new` and is finished exactly once, after
+        // every CHOLMOD object allocated with it has been freed.
+        unsafe { cholmod_l_finish(&mut *self.common) };
     }
 }
 
 impl SymmetricSolver for CholmodCholesky {
     fn name(&self) -> &'static str {
-        "cholmod"
+        NAME
     }
-    fn analyze(&mut self, _a: &LowerCsc) -> Result<()> {
-        unreachable!()
+
+    fn analyze(&mut self, a: &LowerCsc) -> Result<()> {
+        Self::check_pattern(a)?;
+        self.free_all();
+        let to_long = |v: usize| {
+            i64::try_from(v).map_err(|_| err(format!("index {v} does not fit CHOLMOD's long")))
+        };
+        self.n = a.n;
+        self.col_ptr = a
+            .col_ptr
+            .iter()
+            .map(|&v| to_long(v))
+            .collect::<Result<_>>()?;
+        self.row_idx = a
+            .row_idx
+            .iter()
+            .map(|&v| to_long(v))
+            .collect::<Result<_>>()?;
+        // Values are not read by the analysis; zeros keep the buffer initialised.
+        self.values = vec![0.0; a.row_idx.len()];
+        self.b = vec![0.0; a.n];
+        let mut header = self.sparse_header();
+        // SAFETY: `header` describes valid, checked arrays (n + 1 column pointers, nnz
+        // in-range sorted row indices and nnz values) owned by `self` and alive for the
+        // call; `common` was started in `new`. The returned factor is owned by `self`.
+        self.factor = unsafe { cholmod_l_analyze(&mut header, &mut *self.common) };
+        if self.factor.is_null() || self.common.status < CHOLMOD_OK as i32 {
+            let status = self.common.status;
+            self.free_all();
+            return Err(err(format!(
+                "cholmod_l_analyze failed: {} (status {status})",
+                status_name(status)
+            )));
+        }
+        Ok(())
     }
-    fn factorize(&mut self, _a: &LowerCsc) -> Result<()> {
-        unreachable!()
+
+    fn factorize(&mut self, a: &LowerCsc) -> Result<()> {
+        if self.factor.is_null() {
+            return Err(not_analysed(NAME));
+        }
+        if !self.same_pattern(a) {
+            return Err(err(
+                "factorize: the matrix pattern differs from the analysed one",
+            ));
+        }
+        self.factorized = false;
+        for (k, (dst, &src)) in self.values.iter_mut().zip(&a.values).enumerate() {
+            if !src.is_finite() {
+                return Err(err(format!("matrix entry {k} is not finite ({src})")));
+            }
+            *dst = src;
+        }
+        let mut header = self.sparse_header();
+        // SAFETY: `header` points into buffers owned by `self` with the analysed
+        // pattern (checked above), `self.factor` was produced by `cholmod_l_analyze`
+        // for that pattern with this `common`, and nothing else aliases them.
+        let ok = unsafe { cholmod_l_factorize(&mut header, self.factor, &mut *self.common) };
+        let status = self.common.status;
+        if ok == 0 || status < CHOLMOD_OK as i32 {
+            return Err(err(format!(
+                "cholmod_l_factorize failed: {} (status {status})",
+                status_name(status)
+            )));
+        }
+        // SAFETY: `self.factor` is non-null and valid (checked above); we only read
+        // scalar fields and, if `minor < n`, entry `minor` of its size-n `Perm` array.
+        let (minor, n, col) = unsafe {
+            let f = &*self.factor;
+            let col = if f.minor < f.n && !f.Perm.is_null() {
+                Some(*(f.Perm as *const i64).add(f.minor))
+            } else {
+                None
+            };
+            (f.minor, f.n, col)
+        };
+        if status == CHOLMOD_NOT_POSDEF as i32 || minor < n {
+            let at = match col {
+                Some(c) => format!("at column {c} (pivot {minor} of {n} in AMD order)"),
+                None => format!("at pivot {minor} of {n}"),
+            };
+            return Err(err(format!(
+                "numeric factorisation failed {at}: the effective matrix is not positive \
+                 definite (a body without supports in a static run, or a bad material)"
+            )));
+        }
+        self.factorized = true;
+        Ok(())
     }
-    fn solve_in_place(&mut self, _rhs: &mut [f64]) -> Result<()> {
-        unreachable!()
+
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()> {
+        if self.factor.is_null() || !self.factorized {
+            return Err(not_analysed(NAME));
+        }
+        let n = self.n;
+        if rhs.len() != n {
+            return Err(err(format!(
+                "right-hand side has {} entries, the matrix {n} rows",
+                rhs.len()
+            )));
+        }
+        if n == 0 {
+            return Ok(());
+        }
+        self.b.copy_from_slice(rhs);
+        let mut b = cholmod_dense {
+            nrow: n,
+            ncol: 1,
+            nzmax: n,
+            d: n,
+            x: self.b.as_mut_ptr() as *mut c_void,
+            z: ptr::null_mut(),
+            xtype: CHOLMOD_REAL as i32,
+            dtype: CHOLMOD_DOUBLE as i32,
+        };
+        // SAFETY: the factor is numeric and valid (factorized), `b` describes the owned
+        // n-vector `self.b`, `x`/`y`/`e` are null or n-by-1 dense matrices CHOLMOD
+        // allocated with this `common` in a previous call (it reallocates them if
+        // their shape does not fit), and no sparse Bset/Xset is used.
+        let ok = unsafe {
+            cholmod_l_solve2(
+                CHOLMOD_A as i32,
+                self.factor,
+                &mut b,
+                ptr::null_mut(),
+                &mut self.x,
+                ptr::null_mut(),
+                &mut self.y,
+                &mut self.e,
+                &mut *self.common,
+            )
+        };
+        if ok == 0 || self.x.is_null() {
+            let status = self.common.status;
+            return Err(err(format!(
+                "cholmod_l_solve2 failed: {} (status {status})",
+                status_name(status)
+            )));
+        }
+        // SAFETY: `self.x` is the n-by-1 real double solution CHOLMOD just wrote; its
+        // `x` array holds at least `n` doubles and does not overlap `rhs`.
+        unsafe {
+            let x = &*self.x;
+            if x.nrow != n || x.ncol != 1 || x.x.is_null() {
+                return Err(err(
+                    "cholmod_l_solve2 returned a solution of the wrong shape",
+                ));
+            }
+            rhs.copy_from_slice(std::slice::from_raw_parts(x.x as *const f64, n));
+        }
+        Ok(())
     }
+
+    /// nnz(L) as the sum of `L->ColCount`: the exact column counts of the Cholesky
+    /// factor for the chosen ordering, without the explicit zeros that relaxed
+    /// supernode amalgamation stores (`xsize` would count those and the padding of
+    /// the supernodes' dense blocks).
     fn factor_nnz(&self) -> Option<usize> {
-        None
+        if self.factor.is_null() {
+            return None;
+        }
+        // SAFETY: the factor is valid; its `ColCount` array has `n` long entries.
+        let counts = unsafe {
+            let f = &*self.factor;
+            if f.ColCount.is_null() {
+                return None;
+            }
+            std::slice::from_raw_parts(f.ColCount as *const i64, f.n)
+        };
+        Some(counts.iter().map(|&c| c.max(0) as usize).sum())
     }
 }

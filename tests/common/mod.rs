@@ -1,0 +1,69 @@
+//! Shared builders for the integration tests.
+#![allow(dead_code)]
+
+use rothe::fe::Plane;
+use rothe::material::Material;
+use rothe::mesh::{Mesh, Part};
+use rothe::model::{Analysis, AnalysisKind, Body, Constraint, Load, Model, TimeFunction};
+
+/// A one-body model of `part` made of one elastic material, static by default.
+pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness: f64) -> Model {
+    let mut mesh = Mesh::default();
+    mesh.add_part(part, 0, "b", 0, thickness);
+    Model {
+        mesh,
+        materials: vec![Material::elastic("m", e, nu, rho)],
+        plane,
+        bodies: vec![Body {
+            name: "b".into(),
+            velocity: [0.0, 0.0],
+            thickness,
+        }],
+        constraints: Vec::new(),
+        loads: Vec::new(),
+        gravity: None,
+        probes: Vec::new(),
+        analysis: Analysis {
+            kind: AnalysisKind::Static,
+            dt: 1.0,
+            t_end: 1.0,
+            lumped_mass: false,
+            zeta: 0.0,
+            rayleigh: [0.0, 0.0],
+            vtk_every: 0,
+        },
+    }
+}
+
+/// Holds component `comp` of `nodes` at `value(x)` (constant in time).
+pub fn prescribe(model: &mut Model, nodes: &[usize], comp: usize, value: impl Fn([f64; 2]) -> f64) {
+    for &n in nodes {
+        let v = value(model.mesh.coords[n]);
+        model.constraints.push(Constraint {
+            dof: 2 * n + comp,
+            value: v,
+            function: TimeFunction::Constant,
+        });
+    }
+    model.constraints.sort_by_key(|c| c.dof);
+    model.constraints.dedup_by_key(|c| c.dof);
+}
+
+/// A load from a dense force vector.
+pub fn load_from(f: &[f64], function: TimeFunction) -> Load {
+    Load {
+        label: "test".into(),
+        entries: f
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v != 0.0)
+            .map(|(d, v)| (d, *v))
+            .collect(),
+        function,
+    }
+}
+
+/// Observed order from errors at successive halvings.
+pub fn orders(errors: &[f64]) -> Vec<f64> {
+    errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+}
