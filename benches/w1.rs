@@ -1,1 +1,46 @@
-fn main() {}
+//! Criterion benches of workload W1 (see `rothe::workload`): element assembly of K and
+//! M, numeric factorisation of the effective matrix, and one backward-Euler step, each
+//! at several sizes (`ny`), with setup outside the timed loop. Larger sizes and the
+//! CHOLMOD backend: `cargo run --release --example w1 -- NY [faer|cholmod]`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use rothe::assembly::Assembler;
+use rothe::linsolve::Backend;
+use rothe::time::backward_euler::BackwardEuler;
+
+fn assembly(c: &mut Criterion) {
+    let mut g = c.benchmark_group("w1_assembly");
+    g.sample_size(10);
+    for ny in [25usize, 100] {
+        let model = rothe::workload::w1(ny).unwrap();
+        let asm = Assembler::new(&model.mesh);
+        g.bench_with_input(BenchmarkId::new("stiffness", ny), &ny, |b, _| {
+            b.iter(|| asm.stiffness(&model.mesh, &model.materials, model.plane))
+        });
+        g.bench_with_input(BenchmarkId::new("consistent_mass", ny), &ny, |b, _| {
+            b.iter(|| asm.mass(&model.mesh, &model.materials, false))
+        });
+        g.bench_with_input(BenchmarkId::new("pattern_and_colours", ny), &ny, |b, _| {
+            b.iter(|| Assembler::new(&model.mesh))
+        });
+    }
+    g.finish();
+}
+
+fn factorisation_and_step(c: &mut Criterion) {
+    let mut g = c.benchmark_group("w1_solver");
+    g.sample_size(10);
+    for ny in [25usize, 100] {
+        let model = rothe::workload::w1(ny).unwrap();
+        let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
+        g.bench_with_input(BenchmarkId::new("refactorize", ny), &ny, |b, _| {
+            b.iter(|| be.set_step(model.analysis.dt).unwrap())
+        });
+        let mut s = be.initial_state();
+        g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| b.iter(|| be.step(&mut s).unwrap()));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, assembly, factorisation_and_step);
+criterion_main!(benches);

@@ -29,5 +29,6 @@ pub mod model;
 pub mod output;
 pub mod run;
 pub mod time;
+pub mod workload;
 
 pub use error::{Error, Result};

@@ -259,7 +259,13 @@ pub fn load(path: &Path) -> Result<Model> {
         other => other,
     })?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    validate::build(&scenario, dir)
+    validate::build(&scenario, dir).map_err(|e| match e {
+        Error::Config { field, message } => Error::Config {
+            field: format!("{}: {field}", path.display()),
+            message,
+        },
+        other => other,
+    })
 }
 
 /// Parses scenario text (no validation).

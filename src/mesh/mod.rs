@@ -226,7 +226,7 @@ impl Mesh {
         Ok(())
     }
 
-    /// Smallest characteristic length per element block (used by the CFL estimate):
+    /// Characteristic length of element `e` of `block` (the CFL estimate takes the minimum):
     /// for a triangle its smallest altitude, for a quadrilateral its area over its
     /// longest diagonal, for a bar its length.
     pub fn element_length(&self, block: usize, e: usize) -> f64 {

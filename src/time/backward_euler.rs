@@ -48,7 +48,7 @@ pub struct DynState {
 pub struct StepReport {
     /// Linear solves taken.
     pub iterations: usize,
-    /// `|r_free| / max(|f_ext|, |f_int|, |M a|)` at the end of the step.
+    /// `sqrt(Σ r² / Σ (f_ext² + f_int² + (M a)²))` over the free dofs at the end of the step.
     pub nl_residual: f64,
 }
 

@@ -1,0 +1,47 @@
+//! Workload W1, the project's speed yardstick: a plane-stress rectangle 2.0 m x 0.5 m,
+//! thickness 0.2 m, structured Q4 with `nx = 4 ny`, `E = 30e9, ν = 0.2, ρ = 2400`,
+//! consistent mass, left edge fixed, a step traction of 1e6 Pa downwards on the top
+//! edge, backward Euler `h = 1e-5`, 100 steps from rest; probe `u_y` at (2.0, 0.25).
+
+use crate::error::Result;
+use crate::model::Model;
+
+/// The W1 scenario text for `ny` cells across the height.
+pub fn w1_scenario(ny: usize) -> String {
+    format!(
+        r#"
+[analysis]
+t_end = 1.0e-3
+dt = 1.0e-5
+mass = "consistent"
+vtk_every = 0
+[materials.concrete]
+model = "elastic"
+E = 30e9
+nu = 0.2
+rho = 2400.0
+[[bodies]]
+name = "beam"
+material = "concrete"
+thickness = 0.2
+mesh = {{ kind = "rectangle", size = [2.0, 0.5], divisions = [{nx}, {ny}] }}
+[[supports]]
+set = "beam.left"
+fix = ["x", "y"]
+[[loads]]
+kind = "traction"
+set = "beam.top"
+value = [0.0, -1.0e6]
+function = {{ kind = "step", at = 0.0 }}
+[[probes]]
+name = "tip"
+at = [2.0, 0.25]
+"#,
+        nx = 4 * ny
+    )
+}
+
+/// The W1 model for `ny` cells across the height.
+pub fn w1(ny: usize) -> Result<Model> {
+    crate::config::from_str(&w1_scenario(ny), std::path::Path::new("."))
+}

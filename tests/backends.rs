@@ -1,0 +1,477 @@
+//! CHOLMOD against faer: same solutions on SPD matrices, refactorisation on a fixed
+//! pattern, errors (not panics) on bad input, and identical static and dynamic runs.
+#![cfg(feature = "cholmod")]
+
+use std::path::Path;
+use std::time::Instant;
+
+use rothe::assembly::{Assembler, Mass};
+use rothe::linsolve::cholmod_backend::CholmodCholesky;
+use rothe::linsolve::faer_backend::FaerCholesky;
+use rothe::linsolve::{Backend, LowerCsc, SymmetricSolver};
+use rothe::model::Model;
+use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::statics;
+use rothe::time::system::{DofMap, ReducedMatrix};
+
+const TOL: f64 = 1e-10;
+
+/// `max|a − b| / max|b|`.
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let num = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    let den = b.iter().map(|y| y.abs()).fold(0.0, f64::max);
+    if den == 0.0 {
+        num
+    } else {
+        num / den
+    }
+}
+
+/// Lower triangle of the 5-point Laplacian on an `m × m` grid plus `shift · I`.
+fn laplacian(m: usize, shift: f64) -> LowerCsc {
+    let n = m * m;
+    let mut col_ptr = vec![0];
+    let mut row_idx = Vec::new();
+    let mut values = Vec::new();
+    for j in 0..n {
+        let (x, y) = (j % m, j / m);
+        row_idx.push(j);
+        values.push(4.0 + shift);
+        if x + 1 < m {
+            row_idx.push(j + 1);
+            values.push(-1.0);
+        }
+        if y + 1 < m {
+            row_idx.push(j + m);
+            values.push(-1.0);
+        }
+        col_ptr.push(row_idx.len());
+    }
+    LowerCsc {
+        n,
+        col_ptr,
+        row_idx,
+        values,
+    }
+}
+
+/// A deterministic, non-trivial right-hand side.
+fn rhs(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| ((i as f64) * 0.37).sin() + 0.1 * (i % 7) as f64)
+        .collect()
+}
+
+fn solve_with(solver: &mut dyn SymmetricSolver, a: &LowerCsc, b: &[f64]) -> Vec<f64> {
+    solver.analyze(a).expect("analyze");
+    solver.factorize(a).expect("factorize");
+    let mut x = b.to_vec();
+    solver.solve_in_place(&mut x).expect("solve");
+    x
+}
+
+/// Relative residual `|A x − b|∞ / |b|∞`.
+fn residual(a: &LowerCsc, x: &[f64], b: &[f64]) -> f64 {
+    let mut ax = vec![0.0; a.n];
+    a.sym_matvec(x, &mut ax);
+    rel_diff(&ax, b)
+}
+
+fn cantilever_text(kind: &str, divisions: [usize; 2], t_end: f64) -> String {
+    format!(
+        r#"
+[analysis]
+kind = "{kind}"
+t_end = {t_end:e}
+dt = 1.0e-5
+plane = "stress"
+mass = "consistent"
+vtk_every = 0
+
+[materials.concrete]
+model = "elastic"
+E = 30e9
+nu = 0.2
+rho = 2400.0
+
+[[bodies]]
+name = "beam"
+material = "concrete"
+thickness = 0.2
+mesh = {{ kind = "rectangle", size = [2.0, 0.5], divisions = [{}, {}] }}
+
+[[supports]]
+set = "beam.left"
+fix = ["x", "y"]
+
+[[loads]]
+kind = "traction"
+set = "beam.top"
+value = [0.0, -1.0e6]
+function = {{ kind = "step", at = 0.0 }}
+
+[[probes]]
+name = "tip"
+at = [2.0, 0.25]
+"#,
+        divisions[0], divisions[1]
+    )
+}
+
+fn cantilever(kind: &str, divisions: [usize; 2], t_end: f64) -> Model {
+    rothe::config::from_str(&cantilever_text(kind, divisions, t_end), Path::new("."))
+        .expect("valid scenario")
+}
+
+/// The reduced effective matrix `c_m M + c_k K` of a model, as the integrator builds it.
+fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> LowerCsc {
+    let asm = Assembler::new(&model.mesh);
+    let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+    let mass = asm.mass(&model.mesh, &model.materials, false);
+    let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+    let mut reduced = ReducedMatrix::new(&asm.pattern, &dofs);
+    reduced.fill(&dofs, c_m, &mass, &[(c_k, &k)]);
+    reduced.csc
+}
+
+fn stiffness_matrix(model: &Model) -> LowerCsc {
+    let n = model.mesh.n_dofs();
+    let asm = Assembler::new(&model.mesh);
+    let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+    let dofs = DofMap::new(n, model.constraints.iter().map(|c| c.dof));
+    let mut reduced = ReducedMatrix::new(&asm.pattern, &dofs);
+    reduced.fill(&dofs, 0.0, &Mass::Lumped(vec![0.0; n]), &[(1.0, &k)]);
+    reduced.csc
+}
+
+fn test_matrices() -> Vec<(&'static str, LowerCsc)> {
+    let model = cantilever("dynamic", [20, 6], 1e-4);
+    let h: f64 = 1e-5;
+    vec![
+        ("1x1", laplacian(1, 1.0)),
+        ("laplacian 12x12 + 0.01 I", laplacian(12, 0.01)),
+        ("laplacian 40x40 + 1e-3 I", laplacian(40, 1e-3)),
+        ("cantilever K_eff", effective_matrix(&model, 1.0 / (h * h), 1.0)),
+        ("cantilever K", stiffness_matrix(&model)),
+    ]
+}
+
+#[test]
+fn both_backends_agree_on_spd_matrices() {
+    for (name, a) in test_matrices() {
+        let b = rhs(a.n);
+        let mut faer = FaerCholesky::new();
+        let mut chol = CholmodCholesky::new().expect("cholmod starts");
+        let xf = solve_with(&mut faer, &a, &b);
+        let xc = solve_with(&mut chol, &a, &b);
+        let d = rel_diff(&xc, &xf);
+        assert!(d < TOL, "{name}: backends differ by {d:e}");
+        let r = residual(&a, &xc, &b);
+        assert!(r < 1e-8, "{name}: cholmod residual {r:e}");
+        let (nf, nc) = (faer.factor_nnz().unwrap(), chol.factor_nnz().unwrap());
+        assert!(nc >= a.row_idx.len(), "{name}: nnz(L) {nc} below nnz(A)");
+        eprintln!("{name}: n = {}, nnz(L) faer {nf} (len_val), cholmod {nc}", a.n);
+    }
+}
+
+#[test]
+fn refactorisation_on_the_same_pattern() {
+    let model = cantilever("dynamic", [20, 6], 1e-4);
+    let mut a = effective_matrix(&model, 1e10, 1.0);
+    let b = rhs(a.n);
+    let mut faer = FaerCholesky::new();
+    let mut chol = CholmodCholesky::new().unwrap();
+    faer.analyze(&a).unwrap();
+    chol.analyze(&a).unwrap();
+    let nnz0 = chol.factor_nnz();
+    // Several value sets on one analysis: the step size changes as in `set_step`.
+    for h in [1e-5, 3e-5, 1e-4, 2e-6] {
+        a = effective_matrix(&model, 1.0 / (h * h), 1.0);
+        faer.factorize(&a).unwrap();
+        chol.factorize(&a).unwrap();
+        for scale in [1.0, -2.5] {
+            let mut xf: Vec<f64> = b.iter().map(|v| v * scale).collect();
+            let mut xc = xf.clone();
+            faer.solve_in_place(&mut xf).unwrap();
+            chol.solve_in_place(&mut xc).unwrap();
+            let d = rel_diff(&xc, &xf);
+            assert!(d < TOL, "h = {h:e}, scale {scale}: backends differ by {d:e}");
+        }
+    }
+    assert_eq!(chol.factor_nnz(), nnz0, "refactorisation changed the pattern");
+
+    // Refactorising the Laplacian with new values too.
+    let mut l = laplacian(30, 0.5);
+    chol.analyze(&l).unwrap();
+    faer.analyze(&l).unwrap();
+    for shift in [0.5, 1e-4, 10.0] {
+        for (p, v) in l.values.iter_mut().enumerate() {
+            if *v > 0.0 {
+                *v = 4.0 + shift + 1e-3 * (p % 5) as f64;
+            }
+        }
+        chol.factorize(&l).unwrap();
+        faer.factorize(&l).unwrap();
+        let mut xc = rhs(l.n);
+        let mut xf = xc.clone();
+        chol.solve_in_place(&mut xc).unwrap();
+        faer.solve_in_place(&mut xf).unwrap();
+        assert!(rel_diff(&xc, &xf) < TOL, "shift {shift}");
+    }
+}
+
+#[test]
+fn not_positive_definite_is_an_error() {
+    // Indefinite: the Laplacian shifted below its smallest eigenvalue.
+    let mut a = laplacian(10, -1.0);
+    let mut chol = CholmodCholesky::new().unwrap();
+    chol.analyze(&a).unwrap();
+    let e = chol.factorize(&a).expect_err("indefinite matrix must fail");
+    let msg = e.to_string();
+    assert!(msg.contains("cholmod"), "{msg}");
+    assert!(msg.contains("not positive definite"), "{msg}");
+    assert!(msg.contains("column"), "{msg}");
+    eprintln!("indefinite: {msg}");
+    // No solve with a failed factor.
+    let mut x = rhs(a.n);
+    assert!(chol.solve_in_place(&mut x).is_err());
+
+    // The same analysis still works once the values are fixed.
+    for v in a.values.iter_mut().filter(|v| **v > 0.0) {
+        *v = 5.0;
+    }
+    chol.factorize(&a).unwrap();
+    let b = rhs(a.n);
+    let mut x = b.clone();
+    chol.solve_in_place(&mut x).unwrap();
+    assert!(residual(&a, &x, &b) < 1e-12);
+
+    // A single negative pivot, named by its column.
+    let mut d = laplacian(4, 1.0);
+    let p = d.col_ptr[9];
+    d.values[p] = -1.0;
+    let mut chol = CholmodCholesky::new().unwrap();
+    chol.analyze(&d).unwrap();
+    let msg = chol.factorize(&d).unwrap_err().to_string();
+    eprintln!("negative diagonal: {msg}");
+
+    // The cantilever without its supports: singular stiffness.
+    let mut free_model = cantilever("static", [8, 2], 1e-4);
+    free_model.constraints.clear();
+    let k = stiffness_matrix(&free_model);
+    let mut chol = CholmodCholesky::new().unwrap();
+    chol.analyze(&k).unwrap();
+    let r = chol.factorize(&k);
+    assert!(r.is_err(), "singular stiffness must fail");
+    eprintln!("singular K: {}", r.unwrap_err());
+    // The static driver reports it as an error too.
+    assert!(statics::solve(&free_model, Backend::Cholmod, &[0.0]).is_err());
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let a = laplacian(5, 1.0);
+    let mut chol = CholmodCholesky::new().unwrap();
+    let mut x = rhs(a.n);
+    assert!(chol.factorize(&a).is_err(), "factorize before analyze");
+    assert!(chol.solve_in_place(&mut x).is_err(), "solve before analyze");
+    assert!(chol.factor_nnz().is_none());
+    chol.analyze(&a).unwrap();
+    assert!(chol.solve_in_place(&mut x).is_err(), "solve before factorize");
+
+    let mut bad = a.clone();
+    bad.row_idx[1] = 99;
+    assert!(chol.analyze(&bad).is_err(), "row index out of range");
+    let mut bad = a.clone();
+    bad.row_idx[0] = 1;
+    bad.row_idx[1] = 0;
+    assert!(chol.analyze(&bad).is_err(), "unsorted / upper entries");
+    let mut bad = a.clone();
+    bad.col_ptr.pop();
+    assert!(chol.analyze(&bad).is_err(), "short col_ptr");
+    let mut bad = a.clone();
+    bad.values.pop();
+    assert!(chol.analyze(&bad).is_err(), "values length");
+
+    chol.analyze(&a).unwrap();
+    let other = laplacian(6, 1.0);
+    assert!(chol.factorize(&other).is_err(), "pattern mismatch");
+    let mut nan = a.clone();
+    nan.values[3] = f64::NAN;
+    assert!(chol.factorize(&nan).is_err(), "NaN value");
+    chol.factorize(&a).unwrap();
+    let mut short = vec![1.0; a.n - 1];
+    assert!(chol.solve_in_place(&mut short).is_err(), "rhs length");
+    let mut x = rhs(a.n);
+    chol.solve_in_place(&mut x).unwrap();
+
+    // An empty system (everything constrained) is fine.
+    let empty = LowerCsc {
+        n: 0,
+        col_ptr: vec![0],
+        row_idx: vec![],
+        values: vec![],
+    };
+    chol.analyze(&empty).unwrap();
+    chol.factorize(&empty).unwrap();
+    chol.solve_in_place(&mut []).unwrap();
+}
+
+#[test]
+fn static_cantilever_agrees() {
+    let model = cantilever("static", [40, 10], 1e-3);
+    let times = [0.0, 1e-3];
+    let sf = statics::solve(&model, Backend::Faer, &times).unwrap();
+    let sc = statics::solve(&model, Backend::Cholmod, &times).unwrap();
+    for (f, c) in sf.iter().zip(&sc) {
+        let d = rel_diff(&c.u, &f.u);
+        assert!(d < TOL, "static displacements differ by {d:e}");
+        assert!((c.elastic - f.elastic).abs() <= TOL * f.elastic.abs());
+    }
+    assert!(sf[1].u.iter().any(|&v| v != 0.0));
+}
+
+#[test]
+fn dynamic_cantilever_histories_agree() {
+    let model = cantilever("dynamic", [40, 10], 2e-4);
+    let mut bf = BackwardEuler::new(&model, Backend::Faer).unwrap();
+    let mut bc = BackwardEuler::new(&model, Backend::Cholmod).unwrap();
+    assert_eq!(bc.backend(), "cholmod");
+    assert!(bc.factor_nnz().is_some());
+    let mut sf = bf.initial_state();
+    let mut sc = bc.initial_state();
+    let steps = model.analysis.n_steps();
+    assert_eq!(steps, 20);
+    let mut worst: f64 = 0.0;
+    for step in 1..=steps {
+        bf.step(&mut sf).unwrap();
+        bc.step(&mut sc).unwrap();
+        let d = rel_diff(&sc.u, &sf.u);
+        worst = worst.max(d);
+        assert!(d < TOL, "step {step}: displacements differ by {d:e}");
+        assert!(rel_diff(&sc.v, &sf.v) < TOL, "step {step}: velocities differ");
+    }
+    // A step-size change refactorises both on the same pattern.
+    bf.set_step(5e-6).unwrap();
+    bc.set_step(5e-6).unwrap();
+    for _ in 0..5 {
+        bf.step(&mut sf).unwrap();
+        bc.step(&mut sc).unwrap();
+        worst = worst.max(rel_diff(&sc.u, &sf.u));
+    }
+    assert!(worst < TOL, "after set_step: {worst:e}");
+    eprintln!("dynamic: worst relative difference {worst:e}");
+}
+
+/// Probe displacement columns (`*_ux`, `*_uy`) of a `history.csv`.
+fn probe_columns(path: &Path) -> Vec<(String, Vec<f64>)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let wanted: Vec<usize> = (0..header.len())
+        .filter(|&c| header[c].ends_with("_ux") || header[c].ends_with("_uy"))
+        .collect();
+    let mut cols: Vec<(String, Vec<f64>)> = wanted
+        .iter()
+        .map(|&c| (header[c].to_string(), Vec::new()))
+        .collect();
+    for line in lines {
+        let fields: Vec<&str> = line.split(',').collect();
+        for (k, &c) in wanted.iter().enumerate() {
+            cols[k].1.push(fields[c].trim().parse().unwrap());
+        }
+    }
+    cols
+}
+
+#[test]
+fn full_run_histories_agree() {
+    let model = cantilever("dynamic", [20, 5], 2e-4);
+    let dir = tempfile::tempdir().unwrap();
+    let mut histories = Vec::new();
+    for backend in [Backend::Faer, Backend::Cholmod] {
+        let out = dir.path().join(backend.name());
+        let opts = rothe::run::RunOptions {
+            out: out.clone(),
+            backend,
+            progress: false,
+        };
+        let summary = rothe::run::run(&model, &opts).unwrap();
+        assert_eq!(summary.status, "completed");
+        assert_eq!(summary.solver.backend, backend.name());
+        assert_eq!(summary.steps, 20);
+        histories.push(probe_columns(&out.join("history.csv")));
+    }
+    let (hf, hc) = (&histories[0], &histories[1]);
+    assert!(!hf.is_empty());
+    for ((name, f), (_, c)) in hf.iter().zip(hc) {
+        assert_eq!(f.len(), 21, "{name}: rows");
+        // history.csv keeps 13 significant digits.
+        let d = rel_diff(c, f);
+        assert!(d < TOL, "{name}: histories differ by {d:e}");
+    }
+}
+
+/// Factorisation and solve times of both backends on the same matrices; run with
+/// `cargo test --release --features cholmod --test backends -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timing_report() {
+    let h: f64 = 1e-5;
+    let cases = [
+        ("cantilever 200x50 K_eff", {
+            let m = cantilever("dynamic", [200, 50], 1e-4);
+            effective_matrix(&m, 1.0 / (h * h), 1.0)
+        }),
+        ("cantilever 400x100 K_eff", {
+            let m = cantilever("dynamic", [400, 100], 1e-4);
+            effective_matrix(&m, 1.0 / (h * h), 1.0)
+        }),
+        ("laplacian 300x300", laplacian(300, 1e-3)),
+    ];
+    for (name, a) in cases {
+        let mut solvers: Vec<Box<dyn SymmetricSolver>> = vec![
+            Box::new(FaerCholesky::new()),
+            Box::new(CholmodCholesky::new().unwrap()),
+        ];
+        let mut xs = Vec::new();
+        for s in solvers.iter_mut() {
+            let t = Instant::now();
+            s.analyze(&a).unwrap();
+            let t_an = t.elapsed().as_secs_f64();
+            let reps = 5;
+            let t = Instant::now();
+            for _ in 0..reps {
+                s.factorize(&a).unwrap();
+            }
+            let t_fac = t.elapsed().as_secs_f64() / reps as f64;
+            let b = rhs(a.n);
+            let mut x = b.clone();
+            let t = Instant::now();
+            let sreps = 20;
+            for _ in 0..sreps {
+                x.copy_from_slice(&b);
+                s.solve_in_place(&mut x).unwrap();
+            }
+            let t_sol = t.elapsed().as_secs_f64() / sreps as f64;
+            eprintln!(
+                "{name} (n = {}, nnz(A) = {}): {:8} analyze {:7.2} ms, factorize {:7.2} ms, \
+                 solve {:6.2} ms, nnz(L) {:?}",
+                a.n,
+                a.row_idx.len(),
+                s.name(),
+                1e3 * t_an,
+                1e3 * t_fac,
+                1e3 * t_sol,
+                s.factor_nnz()
+            );
+            xs.push(x);
+        }
+        assert!(rel_diff(&xs[1], &xs[0]) < 1e-9);
+    }
+}
