@@ -161,6 +161,10 @@ pub struct Analysis {
     pub rayleigh: [f64; 2],
     /// Write VTK every this many steps (0: never).
     pub vtk_every: usize,
+    /// Relative residual tolerance of equilibrium iterations.
+    pub tolerance: f64,
+    /// Iteration limit per step.
+    pub max_iterations: usize,
 }
 
 impl Analysis {

@@ -11,6 +11,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::energy::{Ledger, StepIncrements};
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;
+use crate::material::store::StateStore;
 use crate::model::{AnalysisKind, Model};
 use crate::output::history::History;
 use crate::output::post::cell_stress;
@@ -80,10 +81,18 @@ impl Recorder {
         self.history.row(t, ledger, it, nl, &self.samples)
     }
 
-    fn vtk(&mut self, model: &Model, step: usize, t: f64, u: &[f64], v: &[f64]) -> Result<()> {
+    fn vtk(
+        &mut self,
+        model: &Model,
+        step: usize,
+        t: f64,
+        u: &[f64],
+        v: &[f64],
+        points: &[StateStore],
+    ) -> Result<()> {
         if let Some(vtk) = &mut self.vtk {
             if step % model.analysis.vtk_every == 0 {
-                vtk.write(step, t, u, v, &cell_stress(model, u))?;
+                vtk.write(step, t, u, v, &cell_stress(model, u, points))?;
             }
         }
         Ok(())
@@ -161,7 +170,7 @@ fn run_dynamic(
     let mut s = be.initial_state();
     summary.solver.factor_nnz = be.factor_nnz();
     rec.record(model, 0.0, &s.ledger, 0, 0.0, &s.u)?;
-    rec.vtk(model, 0, 0.0, &s.u, &s.v)?;
+    rec.vtk(model, 0, 0.0, &s.u, &s.v, &s.points)?;
     let pb = progress(n_steps, opts.progress);
     let mut outcome = Ok(());
     for _ in 0..n_steps {
@@ -176,7 +185,7 @@ fn run_dynamic(
                     report.nl_residual,
                     &s.u,
                 )?;
-                rec.vtk(model, s.step, s.t, &s.u, &s.v)?;
+                rec.vtk(model, s.step, s.t, &s.u, &s.v, &s.points)?;
             }
             Err(e) => {
                 outcome = Err(Error::Stepping(format!(
@@ -227,7 +236,7 @@ fn run_static(
         }
         ledger.record(&inc);
         rec.record(model, times[k], &ledger, 1, 0.0, &sol.u)?;
-        rec.vtk(model, k + 1, times[k], &sol.u, &zero)?;
+        rec.vtk(model, k + 1, times[k], &sol.u, &zero, &[])?;
         u0.clone_from(&sol.u);
         f0.clone_from(&sol.fint);
         summary.solver.iterations += 1;

@@ -4,6 +4,7 @@
 //!
 //! Start with [`Assembler::new`], then [`Assembler::stiffness`] and [`Assembler::mass`].
 
+pub mod internal;
 pub mod loads;
 pub mod pattern;
 

@@ -6,6 +6,8 @@
 
 mod validate;
 
+pub use validate::material;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -77,6 +79,21 @@ pub struct AnalysisSpec {
     /// Write a VTK file every this many steps; 0 for none.
     #[serde(default = "default_vtk_every")]
     pub vtk_every: usize,
+    /// Relative residual tolerance of the equilibrium iterations of materials with
+    /// history. Default 1e-8: well below discretisation error, well above round-off.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Iteration limit per step. Default 30.
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: usize,
+}
+
+fn default_tolerance() -> f64 {
+    1e-8
+}
+
+fn default_max_iterations() -> usize {
+    30
 }
 
 /// Mass matrix kind.
@@ -103,6 +120,62 @@ pub enum MaterialSpec {
         nu: f64,
         /// Density (kg/m³).
         rho: f64,
+    },
+    /// Kelvin-Voigt: `σ = C ε + α C ε̇` (give `alpha`, s) or `σ = C ε + β ε̇` (give
+    /// `beta`, Pa·s, the paper's identity viscosity).
+    KelvinVoigt {
+        /// Young's modulus (Pa).
+        #[serde(rename = "E")]
+        e: f64,
+        /// Poisson's ratio.
+        nu: f64,
+        /// Density (kg/m³).
+        rho: f64,
+        /// Stiffness-proportional viscosity time (s).
+        #[serde(default)]
+        alpha: Option<f64>,
+        /// Identity viscosity (Pa·s).
+        #[serde(default)]
+        beta: Option<f64>,
+    },
+    /// Standard linear solid of eq. (10): parallel spring `C`, Maxwell branch with
+    /// spring `α C` and dashpot `β C`.
+    Sls {
+        /// Young's modulus of the parallel spring (Pa).
+        #[serde(rename = "E")]
+        e: f64,
+        /// Poisson's ratio.
+        nu: f64,
+        /// Density (kg/m³).
+        rho: f64,
+        /// Branch stiffness ratio (dimensionless).
+        alpha: f64,
+        /// Dashpot time (s).
+        beta: f64,
+    },
+    /// Maxwell: spring `C` in series with dashpot `β C` (relaxation time `β`, s).
+    Maxwell {
+        /// Young's modulus of the spring (Pa).
+        #[serde(rename = "E")]
+        e: f64,
+        /// Poisson's ratio.
+        nu: f64,
+        /// Density (kg/m³).
+        rho: f64,
+        /// Relaxation time (s).
+        beta: f64,
+    },
+    /// Kelvin: the SLS without the branch spring, i.e. `σ = C ε + β C ε̇`.
+    Kelvin {
+        /// Young's modulus (Pa).
+        #[serde(rename = "E")]
+        e: f64,
+        /// Poisson's ratio.
+        nu: f64,
+        /// Density (kg/m³).
+        rho: f64,
+        /// Dashpot time (s).
+        beta: f64,
     },
 }
 

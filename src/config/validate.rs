@@ -10,7 +10,7 @@ use crate::material::Material;
 use crate::mesh::{gmsh, structured, ElementKind, Elements, Mesh, Part};
 use crate::model::{Analysis, Body, Constraint, Load, Model, Probe, TimeFunction};
 
-fn positive(field: &str, v: f64) -> Result<()> {
+pub(crate) fn positive(field: &str, v: f64) -> Result<()> {
     if v > 0.0 && v.is_finite() {
         Ok(())
     } else {
@@ -72,12 +72,88 @@ fn check_function(field: &str, f: &TimeFunction) -> Result<()> {
     }
 }
 
-fn material(name: &str, spec: &MaterialSpec) -> Result<Material> {
-    let field = format!("materials.{name}");
+/// Validates one material spec into a [`Material`]; `field` prefixes error paths.
+pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material> {
+    use crate::material::{Model, Viscosity};
+    let with = |e, nu, rho, model| -> Result<Material> {
+        check_elastic(field, e, nu, rho)?;
+        Ok(Material {
+            name: name.into(),
+            e,
+            nu,
+            rho,
+            model,
+        })
+    };
+    let viscosity = |key: &str, v: f64| positive(&format!("{field}.{key}"), v);
     match *spec {
-        MaterialSpec::Elastic { e, nu, rho } => {
-            check_elastic(&field, e, nu, rho)?;
-            Ok(Material::elastic(name, e, nu, rho))
+        MaterialSpec::Elastic { e, nu, rho } => with(e, nu, rho, Model::Elastic),
+        MaterialSpec::KelvinVoigt {
+            e,
+            nu,
+            rho,
+            alpha,
+            beta,
+        } => {
+            let v = match (alpha, beta) {
+                (Some(a), None) => {
+                    viscosity("alpha", a)?;
+                    Viscosity::Proportional(a)
+                }
+                (None, Some(b)) => {
+                    viscosity("beta", b)?;
+                    Viscosity::Identity(b)
+                }
+                _ => {
+                    return Err(Error::config(
+                        field,
+                        "give exactly one of `alpha` (s, η = α C) or `beta` (Pa·s, η = β I)",
+                    ))
+                }
+            };
+            with(e, nu, rho, Model::KelvinVoigt(v))
+        }
+        MaterialSpec::Sls {
+            e,
+            nu,
+            rho,
+            alpha,
+            beta,
+        } => {
+            viscosity("alpha", alpha)?;
+            viscosity("beta", beta)?;
+            with(
+                e,
+                nu,
+                rho,
+                Model::Sls {
+                    alpha,
+                    beta,
+                    parallel: true,
+                },
+            )
+        }
+        MaterialSpec::Maxwell { e, nu, rho, beta } => {
+            viscosity("beta", beta)?;
+            with(
+                e,
+                nu,
+                rho,
+                Model::Sls {
+                    alpha: 1.0,
+                    beta,
+                    parallel: false,
+                },
+            )
+        }
+        MaterialSpec::Kelvin { e, nu, rho, beta } => {
+            viscosity("beta", beta)?;
+            with(
+                e,
+                nu,
+                rho,
+                Model::KelvinVoigt(Viscosity::Proportional(beta)),
+            )
         }
     }
 }
@@ -117,6 +193,13 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
             format!("must be non-negative, got {}", a.zeta),
         ));
     }
+    positive("analysis.tolerance", a.tolerance)?;
+    if a.max_iterations == 0 {
+        return Err(Error::config(
+            "analysis.max_iterations",
+            "must be at least 1",
+        ));
+    }
     if a.rayleigh.iter().any(|c| *c < 0.0 || !c.is_finite()) {
         return Err(Error::config(
             "analysis.rayleigh",
@@ -136,7 +219,7 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
     let mut mat_index = BTreeMap::new();
     for (name, spec) in &s.materials {
         mat_index.insert(name.clone(), materials.len());
-        materials.push(material(name, spec)?);
+        materials.push(material(name, &format!("materials.{name}"), spec)?);
     }
     let find_material = |field: String, name: &str| -> Result<usize> {
         mat_index.get(name).copied().ok_or_else(|| {
@@ -385,6 +468,8 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
             zeta: a.zeta,
             rayleigh: a.rayleigh,
             vtk_every: a.vtk_every,
+            tolerance: a.tolerance,
+            max_iterations: a.max_iterations,
         },
     })
 }

@@ -14,6 +14,14 @@
 //! the orderings. The factorisation is always supernodal (`CHOLMOD_SUPERNODAL`); its
 //! dense kernels run on the system BLAS (OpenBLAS if installed).
 //!
+//! Threads: faer runs sequentially here, and so do CHOLMOD's own OpenMP loops. Debian's
+//! CHOLMOD 3 asks for 4 OpenMP threads on each supernode's loops whatever
+//! `OMP_NUM_THREADS` says; on a 2-core machine that made the factorisation about 3×
+//! slower (thread wake-ups), so `serialise_openmp` sets `omp_set_max_active_levels(0)`
+//! on the calling thread before each factorisation and solve. That libgomp setting is
+//! process-wide with GCC < 11; rothe has no other OpenMP user. BLAS threading
+//! (`OPENBLAS_NUM_THREADS`) is left to the environment.
+//!
 //! CHOLMOD's own messages are silenced (`print = 0`): failures come back as
 //! [`Error::Solver`] with backend `"cholmod"`.
 
@@ -35,6 +43,49 @@ const NAME: &str = "cholmod";
 // CHOLMOD's `long` integer arrays (itype CHOLMOD_LONG) are `SuiteSparse_long`, which is
 // 64 bits on the targets we build for; the index copies below are `i64`.
 const _: () = assert!(std::mem::size_of::<std::os::raw::c_long>() == 8);
+
+/// Turns CHOLMOD's OpenMP loops off on the calling thread (see the module doc).
+///
+/// Debian's CHOLMOD 3 is built with OpenMP and a compiled-in `num_threads(4)` on the
+/// loops of its supernodal factorisation, which neither `OMP_NUM_THREADS` nor any
+/// `cholmod_common` field overrides. `omp_set_max_active_levels(0)` makes every
+/// parallel region run on one thread. The function is looked up at run time in the
+/// already loaded libraries (libgomp comes in with libcholmod), so nothing changes
+/// when CHOLMOD was built without OpenMP. libgomp keeps this setting per thread
+/// (GCC >= 11) or per process (older), hence a call before every CHOLMOD call that
+/// may open a parallel region; it is one indirect call.
+fn serialise_openmp() {
+    use std::os::raw::{c_char, c_int};
+    use std::sync::OnceLock;
+
+    type SetLevels = unsafe extern "C" fn(c_int);
+    static SET_LEVELS: OnceLock<Option<SetLevels>> = OnceLock::new();
+    let f = SET_LEVELS.get_or_init(|| {
+        #[cfg(target_os = "linux")]
+        {
+            extern "C" {
+                fn dlsym(handle: *mut c_void, symbol: *const c_char) -> *mut c_void;
+            }
+            // SAFETY: `dlsym` with the default search handle (null on glibc and
+            // musl) and a NUL-terminated name only reads; a non-null result is the
+            // address of `void omp_set_max_active_levels(int)`, whose signature is
+            // fixed by the OpenMP specification.
+            unsafe {
+                let sym = dlsym(ptr::null_mut(), c"omp_set_max_active_levels".as_ptr());
+                (!sym.is_null()).then(|| std::mem::transmute::<*mut c_void, SetLevels>(sym))
+            }
+        }
+        #[cfg(not(target_os = "linux"))]
+        {
+            None
+        }
+    });
+    if let Some(set_levels) = f {
+        // SAFETY: a valid `omp_set_max_active_levels` (see above); 0 is a valid
+        // argument (no active parallel levels).
+        unsafe { set_levels(0) };
+    }
+}
 
 fn err(message: impl Into<String>) -> Error {
     Error::Solver {
@@ -96,9 +147,9 @@ impl CholmodCholesky {
     /// (supernodal, AMD only, silent).
     pub fn new() -> Result<Self> {
         // SAFETY: `cholmod_common` is a plain C struct of integers, floats, raw pointers
-        // and an optional function pointer, for all of which all-zero bytes are valid.
-        let mut common: Box<cholmod_common> =
-            unsafe { Box::<cholmod_common>::new_zeroed().assume_init() };
+        // and an optional function pointer, for all of which all-zero bytes are valid;
+        // `cholmod_l_start` then sets every field.
+        let mut common: Box<cholmod_common> = Box::new(unsafe { std::mem::zeroed() });
         // SAFETY: `common` points to a valid, exclusively owned `cholmod_common` on the
         // heap, which does not move until `cholmod_l_finish` in `Drop`.
         let ok = unsafe { cholmod_l_start(&mut *common) };
@@ -297,6 +348,7 @@ impl SymmetricSolver for CholmodCholesky {
             ));
         }
         self.factorized = false;
+        serialise_openmp();
         for (k, (dst, &src)) in self.values.iter_mut().zip(&a.values).enumerate() {
             if !src.is_finite() {
                 return Err(err(format!("matrix entry {k} is not finite ({src})")));
@@ -355,6 +407,7 @@ impl SymmetricSolver for CholmodCholesky {
             return Ok(());
         }
         self.b.copy_from_slice(rhs);
+        serialise_openmp();
         let mut b = cholmod_dense {
             nrow: n,
             ncol: 1,

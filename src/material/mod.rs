@@ -10,6 +10,7 @@
 
 pub mod elastic;
 pub mod store;
+pub mod viscoelastic;
 
 use crate::fe::{elasticity, Plane};
 
@@ -51,11 +52,33 @@ pub struct StrainStep {
     pub dt: f64,
 }
 
+/// The viscosity of a Kelvin-Voigt material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Viscosity {
+    /// `η = α C` (stiffness-proportional, `α` in seconds): `σ = C ε + α C ε̇`.
+    Proportional(f64),
+    /// `η = β I` (identity viscosity, `β` in Pa·s), as in the paper's examples.
+    Identity(f64),
+}
+
 /// Constitutive model with its parameters (beyond the elastic `E, ν, ρ`).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Model {
     /// Linear elasticity `σ = C ε`.
     Elastic,
+    /// Kelvin-Voigt `σ = C ε + η ε̇` (also the Kelvin limit of the SLS).
+    KelvinVoigt(Viscosity),
+    /// Standard linear solid (eq. 10): `σ = C ε + τ`, Maxwell branch spring `α C`,
+    /// dashpot `β C` (`β` in seconds). With `parallel = false` the parallel spring
+    /// is absent: the Maxwell model `σ = τ`.
+    Sls {
+        /// Branch stiffness ratio `α` (dimensionless).
+        alpha: f64,
+        /// Dashpot time `β` (s).
+        beta: f64,
+        /// Whether the parallel spring `C` is present.
+        parallel: bool,
+    },
 }
 
 /// A material: elastic constants, density and constitutive model.
@@ -99,8 +122,26 @@ impl Material {
     /// Number of history values stored per Gauss point.
     pub fn n_state(&self) -> usize {
         match self.model {
-            Model::Elastic => 0,
+            Model::Elastic | Model::KelvinVoigt(_) => 0,
+            Model::Sls { .. } => 3,
         }
+    }
+
+    /// Names of the history values (columns of `rothe material` output).
+    pub fn state_names(&self) -> &'static [&'static str] {
+        match self.model {
+            Model::Elastic | Model::KelvinVoigt(_) => &[],
+            Model::Sls { .. } => &["eps_d_xx", "eps_d_yy", "gamma_d_xy"],
+        }
+    }
+
+    /// True when the consistent tangent does not depend on the strain or history
+    /// (for a fixed step): the effective matrix is then factorised once.
+    pub fn has_constant_tangent(&self) -> bool {
+        matches!(
+            self.model,
+            Model::Elastic | Model::KelvinVoigt(_) | Model::Sls { .. }
+        )
     }
 
     /// Initial history values.
@@ -113,11 +154,32 @@ impl Material {
         &self,
         plane: Plane,
         step: &StrainStep,
-        _state_n: &[f64],
-        _state: &mut [f64],
+        state_n: &[f64],
+        state: &mut [f64],
     ) -> PointResponse {
+        let c = self.c(plane);
         match self.model {
-            Model::Elastic => elastic::update(&self.c(plane), step),
+            Model::Elastic => elastic::update(&c, step),
+            Model::KelvinVoigt(Viscosity::Proportional(alpha)) => {
+                let eta = c.map(|row| row.map(|x| alpha * x));
+                viscoelastic::kelvin_voigt(&c, &eta, step)
+            }
+            Model::KelvinVoigt(Viscosity::Identity(beta)) => {
+                viscoelastic::kelvin_voigt(&c, &viscoelastic::identity_viscosity(beta), step)
+            }
+            Model::Sls {
+                alpha,
+                beta,
+                parallel,
+            } => viscoelastic::standard_linear_solid(
+                &c,
+                if parallel { 1.0 } else { 0.0 },
+                alpha,
+                beta,
+                step,
+                state_n,
+                state,
+            ),
         }
     }
 }

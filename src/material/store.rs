@@ -13,6 +13,10 @@ pub struct StateStore {
     pub eps: Vec<f64>,
     /// Trial strain per point.
     pub eps_trial: Vec<f64>,
+    /// Committed stress per point (`n_points * 3`).
+    pub sigma: Vec<f64>,
+    /// Trial stress per point.
+    pub sigma_trial: Vec<f64>,
 }
 
 impl StateStore {
@@ -24,6 +28,8 @@ impl StateStore {
             trial: vec![0.0; n_points * n_state],
             eps: vec![0.0; n_points * 3],
             eps_trial: vec![0.0; n_points * 3],
+            sigma: vec![0.0; n_points * 3],
+            sigma_trial: vec![0.0; n_points * 3],
         }
     }
 
@@ -31,5 +37,11 @@ impl StateStore {
     pub fn commit(&mut self) {
         self.committed.copy_from_slice(&self.trial);
         self.eps.copy_from_slice(&self.eps_trial);
+        self.sigma.copy_from_slice(&self.sigma_trial);
+    }
+
+    /// Number of points.
+    pub fn n_points(&self) -> usize {
+        self.eps.len() / 3
     }
 }

@@ -15,10 +15,12 @@ use std::time::Instant;
 
 use super::system::{DofMap, ReducedMatrix};
 use super::{external_force, gravity_force, Timing};
+use crate::assembly::internal::{new_stores, PointTotals};
 use crate::assembly::{Assembler, Mass};
 use crate::energy::{Ledger, StepIncrements};
 use crate::error::{Error, Result};
 use crate::linsolve::{Backend, SymmetricSolver};
+use crate::material::store::StateStore;
 use crate::material::Dissipation;
 use crate::model::Model;
 
@@ -41,6 +43,9 @@ pub struct DynState {
     pub fext: Vec<f64>,
     /// Energy ledger.
     pub ledger: Ledger,
+    /// Gauss-point history per element block (empty when every material is
+    /// linear elastic and the step runs on global matrices only).
+    pub points: Vec<StateStore>,
 }
 
 /// What a step reports besides the new state.
@@ -63,6 +68,13 @@ pub struct BackwardEuler<'m> {
     pub dofs: DofMap,
     /// Elastic stiffness on the pattern.
     pub k: Vec<f64>,
+    /// Consistent tangent of materials with history (constant for a fixed `h` when
+    /// every material has a constant tangent).
+    pub kt: Option<Vec<f64>>,
+    /// Relative residual tolerance of the equilibrium iterations.
+    pub tolerance: f64,
+    /// Iteration limit per step.
+    pub max_iterations: usize,
     /// Mass matrix.
     pub mass: Mass,
     gravity: Option<Vec<f64>>,
@@ -87,9 +99,9 @@ pub struct BackwardEuler<'m> {
 impl<'m> BackwardEuler<'m> {
     /// Assembles `K`, `M`, the effective matrix, analyses and factorises it.
     pub fn new(model: &'m Model, backend: Backend) -> Result<Self> {
-        if model.materials.iter().any(|m| !m.is_linear_elastic()) {
+        if model.materials.iter().any(|m| !m.has_constant_tangent()) {
             return Err(Error::Stepping(
-                "materials with history are not supported by the linear integrator".into(),
+                "materials with a state-dependent tangent are not supported yet".into(),
             ));
         }
         let a = &model.analysis;
@@ -105,7 +117,17 @@ impl<'m> BackwardEuler<'m> {
         let damp_k = a.rayleigh[1];
         let c_m = 1.0 / (h * h) + damp_m / h;
         let c_k = 1.0 + damp_k / h;
-        reduced.fill(&dofs, c_m, &mass, &[(c_k, &k)]);
+        let kt = if model.materials.iter().all(|m| m.is_linear_elastic()) {
+            None
+        } else {
+            let stores = new_stores(&model.mesh, &model.materials);
+            let u0 = vec![0.0; model.mesh.n_dofs()];
+            Some(asm.tangent(&model.mesh, &model.materials, model.plane, &u0, h, &stores))
+        };
+        match &kt {
+            None => reduced.fill(&dofs, c_m, &mass, &[(c_k, &k)]),
+            Some(kt) => reduced.fill(&dofs, c_m, &mass, &[(damp_k / h, &k), (1.0, kt)]),
+        }
         let assembly_s = t0.elapsed().as_secs_f64();
 
         let t1 = Instant::now();
@@ -120,6 +142,9 @@ impl<'m> BackwardEuler<'m> {
             asm,
             dofs,
             k,
+            kt,
+            tolerance: a.tolerance,
+            max_iterations: a.max_iterations,
             mass,
             gravity,
             reduced,
@@ -164,12 +189,19 @@ impl<'m> BackwardEuler<'m> {
         let v = model.initial_velocity();
         let mut mv = vec![0.0; n];
         let mut fint = vec![0.0; n];
-        self.asm.pattern.matvec(&self.k, &u, &mut fint);
         self.mass.matvec(&self.asm.pattern, &v, &mut mv);
         let mut fext = vec![0.0; n];
         external_force(model, self.gravity.as_deref(), 0.0, &mut fext);
         let e_kin0 = 0.5 * dot(&v, &mv);
-        let e_el0 = 0.5 * dot(&u, &fint);
+        let (e_el0, points) = if self.kt.is_none() {
+            self.asm.pattern.matvec(&self.k, &u, &mut fint);
+            (0.5 * dot(&u, &fint), Vec::new())
+        } else {
+            let mut points = new_stores(&model.mesh, &model.materials);
+            let totals = self.internal(&u, &mut points, &mut fint);
+            points.iter_mut().for_each(StateStore::commit);
+            (totals.psi, points)
+        };
         DynState {
             t: 0.0,
             step: 0,
@@ -179,27 +211,47 @@ impl<'m> BackwardEuler<'m> {
             fint,
             fext,
             ledger: Ledger::new(e_kin0, e_el0),
+            points,
         }
     }
 
-    /// Advances `s` by one step `h`.
+    fn internal(&self, u: &[f64], points: &mut [StateStore], f: &mut [f64]) -> PointTotals {
+        let m = self.model;
+        self.asm
+            .internal_force(&m.mesh, &m.materials, m.plane, u, self.h, points, f)
+    }
+
+    /// Advances `s` by one step `h`. On error `s` is unchanged.
     pub fn step(&mut self, s: &mut DynState) -> Result<StepReport> {
+        if self.kt.is_none() {
+            self.step_linear(s)
+        } else {
+            self.step_history(s)
+        }
+    }
+
+    /// Prescribed increments into `self.du` (zero elsewhere); true if any.
+    fn prescribed_increments(&mut self, u: &[f64], t1: f64) -> bool {
+        self.du.fill(0.0);
+        let mut moving = false;
+        for c in &self.model.constraints {
+            let d = c.at(t1) - u[c.dof];
+            if d != 0.0 {
+                self.du[c.dof] = d;
+                moving = true;
+            }
+        }
+        moving
+    }
+
+    fn step_linear(&mut self, s: &mut DynState) -> Result<StepReport> {
         let t_start = Instant::now();
         let h = self.h;
         let t1 = s.t + h;
         let n = s.u.len();
         external_force(self.model, self.gravity.as_deref(), t1, &mut self.f1);
 
-        // Prescribed increments on constrained dofs, zero elsewhere.
-        self.du.fill(0.0);
-        let mut moving = false;
-        for c in &self.model.constraints {
-            let d = c.at(t1) - s.u[c.dof];
-            if d != 0.0 {
-                self.du[c.dof] = d;
-                moving = true;
-            }
-        }
+        let moving = self.prescribed_increments(&s.u, t1);
         // r = K_eff Δu_c − M v/h + f_int − f_ext¹, wanted on the free dofs only.
         if moving {
             self.asm.pattern.matvec(&self.k, &self.du, &mut self.kdu);
@@ -292,6 +344,107 @@ impl<'m> BackwardEuler<'m> {
         })
     }
 
+    /// A step for materials with Gauss-point history: equilibrium iterations
+    /// `K_eff δ = −r(u)` with `r = M(v − v⁰)/h + C v + f_int(u) − f_ext¹`, `f_int`
+    /// from the Gauss-point loop against the committed history. For constant-tangent
+    /// materials the first solve is exact and the second evaluation confirms it.
+    fn step_history(&mut self, s: &mut DynState) -> Result<StepReport> {
+        let t_start = Instant::now();
+        let mut solve_s = 0.0;
+        let h = self.h;
+        let t1 = s.t + h;
+        let n = s.u.len();
+        external_force(self.model, self.gravity.as_deref(), t1, &mut self.f1);
+        self.prescribed_increments(&s.u, t1);
+        let mut u1: Vec<f64> = s.u.iter().zip(&self.du).map(|(u, d)| u + d).collect();
+        let mut fint1 = vec![0.0; n];
+        let mut kv = vec![0.0; n];
+        let mut history: Vec<(f64, f64)> = Vec::new();
+        let mut iterations = 0;
+        let (totals, nl) = loop {
+            let totals = self.internal(&u1, &mut s.points, &mut fint1);
+            for i in 0..n {
+                self.du[i] = u1[i] - s.u[i];
+                self.v1[i] = self.du[i] / h;
+            }
+            self.mass.matvec(&self.asm.pattern, &self.v1, &mut self.mv1);
+            if self.damp_k != 0.0 {
+                self.asm.pattern.matvec(&self.k, &self.v1, &mut kv);
+            }
+            let (mut r2, mut f2) = (0.0, 0.0);
+            self.rhs.clear();
+            for &d in &self.dofs.free {
+                let inertia = (self.mv1[d] - s.mv[d]) / h;
+                let r = inertia + self.damp_m * self.mv1[d] + self.damp_k * kv[d] + fint1[d]
+                    - self.f1[d];
+                r2 += r * r;
+                f2 += self.f1[d].powi(2) + fint1[d].powi(2) + inertia.powi(2);
+                self.rhs.push(-r);
+            }
+            let nl = if f2 > 0.0 {
+                (r2 / f2).sqrt()
+            } else {
+                r2.sqrt()
+            };
+            history.push((nl, r2.sqrt()));
+            if nl <= self.tolerance || r2 == 0.0 {
+                break (totals, nl);
+            }
+            if iterations >= self.max_iterations {
+                // Leave the committed history untouched: the trial states are
+                // simply not committed.
+                return Err(Error::Stepping(format!(
+                    "no convergence at t = {t1:.6e} after {iterations} iterations; relative residuals {:?}",
+                    history.iter().map(|p| format!("{:.2e}", p.0)).collect::<Vec<_>>()
+                )));
+            }
+            let ts = Instant::now();
+            self.solver.solve_in_place(&mut self.rhs)?;
+            solve_s += ts.elapsed().as_secs_f64();
+            for (eq, &d) in self.dofs.free.iter().enumerate() {
+                u1[d] += self.rhs[eq];
+            }
+            iterations += 1;
+        };
+
+        let mut inc = StepIncrements {
+            elastic: totals.psi,
+            material: totals.dissipation,
+            ..Default::default()
+        };
+        for i in 0..n {
+            let cv1 = self.damp_m * self.mv1[i] + self.damp_k * kv[i];
+            let fext1 = if self.dofs.eq[i] == usize::MAX {
+                let inertia = (self.mv1[i] - s.mv[i]) / h;
+                inertia + cv1 + fint1[i]
+            } else {
+                self.f1[i]
+            };
+            let du = self.du[i];
+            inc.kinetic += 0.5 * self.v1[i] * self.mv1[i];
+            inc.internal_work += 0.5 * du * (s.fint[i] + fint1[i]);
+            inc.external_work += 0.5 * du * (s.fext[i] + fext1);
+            inc.load_jump += 0.5 * du * (fext1 - s.fext[i]);
+            inc.mass_damping += du * cv1;
+            inc.kinetic_loss += 0.5 * (self.v1[i] - s.v[i]) * (self.mv1[i] - s.mv[i]);
+            s.fext[i] = fext1;
+        }
+        s.u = u1;
+        s.fint = fint1;
+        std::mem::swap(&mut s.v, &mut self.v1);
+        std::mem::swap(&mut s.mv, &mut self.mv1);
+        s.points.iter_mut().for_each(StateStore::commit);
+        s.t = t1;
+        s.step += 1;
+        s.ledger.record(&inc);
+        self.timing.solve_s += solve_s;
+        self.timing.step_other_s += t_start.elapsed().as_secs_f64() - solve_s;
+        Ok(StepReport {
+            iterations,
+            nl_residual: nl,
+        })
+    }
+
     /// Effective-matrix coefficients `(c_M, c_K)`.
     pub fn coefficients(&self) -> (f64, f64) {
         (self.c_m, self.c_k)
@@ -303,8 +456,26 @@ impl<'m> BackwardEuler<'m> {
         self.c_m = 1.0 / (h * h) + self.damp_m / h;
         self.c_k = 1.0 + self.damp_k / h;
         let t = Instant::now();
-        self.reduced
-            .fill(&self.dofs, self.c_m, &self.mass, &[(self.c_k, &self.k)]);
+        let m = self.model;
+        if self.kt.is_some() {
+            let stores = new_stores(&m.mesh, &m.materials);
+            let u0 = vec![0.0; m.mesh.n_dofs()];
+            self.kt = Some(
+                self.asm
+                    .tangent(&m.mesh, &m.materials, m.plane, &u0, h, &stores),
+            );
+        }
+        match &self.kt {
+            None => self
+                .reduced
+                .fill(&self.dofs, self.c_m, &self.mass, &[(self.c_k, &self.k)]),
+            Some(kt) => self.reduced.fill(
+                &self.dofs,
+                self.c_m,
+                &self.mass,
+                &[(self.damp_k / h, &self.k), (1.0, kt)],
+            ),
+        }
         self.solver.factorize(&self.reduced.csc)?;
         self.factorizations += 1;
         self.timing.factorization_s += t.elapsed().as_secs_f64();

@@ -31,6 +31,8 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
             zeta: 0.0,
             rayleigh: [0.0, 0.0],
             vtk_every: 0,
+            tolerance: 1e-8,
+            max_iterations: 30,
         },
     }
 }

@@ -1,0 +1,312 @@
+//! The Gauss-point loop: strains from displacements, material updates against the
+//! committed history (trial states written, never committed here), internal forces
+//! `f_int = Σ_e ∫ Bᵀ σ t dA`, the consistent tangent, and the step's stored energy
+//! and dissipation summed with the quadrature weights. Parallel by element colours.
+
+use rayon::prelude::*;
+
+use super::Assembler;
+use crate::fe::{element, kinematics, stiffness_rule, strain, Plane};
+use crate::material::store::StateStore;
+use crate::material::{Dissipation, Material, StrainStep};
+use crate::mesh::{ElementKind, Mesh};
+
+/// Integrated point quantities of one evaluation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointTotals {
+    /// Stored energy `Σ ψ w`.
+    pub psi: f64,
+    /// Dissipation increments `Σ ΔD w` by mechanism.
+    pub dissipation: Dissipation,
+}
+
+impl PointTotals {
+    fn add(mut self, o: PointTotals) -> PointTotals {
+        self.psi += o.psi;
+        let (a, b) = (&mut self.dissipation, o.dissipation);
+        a.viscous += b.viscous;
+        a.damage += b.damage;
+        a.plastic += b.plastic;
+        a.numerical += b.numerical;
+        self
+    }
+
+    fn add_scaled(&mut self, psi: f64, d: &Dissipation, w: f64) {
+        self.psi += w * psi;
+        let a = &mut self.dissipation;
+        a.viscous += w * d.viscous;
+        a.damage += w * d.damage;
+        a.plastic += w * d.plastic;
+        a.numerical += w * d.numerical;
+    }
+}
+
+/// Number of material points of an element kind (bars: one).
+pub fn points_per_element(kind: ElementKind) -> usize {
+    match kind {
+        ElementKind::Bar2 => 1,
+        k => stiffness_rule(k).len(),
+    }
+}
+
+/// One store per block, sized for its points and its material's history.
+pub fn new_stores(mesh: &Mesh, materials: &[Material]) -> Vec<StateStore> {
+    mesh.blocks
+        .iter()
+        .map(|b| {
+            let mat = &materials[b.material];
+            let n = b.elements.len() * points_per_element(b.elements.kind);
+            let mut s = StateStore::new(n, mat.n_state());
+            for chunk in s.committed.chunks_mut(mat.n_state().max(1)) {
+                if mat.n_state() > 0 {
+                    mat.init_state(chunk);
+                }
+            }
+            s.trial.clone_from(&s.committed);
+            s
+        })
+        .collect()
+}
+
+#[derive(Clone, Copy)]
+struct Shared(*mut f64);
+// SAFETY: each element writes only its own points' slots in the stores, and the
+// force entries of its nodes, which no other element of the running colour holds.
+unsafe impl Send for Shared {}
+unsafe impl Sync for Shared {}
+
+impl Shared {
+    /// # Safety
+    /// `start..start+len` must be in bounds and written by one thread only.
+    unsafe fn slice<'a>(self, start: usize, len: usize) -> &'a mut [f64] {
+        std::slice::from_raw_parts_mut(self.0.add(start), len)
+    }
+}
+
+/// What one element evaluation needs besides its index.
+struct Ctx<'a> {
+    mesh: &'a Mesh,
+    mat: &'a Material,
+    plane: Plane,
+    kind: ElementKind,
+    section: f64,
+    dt: f64,
+}
+
+/// Evaluates element `e` at displacements `u`: calls `point(g, w, &resp, &kin, eps)`
+/// for each of its points (global point index within the block `g`).
+fn element_points<F>(
+    cx: &Ctx,
+    store: &StateStore,
+    nodes: &[usize],
+    u: &[f64],
+    e: usize,
+    trial: Option<Shared>,
+    mut point: F,
+) where
+    F: FnMut(
+        usize,
+        f64,
+        &crate::material::PointResponse,
+        Option<&crate::fe::PointKinematics>,
+        &[[f64; 2]],
+    ),
+{
+    let nn = nodes.len();
+    let mut x = [[0.0; 2]; 4];
+    let mut ue = [0.0; 8];
+    for (a, &n) in nodes.iter().enumerate() {
+        x[a] = cx.mesh.coords[n];
+        ue[2 * a] = u[2 * n];
+        ue[2 * a + 1] = u[2 * n + 1];
+    }
+    let ns = store.n_state;
+    let mut scratch = [0.0; 16];
+    if cx.kind == ElementKind::Bar2 {
+        let g = e;
+        let eps = element::bar_strain(&x[..2], &ue[..4]);
+        let eps_n = store.eps[3 * g];
+        let de = eps - eps_n;
+        let (_, l) = element::bar_axis(&x[..2]);
+        let resp = crate::material::PointResponse {
+            sigma: [cx.mat.e * eps, 0.0, 0.0],
+            tangent: [[cx.mat.e, 0.0, 0.0], [0.0; 3], [0.0; 3]],
+            psi: 0.5 * cx.mat.e * eps * eps,
+            dissipation: Dissipation {
+                numerical: 0.5 * cx.mat.e * de * de,
+                ..Default::default()
+            },
+        };
+        if let Some(t) = trial {
+            // SAFETY: point g belongs to element e only.
+            unsafe { t.slice(3 * g, 3) }.copy_from_slice(&[eps, 0.0, 0.0]);
+            unsafe { t.slice(store.eps.len() + 3 * g, 3) }.copy_from_slice(&resp.sigma);
+        }
+        point(g, cx.section * l, &resp, None, &x[..2]);
+        return;
+    }
+    let rule = stiffness_rule(cx.kind);
+    for (q, &(xi, wq)) in rule.iter().enumerate() {
+        let g = e * rule.len() + q;
+        let k = kinematics(cx.kind, &x[..nn], xi);
+        let eps = strain(&k, nn, &ue);
+        let eps_n = [store.eps[3 * g], store.eps[3 * g + 1], store.eps[3 * g + 2]];
+        let step = StrainStep {
+            eps_n,
+            eps,
+            dt: cx.dt,
+        };
+        let committed = &store.committed[g * ns..(g + 1) * ns];
+        let resp = match trial {
+            Some(t) => {
+                // SAFETY: point g belongs to element e only. The trial buffer holds
+                // strains, stresses, then history (see `internal_force`).
+                let n3 = store.eps.len();
+                unsafe { t.slice(3 * g, 3) }.copy_from_slice(&eps);
+                let hist = unsafe { t.slice(2 * n3 + g * ns, ns) };
+                let r = cx.mat.update(cx.plane, &step, committed, hist);
+                unsafe { t.slice(n3 + 3 * g, 3) }.copy_from_slice(&r.sigma);
+                r
+            }
+            None => cx
+                .mat
+                .update(cx.plane, &step, committed, &mut scratch[..ns]),
+        };
+        point(g, wq * k.det_j * cx.section, &resp, Some(&k), &x[..nn]);
+    }
+}
+
+impl Assembler {
+    /// Internal forces at `u` into `f` (overwritten), trial states into the stores,
+    /// and the integrated stored energy and dissipation of the step `dt`.
+    pub fn internal_force(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        u: &[f64],
+        dt: f64,
+        stores: &mut [StateStore],
+        f: &mut [f64],
+    ) -> PointTotals {
+        f.fill(0.0);
+        let fp = Shared(f.as_mut_ptr());
+        let mut totals = PointTotals::default();
+        for (bi, block) in mesh.blocks.iter().enumerate() {
+            let store = &mut stores[bi];
+            // Trial strains, stresses and history are written through one pointer
+            // base: keep them in one buffer for the duration of the loop.
+            let mut buf = std::mem::take(&mut store.eps_trial);
+            let n_eps = buf.len();
+            buf.append(&mut std::mem::take(&mut store.sigma_trial));
+            buf.append(&mut std::mem::take(&mut store.trial));
+            let tp = Shared(buf.as_mut_ptr());
+            let cx = Ctx {
+                mesh,
+                mat: &materials[block.material],
+                plane,
+                kind: block.elements.kind,
+                section: block.section,
+                dt,
+            };
+            let store_ref: &StateStore = store;
+            for colour in &self.colours[bi] {
+                let part = colour
+                    .par_chunks(128)
+                    .map(|chunk| {
+                        let mut acc = PointTotals::default();
+                        for &e in chunk {
+                            let nodes = block.elements.element(e);
+                            let mut fe = [0.0; 8];
+                            element_points(
+                                &cx,
+                                store_ref,
+                                nodes,
+                                u,
+                                e,
+                                Some(tp),
+                                |_, w, r, k, x| {
+                                    acc.add_scaled(r.psi, &r.dissipation, w);
+                                    match k {
+                                        Some(k) => {
+                                            for a in 0..nodes.len() {
+                                                let (dx, dy) = (k.dndx[a][0], k.dndx[a][1]);
+                                                fe[2 * a] +=
+                                                    w * (dx * r.sigma[0] + dy * r.sigma[2]);
+                                                fe[2 * a + 1] +=
+                                                    w * (dy * r.sigma[1] + dx * r.sigma[2]);
+                                            }
+                                        }
+                                        None => {
+                                            let (ax, _) = element::bar_axis(x);
+                                            let n = r.sigma[0] * w / element::bar_axis(x).1;
+                                            fe[0] -= n * ax[0];
+                                            fe[1] -= n * ax[1];
+                                            fe[2] += n * ax[0];
+                                            fe[3] += n * ax[1];
+                                        }
+                                    }
+                                },
+                            );
+                            for (a, &n) in nodes.iter().enumerate() {
+                                // SAFETY: no two elements of this colour share node n.
+                                let fn_ = unsafe { fp.slice(2 * n, 2) };
+                                fn_[0] += fe[2 * a];
+                                fn_[1] += fe[2 * a + 1];
+                            }
+                        }
+                        acc
+                    })
+                    .reduce(PointTotals::default, PointTotals::add);
+                totals = totals.add(part);
+            }
+            let hist = buf.split_off(2 * n_eps);
+            let sigma = buf.split_off(n_eps);
+            store.eps_trial = buf;
+            store.sigma_trial = sigma;
+            store.trial = hist;
+        }
+        totals
+    }
+
+    /// Consistent tangent stiffness `Σ_e ∫ Bᵀ (∂σ/∂ε) B t dA` at `u` from the
+    /// committed states (material updates are pure, so nothing is written).
+    pub fn tangent(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        u: &[f64],
+        dt: f64,
+        stores: &[StateStore],
+    ) -> Vec<f64> {
+        self.assemble(mesh, |bi, e, _x, ke| {
+            let block = &mesh.blocks[bi];
+            let cx = Ctx {
+                mesh,
+                mat: &materials[block.material],
+                plane,
+                kind: block.elements.kind,
+                section: block.section,
+                dt,
+            };
+            let nodes = block.elements.element(e);
+            let nd = 2 * nodes.len();
+            ke[..nd * nd].fill(0.0);
+            element_points(
+                &cx,
+                &stores[bi],
+                nodes,
+                u,
+                e,
+                None,
+                |_, w, r, k, x| match k {
+                    Some(k) => element::add_btdb(k, nodes.len(), &r.tangent, w, ke),
+                    None => {
+                        element::bar_stiffness(x, r.tangent[0][0] * w / element::bar_axis(x).1, ke)
+                    }
+                },
+            );
+        })
+    }
+}
