@@ -37,7 +37,9 @@ fn factorisation_and_step(c: &mut Criterion) {
             b.iter(|| be.set_step(model.analysis.dt).unwrap())
         });
         let mut s = be.initial_state();
-        g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| b.iter(|| be.step(&mut s).unwrap()));
+        g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| {
+            b.iter(|| be.step(&mut s).unwrap())
+        });
     }
     g.finish();
 }

@@ -32,8 +32,15 @@ at = [2.0, 0.25]
 "#;
 
 fn rothe(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rothe")).args(args).output().unwrap();
-    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    let out = Command::new(env!("CARGO_BIN_EXE_rothe"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 fn scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -47,24 +54,50 @@ fn run_writes_history_summary_and_vtk() {
     let dir = tempfile::tempdir().unwrap();
     let sc = scenario(dir.path(), "s.toml", GOOD);
     let out = dir.path().join("out");
-    let (ok, _, err) = rothe(&["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"]);
+    let (ok, _, err) = rothe(&[
+        "run",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
     assert!(ok, "{err}");
     let hist = std::fs::read_to_string(out.join("history.csv")).unwrap();
     let header = hist.lines().next().unwrap();
-    assert!(header.starts_with("t,E_kin,E_int,W_ext,E_el,D_viscous,D_damage,D_plastic,D_contact,D_mass,D_num,residual"));
+    assert!(header.starts_with(
+        "t,E_kin,E_int,W_ext,E_el,D_viscous,D_damage,D_plastic,D_contact,D_mass,D_num,residual"
+    ));
     assert!(header.ends_with("tip_ux,tip_uy"));
     assert_eq!(hist.lines().count(), 12, "header, t = 0 and 10 steps");
-    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["steps"], 10);
     assert_eq!(summary["dofs"], 54);
     assert_eq!(summary["solver"]["backend"], "faer");
     assert!(summary["probes"]["tip"]["max_abs_uy"].as_f64().unwrap() > 0.0);
     assert!(summary["energy"]["balance_residual_rel"].as_f64().unwrap() < 1e-10);
-    for key in ["kinetic_0", "kinetic", "internal", "external_work", "elastic", "balance_residual"] {
+    for key in [
+        "kinetic_0",
+        "kinetic",
+        "internal",
+        "external_work",
+        "elastic",
+        "balance_residual",
+    ] {
         assert!(summary["energy"][key].is_number(), "energy.{key}");
     }
-    for key in ["viscous", "damage", "plastic", "contact", "mass", "numerical"] {
-        assert!(summary["energy"]["dissipated"][key].is_number(), "dissipated.{key}");
+    for key in [
+        "viscous",
+        "damage",
+        "plastic",
+        "contact",
+        "mass",
+        "numerical",
+    ] {
+        assert!(
+            summary["energy"]["dissipated"][key].is_number(),
+            "dissipated.{key}"
+        );
     }
     for key in ["assembly_s", "factorization_s", "solve_s", "total_s"] {
         assert!(summary["timing"][key].is_number(), "timing.{key}");
@@ -89,33 +122,77 @@ fn check_prints_size_and_cfl() {
 #[test]
 fn bad_input_gives_clear_errors() {
     let cases: Vec<(String, Vec<&str>)> = vec![
-        (GOOD.replace("vtk_every = 5", "vtk_every = 5\ncolour = 3"), vec!["unknown field `colour`"]),
-        (GOOD.replace("E = 30e9", "E = -1.0"), vec!["materials.concrete.E", "positive"]),
-        (GOOD.replace("nu = 0.2", "nu = 0.5"), vec!["materials.concrete.nu", "(-1, 0.5)"]),
-        (GOOD.replace("rho = 2400.0", "rho = 0.0"), vec!["materials.concrete.rho"]),
-        (GOOD.replace("dt = 1.0e-5", "dt = 0.0"), vec!["analysis.dt"]),
-        (GOOD.replace("set = \"beam.left\"", "set = \"beam.west\""), vec!["supports[0].set", "unknown node set `beam.west`"]),
-        (GOOD.replace("set = \"beam.top\"", "set = \"beam.roof\""), vec!["loads[0].set", "unknown edge set"]),
-        (GOOD.replace("material = \"concrete\"", "material = \"steel\""), vec!["bodies[0].material", "unknown material `steel`"]),
-        (GOOD.replace("thickness = 0.2", "thickness = -0.2"), vec!["bodies[0].thickness"]),
         (
-            GOOD.replace("mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }", "mesh = { kind = \"gmsh\", file = \"missing.msh\" }"),
+            GOOD.replace("vtk_every = 5", "vtk_every = 5\ncolour = 3"),
+            vec!["unknown field `colour`"],
+        ),
+        (
+            GOOD.replace("E = 30e9", "E = -1.0"),
+            vec!["materials.concrete.E", "positive"],
+        ),
+        (
+            GOOD.replace("nu = 0.2", "nu = 0.5"),
+            vec!["materials.concrete.nu", "(-1, 0.5)"],
+        ),
+        (
+            GOOD.replace("rho = 2400.0", "rho = 0.0"),
+            vec!["materials.concrete.rho"],
+        ),
+        (GOOD.replace("dt = 1.0e-5", "dt = 0.0"), vec!["analysis.dt"]),
+        (
+            GOOD.replace("set = \"beam.left\"", "set = \"beam.west\""),
+            vec!["supports[0].set", "unknown node set `beam.west`"],
+        ),
+        (
+            GOOD.replace("set = \"beam.top\"", "set = \"beam.roof\""),
+            vec!["loads[0].set", "unknown edge set"],
+        ),
+        (
+            GOOD.replace("material = \"concrete\"", "material = \"steel\""),
+            vec!["bodies[0].material", "unknown material `steel`"],
+        ),
+        (
+            GOOD.replace("thickness = 0.2", "thickness = -0.2"),
+            vec!["bodies[0].thickness"],
+        ),
+        (
+            GOOD.replace(
+                "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
+                "mesh = { kind = \"gmsh\", file = \"missing.msh\" }",
+            ),
             vec!["bodies[0].mesh.file", "does not exist"],
         ),
         (
-            GOOD.replace("mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }", "mesh = { kind = \"gmsh\", file = \"broken.msh\" }"),
+            GOOD.replace(
+                "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
+                "mesh = { kind = \"gmsh\", file = \"broken.msh\" }",
+            ),
             vec!["bodies[0].mesh.file", "not a valid MSH"],
         ),
         (
-            GOOD.replace("mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }", "mesh = { kind = \"gmsh\", file = \"flat.msh\" }"),
+            GOOD.replace(
+                "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
+                "mesh = { kind = \"gmsh\", file = \"flat.msh\" }",
+            ),
             vec!["inverted or degenerate"],
         ),
     ];
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("broken.msh"), "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2\n").unwrap();
+    std::fs::write(
+        dir.path().join("broken.msh"),
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2\n",
+    )
+    .unwrap();
     // A triangle with all three nodes on a line: zero area.
-    let square = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square.msh")).unwrap();
-    std::fs::write(dir.path().join("flat.msh"), square.replace("1 1 0\n0 1 0\n", "1 1 0\n0.5 0.5 0\n")).unwrap();
+    let square = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square.msh"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("flat.msh"),
+        square.replace("1 1 0\n0 1 0\n", "1 1 0\n0.5 0.5 0\n"),
+    )
+    .unwrap();
     for (i, (text, words)) in cases.iter().enumerate() {
         let sc = scenario(dir.path(), &format!("bad{i}.toml"), text);
         let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
@@ -129,7 +206,10 @@ fn bad_input_gives_clear_errors() {
 
 #[test]
 fn gmsh_physical_groups_become_sets() {
-    let part = rothe::mesh::gmsh::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square.msh")).unwrap();
+    let part = rothe::mesh::gmsh::read(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square.msh"),
+    )
+    .unwrap();
     assert_eq!(part.coords.len(), 4);
     assert_eq!(part.blocks[0].kind, rothe::mesh::ElementKind::Tri3);
     assert_eq!(part.blocks[0].len(), 2);
