@@ -19,6 +19,7 @@
 
 pub mod assembly;
 pub mod config;
+pub mod driver;
 pub mod energy;
 pub mod error;
 pub mod fe;

@@ -34,6 +34,14 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Drive one material point along a strain or stress path; writes material.csv.
+    Material {
+        /// Material-point file (TOML with [material] and [path]).
+        file: PathBuf,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+    },
     /// Validate a scenario and print its size, the explicit CFL step and a memory
     /// estimate, without solving.
     Check {
@@ -57,6 +65,9 @@ fn main() -> ExitCode {
                 out.display()
             );
             Ok(())
+        }),
+        Command::Material { file, out } => rothe::driver::run_file(&file, &out).map(|records| {
+            eprintln!("{} steps; wrote {}", records.len() - 1, out.join("material.csv").display());
         }),
         Command::Check { scenario } => rothe::config::load(&scenario).and_then(|model| check(&model)),
     };

@@ -8,6 +8,11 @@ mod validate;
 
 pub use validate::material;
 
+/// Checks that `v` is positive and finite; the error names `field`.
+pub fn positive_pub(field: &str, v: f64) -> Result<()> {
+    validate::positive(field, v)
+}
+
 use std::collections::BTreeMap;
 use std::path::Path;
 

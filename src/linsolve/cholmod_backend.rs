@@ -18,8 +18,8 @@
 //! CHOLMOD 3 asks for 4 OpenMP threads on each supernode's loops whatever
 //! `OMP_NUM_THREADS` says; on a 2-core machine that made the factorisation about 3×
 //! slower (thread wake-ups), so `serialise_openmp` sets `omp_set_max_active_levels(0)`
-//! on the calling thread before each factorisation and solve. That libgomp setting is
-//! process-wide with GCC < 11; rothe has no other OpenMP user. BLAS threading
+//! before each factorisation and solve. Depending on the libgomp version that setting
+//! is per thread or process-wide; rothe has no other OpenMP user. BLAS threading
 //! (`OPENBLAS_NUM_THREADS`) is left to the environment.
 //!
 //! CHOLMOD's own messages are silenced (`print = 0`): failures come back as
@@ -51,9 +51,9 @@ const _: () = assert!(std::mem::size_of::<std::os::raw::c_long>() == 8);
 /// `cholmod_common` field overrides. `omp_set_max_active_levels(0)` makes every
 /// parallel region run on one thread. The function is looked up at run time in the
 /// already loaded libraries (libgomp comes in with libcholmod), so nothing changes
-/// when CHOLMOD was built without OpenMP. libgomp keeps this setting per thread
-/// (GCC >= 11) or per process (older), hence a call before every CHOLMOD call that
-/// may open a parallel region; it is one indirect call.
+/// when CHOLMOD was built without OpenMP. Depending on its version libgomp keeps this
+/// setting per process or per thread, hence a call before every CHOLMOD call that may
+/// open a parallel region; it is one indirect call.
 fn serialise_openmp() {
     use std::os::raw::{c_char, c_int};
     use std::sync::OnceLock;

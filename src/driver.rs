@@ -1,0 +1,317 @@
+//! The material-point driver behind `rothe material`: one Gauss point taken along a
+//! strain or stress path with mixed control, the same update the FE loop calls.
+//!
+//! A path fixes, per Voigt component, either the strain or the stress; the free
+//! components are found by Newton with the material's consistent tangent. The output
+//! `material.csv` has time, strain, stress, stored energy, history variables and the
+//! cumulative dissipation by mechanism, plus the work `∫ σ:dε` (backward Euler sum
+//! `Σ σ_{n+1}:Δε`) which equals `Δψ + D` exactly (see `theory/viscoelasticity.md`).
+
+use std::io::Write;
+use std::path::Path;
+
+use serde::Deserialize;
+
+use crate::config::MaterialSpec;
+use crate::error::{Error, Result};
+use crate::fe::Plane;
+use crate::material::{Material, PointResponse, StrainStep};
+use crate::model::TimeFunction;
+
+/// A `rothe material` file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriverFile {
+    /// The material, as in a scenario's `[materials.NAME]`.
+    pub material: MaterialSpec,
+    /// The path.
+    pub path: PathSpec,
+}
+
+/// Which loading path.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum PathKind {
+    /// `x` loaded; `σ_yy = σ_xy = 0`.
+    UniaxialStress,
+    /// `x` loaded; `ε_yy = γ_xy = 0`.
+    UniaxialStrain,
+    /// `γ_xy` (or `σ_xy`) loaded; `ε_xx = ε_yy = 0`.
+    PureShear,
+    /// `x` and `y` loaded in the ratio `ratio`; `σ_xy = 0`.
+    Biaxial,
+    /// The full strain `[ε_xx, ε_yy, γ_xy]` tabulated at `times`.
+    Table,
+}
+
+/// What the amplitude prescribes.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Control {
+    /// Strain.
+    #[default]
+    Strain,
+    /// Stress.
+    Stress,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn constant() -> TimeFunction {
+    TimeFunction::Constant
+}
+
+/// `[path]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathSpec {
+    /// The path kind.
+    pub kind: PathKind,
+    /// Plane stress (default) or plane strain idealisation of the point.
+    #[serde(default)]
+    pub plane: Plane,
+    /// Strain or stress control of the loaded components.
+    #[serde(default)]
+    pub control: Control,
+    /// Amplitude of the loaded component (strain, or stress in Pa).
+    #[serde(default)]
+    pub amplitude: f64,
+    /// Time function of the amplitude (default constant: a step at t = 0).
+    #[serde(default = "constant")]
+    pub function: TimeFunction,
+    /// Biaxial ratio `y / x` (default 1).
+    #[serde(default = "one")]
+    pub ratio: f64,
+    /// End time (s).
+    pub t_end: f64,
+    /// Step (s).
+    pub dt: f64,
+    /// Table path: times.
+    #[serde(default)]
+    pub times: Vec<f64>,
+    /// Table path: strains `[ε_xx, ε_yy, γ_xy]` at `times` (linear in between).
+    #[serde(default)]
+    pub strains: Vec<[f64; 3]>,
+}
+
+/// One output row.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointRecord {
+    /// Time.
+    pub t: f64,
+    /// Strain.
+    pub eps: [f64; 3],
+    /// Material response of the step.
+    pub response: PointResponse,
+    /// History after the step.
+    pub state: Vec<f64>,
+    /// Cumulative viscous, damage, plastic, numerical dissipation.
+    pub dissipated: [f64; 4],
+    /// Cumulative work `Σ σ_{n+1}:Δε`.
+    pub work: f64,
+}
+
+/// Targets per component at time `t`: `(strain_given, value)`.
+fn targets(p: &PathSpec, t: f64) -> [(bool, f64); 3] {
+    let a = p.amplitude * p.function.at(t);
+    let s = p.control == Control::Strain;
+    match p.kind {
+        PathKind::UniaxialStress => [(s, a), (false, 0.0), (false, 0.0)],
+        PathKind::UniaxialStrain => [(s, a), (true, 0.0), (true, 0.0)],
+        PathKind::PureShear => [(true, 0.0), (true, 0.0), (s, a)],
+        PathKind::Biaxial => [(s, a), (s, p.ratio * a), (false, 0.0)],
+        PathKind::Table => {
+            let f = |i: usize| {
+                let pts: Vec<[f64; 2]> = p
+                    .times
+                    .iter()
+                    .zip(&p.strains)
+                    .map(|(t, e)| [*t, e[i]])
+                    .collect();
+                TimeFunction::Table { points: pts }.at(t)
+            };
+            [(true, f(0)), (true, f(1)), (true, f(2))]
+        }
+    }
+}
+
+/// Validates the path; `field` prefixes errors.
+fn check(p: &PathSpec) -> Result<()> {
+    crate::config::positive_pub("path.dt", p.dt)?;
+    crate::config::positive_pub("path.t_end", p.t_end)?;
+    if p.kind == PathKind::Table {
+        if p.times.is_empty() || p.times.len() != p.strains.len() {
+            return Err(Error::config(
+                "path.strains",
+                "a table path needs `times` and as many `strains`",
+            ));
+        }
+        if p.times.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(Error::config("path.times", "must increase strictly"));
+        }
+    } else if !p.amplitude.is_finite() {
+        return Err(Error::config("path.amplitude", "must be finite"));
+    }
+    Ok(())
+}
+
+/// Runs the path and returns one record per step (the first at `t = 0`).
+pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
+    check(p)?;
+    let ns = mat.n_state();
+    let mut state_n = vec![0.0; ns];
+    mat.init_state(&mut state_n);
+    let mut state = state_n.clone();
+    let mut eps_n = [0.0; 3];
+    let mut out = vec![PointRecord {
+        t: 0.0,
+        eps: eps_n,
+        response: PointResponse::default(),
+        state: state_n.clone(),
+        dissipated: [0.0; 4],
+        work: 0.0,
+    }];
+    let n = (p.t_end / p.dt).round().max(1.0) as usize;
+    let (mut diss, mut work) = ([0.0; 4], 0.0);
+    for k in 1..=n {
+        let t = k as f64 * p.dt;
+        let tg = targets(p, t);
+        let mut eps = eps_n;
+        for (i, (given, v)) in tg.iter().enumerate() {
+            if *given {
+                eps[i] = *v;
+            }
+        }
+        let mut resp;
+        let mut it = 0;
+        loop {
+            resp = mat.update(
+                p.plane,
+                &StrainStep {
+                    eps_n,
+                    eps,
+                    dt: p.dt,
+                },
+                &state_n,
+                &mut state,
+            );
+            let free: Vec<usize> = (0..3).filter(|&i| !tg[i].0).collect();
+            let r: Vec<f64> = free.iter().map(|&i| resp.sigma[i] - tg[i].1).collect();
+            let scale = resp
+                .sigma
+                .iter()
+                .map(|s| s.abs())
+                .fold(mat.e * 1e-12, f64::max)
+                .max(tg.iter().map(|x| x.1.abs()).fold(0.0, f64::max));
+            if free.is_empty() || r.iter().all(|x| x.abs() <= 1e-12 * scale) {
+                break;
+            }
+            if it == 50 {
+                return Err(Error::Stepping(format!(
+                    "material point: no convergence of the mixed-control path at t = {t:e}"
+                )));
+            }
+            // Newton on the stress-controlled components.
+            let m = free.len();
+            let mut a = vec![vec![0.0; m]; m];
+            for (ii, &i) in free.iter().enumerate() {
+                for (jj, &j) in free.iter().enumerate() {
+                    a[ii][jj] = resp.tangent[i][j];
+                }
+            }
+            let d = solve_small(a, r).ok_or_else(|| {
+                Error::Stepping(format!("material point: singular tangent at t = {t:e}"))
+            })?;
+            for (ii, &i) in free.iter().enumerate() {
+                eps[i] -= d[ii];
+            }
+            it += 1;
+        }
+        let d = &resp.dissipation;
+        diss[0] += d.viscous;
+        diss[1] += d.damage;
+        diss[2] += d.plastic;
+        diss[3] += d.numerical;
+        work += (0..3)
+            .map(|i| resp.sigma[i] * (eps[i] - eps_n[i]))
+            .sum::<f64>();
+        out.push(PointRecord {
+            t,
+            eps,
+            response: resp,
+            state: state.clone(),
+            dissipated: diss,
+            work,
+        });
+        eps_n = eps;
+        state_n.clone_from(&state);
+    }
+    Ok(out)
+}
+
+/// Gaussian elimination with partial pivoting for the tiny mixed-control systems.
+fn solve_small(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+    let n = b.len();
+    for c in 0..n {
+        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+        if a[p][c] == 0.0 {
+            return None;
+        }
+        a.swap(c, p);
+        b.swap(c, p);
+        for r in c + 1..n {
+            let f = a[r][c] / a[c][c];
+            for k in c..n {
+                a[r][k] -= f * a[c][k];
+            }
+            b[r] -= f * b[c];
+        }
+    }
+    let mut x = vec![0.0; n];
+    for c in (0..n).rev() {
+        x[c] = (b[c] - (c + 1..n).map(|k| a[c][k] * x[k]).sum::<f64>()) / a[c][c];
+    }
+    Some(x)
+}
+
+/// Reads a driver file, runs it and writes `out/material.csv`.
+pub fn run_file(file: &Path, out: &Path) -> Result<Vec<PointRecord>> {
+    let text = std::fs::read_to_string(file).map_err(|e| Error::io(file, e))?;
+    let spec: DriverFile = toml::from_str(&text)
+        .map_err(|e| Error::config(file.display().to_string(), e.message().to_string()))?;
+    let mat = crate::config::material("point", "material", &spec.material)
+        .map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
+    let records = run_path(&mat, &spec.path)?;
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let path = out.join("material.csv");
+    let mut w =
+        std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| Error::io(&path, e))?);
+    let mut header = vec![
+        "t", "eps_xx", "eps_yy", "gamma_xy", "sig_xx", "sig_yy", "sig_xy", "psi",
+    ];
+    header.extend(mat.state_names());
+    header.extend(["D_viscous", "D_damage", "D_plastic", "D_num", "work"]);
+    let io = |e| Error::io(&path, e);
+    writeln!(w, "{}", header.join(",")).map_err(io)?;
+    for r in &records {
+        let mut row = vec![
+            r.t,
+            r.eps[0],
+            r.eps[1],
+            r.eps[2],
+            r.response.sigma[0],
+            r.response.sigma[1],
+            r.response.sigma[2],
+            r.response.psi,
+        ];
+        row.extend(&r.state);
+        row.extend(r.dissipated);
+        row.push(r.work);
+        let line: Vec<String> = row.iter().map(|v| format!("{v:.12e}")).collect();
+        writeln!(w, "{}", line.join(",")).map_err(io)?;
+    }
+    w.flush().map_err(io)?;
+    Ok(records)
+}
