@@ -44,5 +44,36 @@ fn factorisation_and_step(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, assembly, factorisation_and_step);
+fn sls(c: &mut Criterion) {
+    let mut g = c.benchmark_group("w1_sls");
+    g.sample_size(10);
+    for ny in [25usize, 100] {
+        let model = rothe::workload::w1_with(ny, rothe::workload::W1_SLS).unwrap();
+        let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let n = model.mesh.n_dofs();
+        let u: Vec<f64> = (0..n).map(|i| 1e-6 * (i % 7) as f64).collect();
+        let (mut f, mut fp) = (vec![0.0; n], vec![0.0; n]);
+        g.bench_with_input(BenchmarkId::new("gauss_point_loop", ny), &ny, |b, _| {
+            b.iter(|| {
+                be.asm.internal_force(
+                    &model.mesh,
+                    &model.materials,
+                    model.plane,
+                    &u,
+                    1e-5,
+                    &mut s.points,
+                    &mut f,
+                    Some(&mut fp),
+                )
+            })
+        });
+        g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| {
+            b.iter(|| be.step(&mut s).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, assembly, factorisation_and_step, sls);
 criterion_main!(benches);

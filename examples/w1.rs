@@ -1,6 +1,7 @@
 //! Workload W1 at any size and backend, printing the figures the README reports:
-//! `cargo run --release --example w1 -- [NY] [faer|cholmod]` (defaults 100, faer).
-//! Add `--features cholmod` for the CHOLMOD backend.
+//! `cargo run --release --example w1 -- [NY] [faer|cholmod] [elastic|sls]` (defaults
+//! 100, faer, elastic). Add `--features cholmod` for the CHOLMOD backend; `sls` puts
+//! the standard linear solid in place of elasticity (Gauss-point history path).
 
 use std::time::Instant;
 
@@ -34,7 +35,12 @@ fn main() -> rothe::Result<()> {
         .map(|s| s.parse().expect("backend is faer or cholmod"))
         .unwrap_or_default();
     let t0 = Instant::now();
-    let model = rothe::workload::w1(ny)?;
+    let sls = args.get(2).map(|s| s == "sls").unwrap_or(false);
+    let model = if sls {
+        rothe::workload::w1_with(ny, rothe::workload::W1_SLS)?
+    } else {
+        rothe::workload::w1(ny)?
+    };
     let setup_s = t0.elapsed().as_secs_f64();
     let mut be = BackwardEuler::new(&model, backend)?;
     let mut s = be.initial_state();

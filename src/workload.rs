@@ -6,8 +6,19 @@
 use crate::error::Result;
 use crate::model::Model;
 
+/// The W1 material block with the standard linear solid of eq. (10) in place of
+/// elasticity (`α = 0.5`, `β = 1e-4 s`), for the cost comparison of issue-level
+/// benchmarks.
+pub const W1_SLS: &str = "model = \"sls\"\nalpha = 0.5\nbeta = 1.0e-4";
+
 /// The W1 scenario text for `ny` cells across the height.
 pub fn w1_scenario(ny: usize) -> String {
+    w1_scenario_with(ny, "model = \"elastic\"")
+}
+
+/// The W1 scenario with another material model line block (`model = ...` plus its
+/// parameters; `E, nu, rho` stay W1's).
+pub fn w1_scenario_with(ny: usize, model_lines: &str) -> String {
     format!(
         r#"
 [analysis]
@@ -16,7 +27,7 @@ dt = 1.0e-5
 mass = "consistent"
 vtk_every = 0
 [materials.concrete]
-model = "elastic"
+{model_lines}
 E = 30e9
 nu = 0.2
 rho = 2400.0
@@ -44,4 +55,12 @@ at = [2.0, 0.25]
 /// The W1 model for `ny` cells across the height.
 pub fn w1(ny: usize) -> Result<Model> {
     crate::config::from_str(&w1_scenario(ny), std::path::Path::new("."))
+}
+
+/// The W1 model with the material block `model_lines`.
+pub fn w1_with(ny: usize, model_lines: &str) -> Result<Model> {
+    crate::config::from_str(
+        &w1_scenario_with(ny, model_lines),
+        std::path::Path::new("."),
+    )
 }

@@ -156,7 +156,10 @@ fn test_matrices() -> Vec<(&'static str, LowerCsc)> {
         ("1x1", laplacian(1, 1.0)),
         ("laplacian 12x12 + 0.01 I", laplacian(12, 0.01)),
         ("laplacian 40x40 + 1e-3 I", laplacian(40, 1e-3)),
-        ("cantilever K_eff", effective_matrix(&model, 1.0 / (h * h), 1.0)),
+        (
+            "cantilever K_eff",
+            effective_matrix(&model, 1.0 / (h * h), 1.0),
+        ),
         ("cantilever K", stiffness_matrix(&model)),
     ]
 }
@@ -175,7 +178,10 @@ fn both_backends_agree_on_spd_matrices() {
         assert!(r < 1e-8, "{name}: cholmod residual {r:e}");
         let (nf, nc) = (faer.factor_nnz().unwrap(), chol.factor_nnz().unwrap());
         assert!(nc >= a.row_idx.len(), "{name}: nnz(L) {nc} below nnz(A)");
-        eprintln!("{name}: n = {}, nnz(L) faer {nf} (len_val), cholmod {nc}", a.n);
+        eprintln!(
+            "{name}: n = {}, nnz(L) faer {nf} (len_val), cholmod {nc}",
+            a.n
+        );
     }
 }
 
@@ -200,10 +206,17 @@ fn refactorisation_on_the_same_pattern() {
             faer.solve_in_place(&mut xf).unwrap();
             chol.solve_in_place(&mut xc).unwrap();
             let d = rel_diff(&xc, &xf);
-            assert!(d < TOL, "h = {h:e}, scale {scale}: backends differ by {d:e}");
+            assert!(
+                d < TOL,
+                "h = {h:e}, scale {scale}: backends differ by {d:e}"
+            );
         }
     }
-    assert_eq!(chol.factor_nnz(), nnz0, "refactorisation changed the pattern");
+    assert_eq!(
+        chol.factor_nnz(),
+        nnz0,
+        "refactorisation changed the pattern"
+    );
 
     // Refactorising the Laplacian with new values too.
     let mut l = laplacian(30, 0.5);
@@ -282,7 +295,10 @@ fn bad_input_is_an_error() {
     assert!(chol.solve_in_place(&mut x).is_err(), "solve before analyze");
     assert!(chol.factor_nnz().is_none());
     chol.analyze(&a).unwrap();
-    assert!(chol.solve_in_place(&mut x).is_err(), "solve before factorize");
+    assert!(
+        chol.solve_in_place(&mut x).is_err(),
+        "solve before factorize"
+    );
 
     let mut bad = a.clone();
     bad.row_idx[1] = 99;
@@ -354,7 +370,10 @@ fn dynamic_cantilever_histories_agree() {
         let d = rel_diff(&sc.u, &sf.u);
         worst = worst.max(d);
         assert!(d < TOL, "step {step}: displacements differ by {d:e}");
-        assert!(rel_diff(&sc.v, &sf.v) < TOL, "step {step}: velocities differ");
+        assert!(
+            rel_diff(&sc.v, &sf.v) < TOL,
+            "step {step}: velocities differ"
+        );
     }
     // A step-size change refactorises both on the same pattern.
     bf.set_step(5e-6).unwrap();

@@ -333,3 +333,48 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn predicted_stress_is_the_update_at_unchanged_strain() {
+    // The shortcut the constant-tangent FE path uses must equal the full update.
+    for text in [
+        "model = \"elastic\"",
+        "model = \"kelvin_voigt\"\nalpha = 1e-3",
+        "model = \"sls\"\nalpha = 0.7\nbeta = 1e-3",
+        "model = \"maxwell\"\nbeta = 1e-3",
+    ] {
+        let m = mat(&format!("{text}\nE = {E}\nnu = {NU}\nrho = 2400.0"));
+        let ns = m.n_state();
+        let (mut s1, mut s2) = (vec![0.0; ns], vec![0.0; ns]);
+        let eps = [1e-4, -3e-5, 5e-5];
+        m.update(
+            Plane::Stress,
+            &StrainStep {
+                eps_n: [0.0; 3],
+                eps,
+                dt: 1e-4,
+            },
+            &vec![0.0; ns],
+            &mut s1,
+        );
+        let full = m
+            .update(
+                Plane::Stress,
+                &StrainStep {
+                    eps_n: eps,
+                    eps,
+                    dt: 1e-4,
+                },
+                &s1,
+                &mut s2,
+            )
+            .sigma;
+        let quick = m.predicted_stress(Plane::Stress, &eps, &s1, 1e-4);
+        for i in 0..3 {
+            assert!(
+                (full[i] - quick[i]).abs() <= 1e-12 * full[0].abs(),
+                "{text}: {full:?} vs {quick:?}"
+            );
+        }
+    }
+}

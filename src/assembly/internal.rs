@@ -91,10 +91,15 @@ struct Ctx<'a> {
     kind: ElementKind,
     section: f64,
     dt: f64,
+    /// Also evaluate the stress of the next step at an unchanged strain.
+    predict: bool,
 }
 
-/// Evaluates element `e` at displacements `u`: calls `point(g, w, &resp, &kin, eps)`
-/// for each of its points (global point index within the block `g`).
+/// Evaluates element `e` at displacements `u`: calls `point(g, w, &resp, &kin, x,
+/// σ_pred)` for each of its points (global point index within the block `g`), where
+/// `σ_pred` (when `cx.predict`) is the stress of the next step of the same size at
+/// an unchanged strain, from the trial history: for constant-tangent materials
+/// `f_int` of the next step is then `f_pred + K_t Δu` exactly.
 fn element_points<F>(
     cx: &Ctx,
     store: &StateStore,
@@ -110,6 +115,7 @@ fn element_points<F>(
         &crate::material::PointResponse,
         Option<&crate::fe::PointKinematics>,
         &[[f64; 2]],
+        [f64; 3],
     ),
 {
     let nn = nodes.len();
@@ -142,7 +148,7 @@ fn element_points<F>(
             unsafe { t.slice(3 * g, 3) }.copy_from_slice(&[eps, 0.0, 0.0]);
             unsafe { t.slice(store.eps.len() + 3 * g, 3) }.copy_from_slice(&resp.sigma);
         }
-        point(g, cx.section * l, &resp, None, &x[..2]);
+        point(g, cx.section * l, &resp, None, &x[..2], resp.sigma);
         return;
     }
     let rule = stiffness_rule(cx.kind);
@@ -157,6 +163,7 @@ fn element_points<F>(
             dt: cx.dt,
         };
         let committed = &store.committed[g * ns..(g + 1) * ns];
+        let mut pred = [0.0; 3];
         let resp = match trial {
             Some(t) => {
                 // SAFETY: point g belongs to element e only. The trial buffer holds
@@ -166,19 +173,61 @@ fn element_points<F>(
                 let hist = unsafe { t.slice(2 * n3 + g * ns, ns) };
                 let r = cx.mat.update(cx.plane, &step, committed, hist);
                 unsafe { t.slice(n3 + 3 * g, 3) }.copy_from_slice(&r.sigma);
+                if cx.predict {
+                    pred = cx.mat.predicted_stress(cx.plane, &eps, hist, cx.dt);
+                }
                 r
             }
             None => cx
                 .mat
                 .update(cx.plane, &step, committed, &mut scratch[..ns]),
         };
-        point(g, wq * k.det_j * cx.section, &resp, Some(&k), &x[..nn]);
+        point(
+            g,
+            wq * k.det_j * cx.section,
+            &resp,
+            Some(&k),
+            &x[..nn],
+            pred,
+        );
+    }
+}
+
+/// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`.
+#[inline]
+fn add_bt_sigma(
+    k: Option<&crate::fe::PointKinematics>,
+    x: &[[f64; 2]],
+    nn: usize,
+    w: f64,
+    sigma: &[f64; 3],
+    fe: &mut [f64; 8],
+) {
+    match k {
+        Some(k) => {
+            for a in 0..nn {
+                let (dx, dy) = (k.dndx[a][0], k.dndx[a][1]);
+                fe[2 * a] += w * (dx * sigma[0] + dy * sigma[2]);
+                fe[2 * a + 1] += w * (dy * sigma[1] + dx * sigma[2]);
+            }
+        }
+        None => {
+            let (ax, l) = element::bar_axis(x);
+            let n = sigma[0] * w / l;
+            fe[0] -= n * ax[0];
+            fe[1] -= n * ax[1];
+            fe[2] += n * ax[0];
+            fe[3] += n * ax[1];
+        }
     }
 }
 
 impl Assembler {
     /// Internal forces at `u` into `f` (overwritten), trial states into the stores,
-    /// and the integrated stored energy and dissipation of the step `dt`.
+    /// and the integrated stored energy and dissipation of the step `dt`. With
+    /// `f_pred`, also the internal force of the next step at unchanged `u` (see
+    /// `element_points`), in the same pass.
+    #[allow(clippy::too_many_arguments)]
     pub fn internal_force(
         &self,
         mesh: &Mesh,
@@ -188,9 +237,15 @@ impl Assembler {
         dt: f64,
         stores: &mut [StateStore],
         f: &mut [f64],
+        mut f_pred: Option<&mut [f64]>,
     ) -> PointTotals {
         f.fill(0.0);
         let fp = Shared(f.as_mut_ptr());
+        let predict = f_pred.is_some();
+        let pp = f_pred.as_mut().map(|v| {
+            v.fill(0.0);
+            Shared(v.as_mut_ptr())
+        });
         let mut totals = PointTotals::default();
         for (bi, block) in mesh.blocks.iter().enumerate() {
             let store = &mut stores[bi];
@@ -208,6 +263,7 @@ impl Assembler {
                 kind: block.elements.kind,
                 section: block.section,
                 dt,
+                predict,
             };
             let store_ref: &StateStore = store;
             for colour in &self.colours[bi] {
@@ -218,6 +274,7 @@ impl Assembler {
                         for &e in chunk {
                             let nodes = block.elements.element(e);
                             let mut fe = [0.0; 8];
+                            let mut fe_pred = [0.0; 8];
                             element_points(
                                 &cx,
                                 store_ref,
@@ -225,26 +282,11 @@ impl Assembler {
                                 u,
                                 e,
                                 Some(tp),
-                                |_, w, r, k, x| {
+                                |_, w, r, k, x, sp| {
                                     acc.add_scaled(r.psi, &r.dissipation, w);
-                                    match k {
-                                        Some(k) => {
-                                            for a in 0..nodes.len() {
-                                                let (dx, dy) = (k.dndx[a][0], k.dndx[a][1]);
-                                                fe[2 * a] +=
-                                                    w * (dx * r.sigma[0] + dy * r.sigma[2]);
-                                                fe[2 * a + 1] +=
-                                                    w * (dy * r.sigma[1] + dx * r.sigma[2]);
-                                            }
-                                        }
-                                        None => {
-                                            let (ax, _) = element::bar_axis(x);
-                                            let n = r.sigma[0] * w / element::bar_axis(x).1;
-                                            fe[0] -= n * ax[0];
-                                            fe[1] -= n * ax[1];
-                                            fe[2] += n * ax[0];
-                                            fe[3] += n * ax[1];
-                                        }
+                                    add_bt_sigma(k, x, nodes.len(), w, &r.sigma, &mut fe);
+                                    if predict {
+                                        add_bt_sigma(k, x, nodes.len(), w, &sp, &mut fe_pred);
                                     }
                                 },
                             );
@@ -253,6 +295,12 @@ impl Assembler {
                                 let fn_ = unsafe { fp.slice(2 * n, 2) };
                                 fn_[0] += fe[2 * a];
                                 fn_[1] += fe[2 * a + 1];
+                                if let Some(pp) = pp {
+                                    // SAFETY: as above, for the predicted force.
+                                    let pn = unsafe { pp.slice(2 * n, 2) };
+                                    pn[0] += fe_pred[2 * a];
+                                    pn[1] += fe_pred[2 * a + 1];
+                                }
                             }
                         }
                         acc
@@ -289,6 +337,7 @@ impl Assembler {
                 kind: block.elements.kind,
                 section: block.section,
                 dt,
+                predict: false,
             };
             let nodes = block.elements.element(e);
             let nd = 2 * nodes.len();
@@ -300,7 +349,7 @@ impl Assembler {
                 u,
                 e,
                 None,
-                |_, w, r, k, x| match k {
+                |_, w, r, k, x, _| match k {
                     Some(k) => element::add_btdb(k, nodes.len(), &r.tangent, w, ke),
                     None => {
                         element::bar_stiffness(x, r.tangent[0][0] * w / element::bar_axis(x).1, ke)

@@ -149,6 +149,39 @@ impl Material {
         state.fill(0.0);
     }
 
+    /// Stress of a step of size `dt` that leaves the strain at `eps`, from the history
+    /// `state` (the trial state of the step just taken): what `update` would return
+    /// with `eps_n = eps`, computed without the energy terms. For constant-tangent
+    /// models the next step's stress is this plus `tangent · Δε`.
+    pub fn predicted_stress(
+        &self,
+        plane: Plane,
+        eps: &[f64; 3],
+        state: &[f64],
+        dt: f64,
+    ) -> [f64; 3] {
+        let c = self.c(plane);
+        match self.model {
+            Model::Elastic | Model::KelvinVoigt(_) => mul3(&c, eps),
+            Model::Sls {
+                alpha,
+                beta,
+                parallel,
+            } => {
+                let k = dt * alpha / beta;
+                let p = if parallel { 1.0 } else { 0.0 };
+                let ee = [eps[0] - state[0], eps[1] - state[1], eps[2] - state[2]];
+                let (ce, cee) = (mul3(&c, eps), mul3(&c, &ee));
+                let a = alpha / (1.0 + k);
+                [
+                    p * ce[0] + a * cee[0],
+                    p * ce[1] + a * cee[1],
+                    p * ce[2] + a * cee[2],
+                ]
+            }
+        }
+    }
+
     /// The material update (see the module docs).
     pub fn update(
         &self,
