@@ -62,6 +62,7 @@ fn sls(c: &mut Criterion) {
                     model.plane,
                     &u,
                     1e-5,
+                    false,
                     &mut s.points,
                     &mut f,
                     Some(&mut fp),

@@ -46,8 +46,9 @@ fn main() -> rothe::Result<()> {
     let mut s = be.initial_state();
     let t_steps = Instant::now();
     let n = model.analysis.n_steps();
+    let mut solves = 0;
     for _ in 0..n {
-        be.step(&mut s)?;
+        solves += be.step(&mut s)?.iterations;
     }
     let steps_s = t_steps.elapsed().as_secs_f64();
     let tip = model.probes[0].node;
@@ -86,6 +87,7 @@ fn main() -> rothe::Result<()> {
         "  energy residual rel  {:.2e}",
         s.ledger.relative_residual()
     );
+    println!("  solves per step      {:.2}", solves as f64 / n as f64);
     println!("  total                {:.3} s", t0.elapsed().as_secs_f64());
     Ok(())
 }

@@ -93,6 +93,9 @@ struct Ctx<'a> {
     dt: f64,
     /// Also evaluate the stress of the next step at an unchanged strain.
     predict: bool,
+    /// Evaluate the state at rest at `u` (the initial state): `ε_n = ε`, no
+    /// history evolution, no dissipation.
+    at_rest: bool,
 }
 
 /// Evaluates element `e` at displacements `u`: calls `point(g, w, &resp, &kin, x,
@@ -131,7 +134,7 @@ fn element_points<F>(
     if cx.kind == ElementKind::Bar2 {
         let g = e;
         let eps = element::bar_strain(&x[..2], &ue[..4]);
-        let eps_n = store.eps[3 * g];
+        let eps_n = if cx.at_rest { eps } else { store.eps[3 * g] };
         let de = eps - eps_n;
         let (_, l) = element::bar_axis(&x[..2]);
         let resp = crate::material::PointResponse {
@@ -226,7 +229,8 @@ impl Assembler {
     /// Internal forces at `u` into `f` (overwritten), trial states into the stores,
     /// and the integrated stored energy and dissipation of the step `dt`. With
     /// `f_pred`, also the internal force of the next step at unchanged `u` (see
-    /// `element_points`), in the same pass.
+    /// `element_points`), in the same pass. With `at_rest`, the state at rest at `u`
+    /// is evaluated instead of a step (the initial state: history not evolved).
     #[allow(clippy::too_many_arguments)]
     pub fn internal_force(
         &self,
@@ -235,6 +239,7 @@ impl Assembler {
         plane: Plane,
         u: &[f64],
         dt: f64,
+        at_rest: bool,
         stores: &mut [StateStore],
         f: &mut [f64],
         mut f_pred: Option<&mut [f64]>,
@@ -264,6 +269,7 @@ impl Assembler {
                 section: block.section,
                 dt,
                 predict,
+                at_rest,
             };
             let store_ref: &StateStore = store;
             for colour in &self.colours[bi] {
@@ -338,6 +344,7 @@ impl Assembler {
                 section: block.section,
                 dt,
                 predict: false,
+                at_rest: false,
             };
             let nodes = block.elements.element(e);
             let nd = 2 * nodes.len();

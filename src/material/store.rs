@@ -33,11 +33,12 @@ impl StateStore {
         }
     }
 
-    /// Accepts the step: trial becomes committed.
+    /// Accepts the step: trial becomes committed. The buffers are swapped, not
+    /// copied: every evaluation rewrites all trial entries before they are read.
     pub fn commit(&mut self) {
-        self.committed.copy_from_slice(&self.trial);
-        self.eps.copy_from_slice(&self.eps_trial);
-        self.sigma.copy_from_slice(&self.sigma_trial);
+        std::mem::swap(&mut self.committed, &mut self.trial);
+        std::mem::swap(&mut self.eps, &mut self.eps_trial);
+        std::mem::swap(&mut self.sigma, &mut self.sigma_trial);
     }
 
     /// Number of points.

@@ -97,6 +97,10 @@ pub struct BackwardEuler<'m> {
     v1: Vec<f64>,
     mv1: Vec<f64>,
     rhs: Vec<f64>,
+    u1: Vec<f64>,
+    fint1: Vec<f64>,
+    fpred1: Vec<f64>,
+    kv: Vec<f64>,
 }
 
 impl<'m> BackwardEuler<'m> {
@@ -168,6 +172,10 @@ impl<'m> BackwardEuler<'m> {
             v1: vec![0.0; n],
             mv1: vec![0.0; n],
             rhs: Vec::with_capacity(n),
+            u1: Vec::new(),
+            fint1: Vec::new(),
+            fpred1: Vec::new(),
+            kv: Vec::new(),
         })
     }
 
@@ -206,7 +214,7 @@ impl<'m> BackwardEuler<'m> {
             (0.5 * dot(&u, &fint), Vec::new())
         } else {
             let mut points = new_stores(&model.mesh, &model.materials);
-            let totals = self.internal(&u, &mut points, &mut fint, Some(&mut fpred));
+            let totals = self.internal(&u, true, &mut points, &mut fint, Some(&mut fpred));
             points.iter_mut().for_each(StateStore::commit);
             (totals.psi, points)
         };
@@ -227,13 +235,23 @@ impl<'m> BackwardEuler<'m> {
     fn internal(
         &self,
         u: &[f64],
+        at_rest: bool,
         points: &mut [StateStore],
         f: &mut [f64],
         f_pred: Option<&mut [f64]>,
     ) -> PointTotals {
         let m = self.model;
-        self.asm
-            .internal_force(&m.mesh, &m.materials, m.plane, u, self.h, points, f, f_pred)
+        self.asm.internal_force(
+            &m.mesh,
+            &m.materials,
+            m.plane,
+            u,
+            self.h,
+            at_rest,
+            points,
+            f,
+            f_pred,
+        )
     }
 
     /// Advances `s` by one step `h`. On error `s` is unchanged.
@@ -362,7 +380,10 @@ impl<'m> BackwardEuler<'m> {
     /// A step for materials with Gauss-point history: equilibrium iterations
     /// `K_eff δ = −r(u)` with `r = M(v − v⁰)/h + C v + f_int(u) − f_ext¹`, `f_int`
     /// from the Gauss-point loop against the committed history. For constant-tangent
-    /// materials the first solve is exact and the second evaluation confirms it.
+    /// materials the first solve starts from the force predicted at the end of the
+    /// previous step (`DynState::fpred`), is exact up to round-off, and the one
+    /// Gauss-point pass that follows confirms it and yields the final state (after
+    /// `set_step` the prediction is for the old step and a second solve follows).
     fn step_history(&mut self, s: &mut DynState) -> Result<StepReport> {
         let t_start = Instant::now();
         let mut solve_s = 0.0;
@@ -371,10 +392,15 @@ impl<'m> BackwardEuler<'m> {
         let n = s.u.len();
         external_force(self.model, self.gravity.as_deref(), t1, &mut self.f1);
         let moving = self.prescribed_increments(&s.u, t1);
-        let mut u1: Vec<f64> = s.u.iter().zip(&self.du).map(|(u, d)| u + d).collect();
-        let mut fint1 = vec![0.0; n];
-        let mut fpred1 = vec![0.0; s.fpred.len()];
-        let mut kv = vec![0.0; n];
+        let mut u1 = std::mem::take(&mut self.u1);
+        u1.clear();
+        u1.extend(s.u.iter().zip(&self.du).map(|(u, d)| u + d));
+        let mut fint1 = std::mem::take(&mut self.fint1);
+        fint1.resize(n, 0.0);
+        let mut fpred1 = std::mem::take(&mut self.fpred1);
+        fpred1.resize(s.fpred.len(), 0.0);
+        let mut kv = std::mem::take(&mut self.kv);
+        kv.resize(n, 0.0);
         let mut history: Vec<f64> = Vec::new();
         let mut iterations = 0;
         let constant = !s.fpred.is_empty();
@@ -411,7 +437,7 @@ impl<'m> BackwardEuler<'m> {
             } else {
                 None
             };
-            let totals = self.internal(&u1, &mut s.points, &mut fint1, pred);
+            let totals = self.internal(&u1, false, &mut s.points, &mut fint1, pred);
             for i in 0..n {
                 self.du[i] = u1[i] - s.u[i];
                 self.v1[i] = self.du[i] / h;
@@ -477,9 +503,10 @@ impl<'m> BackwardEuler<'m> {
             inc.kinetic_loss += 0.5 * (self.v1[i] - s.v[i]) * (self.mv1[i] - s.mv[i]);
             s.fext[i] = fext1;
         }
-        s.u = u1;
-        s.fint = fint1;
-        s.fpred = fpred1;
+        self.u1 = std::mem::replace(&mut s.u, u1);
+        self.fint1 = std::mem::replace(&mut s.fint, fint1);
+        self.fpred1 = std::mem::replace(&mut s.fpred, fpred1);
+        self.kv = kv;
         std::mem::swap(&mut s.v, &mut self.v1);
         std::mem::swap(&mut s.mv, &mut self.mv1);
         s.points.iter_mut().for_each(StateStore::commit);

@@ -1,5 +1,7 @@
 //! Free and constrained dofs, and the effective matrix restricted to the free dofs.
 
+use rayon::prelude::*;
+
 use crate::assembly::{Mass, Pattern};
 use crate::linsolve::LowerCsc;
 
@@ -52,8 +54,9 @@ impl ReducedMatrix {
         let nf = dofs.n_free();
         let mut col_ptr = Vec::with_capacity(nf + 1);
         col_ptr.push(0);
-        let mut row_idx = Vec::new();
-        let mut src = Vec::new();
+        let cap = pattern.nnz() / 2 + pattern.n_dofs();
+        let mut row_idx = Vec::with_capacity(cap);
+        let mut src = Vec::with_capacity(cap);
         let mut diag_pos = Vec::with_capacity(nf);
         for n in 0..pattern.n_nodes {
             let nbrs = &pattern.adj[pattern.adj_ptr[n]..pattern.adj_ptr[n + 1]];
@@ -94,16 +97,27 @@ impl ReducedMatrix {
     /// Refills the values with `c_m M + Σ (c_i, A_i)` restricted to the free dofs.
     pub fn fill(&mut self, dofs: &DofMap, c_m: f64, mass: &Mass, terms: &[(f64, &[f64])]) {
         let v = &mut self.csc.values;
-        for (p, out) in v.iter_mut().enumerate() {
-            let s = self.src[p];
-            *out = terms.iter().map(|(c, a)| c * a[s]).sum();
+        let src = &self.src;
+        match terms {
+            [(c, a)] => v
+                .par_iter_mut()
+                .zip(src.par_iter())
+                .for_each(|(o, &s)| *o = c * a[s]),
+            [(c, a), (d, b)] => v
+                .par_iter_mut()
+                .zip(src.par_iter())
+                .for_each(|(o, &s)| *o = c * a[s] + d * b[s]),
+            _ => v
+                .par_iter_mut()
+                .zip(src.par_iter())
+                .for_each(|(o, &s)| *o = terms.iter().map(|(c, a)| c * a[s]).sum()),
         }
         match mass {
             Mass::Consistent(m) => {
                 if c_m != 0.0 {
-                    for (p, out) in v.iter_mut().enumerate() {
-                        *out += c_m * m[self.src[p]];
-                    }
+                    v.par_iter_mut()
+                        .zip(src.par_iter())
+                        .for_each(|(o, &s)| *o += c_m * m[s]);
                 }
             }
             Mass::Lumped(d) => {
