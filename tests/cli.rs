@@ -221,3 +221,34 @@ fn gmsh_physical_groups_become_sets() {
     let (a, b, c) = (x(3), x(4), x(5));
     assert!((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]) > 0.0);
 }
+
+#[test]
+fn material_driver_writes_curves_and_rejects_bad_parameters() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/materials/sls_relaxation.toml");
+    let out = dir.path().join("m");
+    let (ok, _, err) = rothe(&["material", file.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(out.join("material.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert_eq!(
+        header,
+        "t,eps_xx,eps_yy,gamma_xy,sig_xx,sig_yy,sig_xy,psi,eps_d_xx,eps_d_yy,gamma_d_xy,D_viscous,D_damage,D_plastic,D_num,work"
+    );
+    assert_eq!(csv.lines().count(), 1002);
+    let text = std::fs::read_to_string(&file).unwrap();
+    for (bad, words) in [
+        (text.replace("beta = 1.0e-3", "beta = -1.0"), vec!["material.beta", "positive"]),
+        (text.replace("alpha = 0.5\n", ""), vec!["missing field `alpha`"]),
+        (text.replace("kind = \"uniaxial_stress\"", "kind = \"twisted\""), vec!["unknown variant `twisted`"]),
+    ] {
+        let f = dir.path().join("bad.toml");
+        std::fs::write(&f, bad).unwrap();
+        let (ok, _, err) = rothe(&["material", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        assert!(!ok);
+        assert!(!err.contains("panicked"), "{err}");
+        for w in words {
+            assert!(err.contains(w), "`{w}` not in {err}");
+        }
+    }
+}

@@ -159,12 +159,16 @@ fn element_points<F>(
         let g = e * rule.len() + q;
         let k = kinematics(cx.kind, &x[..nn], xi);
         let eps = strain(&k, nn, &ue);
-        let eps_n = [store.eps[3 * g], store.eps[3 * g + 1], store.eps[3 * g + 2]];
-        let step = StrainStep {
-            eps_n,
-            eps,
-            dt: cx.dt,
+        let (eps_n, dt) = if cx.at_rest {
+            // A vanishing step: rates are zero and history does not evolve.
+            (eps, f64::MIN_POSITIVE)
+        } else {
+            (
+                [store.eps[3 * g], store.eps[3 * g + 1], store.eps[3 * g + 2]],
+                cx.dt,
+            )
         };
+        let step = StrainStep { eps_n, eps, dt };
         let committed = &store.committed[g * ns..(g + 1) * ns];
         let mut pred = [0.0; 3];
         let resp = match trial {
