@@ -94,6 +94,14 @@ pub struct PathSpec {
     /// Table path: strains `[ε_xx, ε_yy, γ_xy]` at `times` (linear in between).
     #[serde(default)]
     pub strains: Vec<[f64; 3]>,
+    /// Size of the element the point stands for (m), the crack-band length of
+    /// softening laws. Default 0.1 m, a typical concrete element.
+    #[serde(default = "default_length")]
+    pub length: f64,
+}
+
+fn default_length() -> f64 {
+    0.1
 }
 
 /// One output row.
@@ -141,6 +149,7 @@ fn targets(p: &PathSpec, t: f64) -> [(bool, f64); 3] {
 fn check(p: &PathSpec) -> Result<()> {
     crate::config::positive_pub("path.dt", p.dt)?;
     crate::config::positive_pub("path.t_end", p.t_end)?;
+    crate::config::positive_pub("path.length", p.length)?;
     if p.kind == PathKind::Table {
         if p.times.is_empty() || p.times.len() != p.strains.len() {
             return Err(Error::config(
@@ -193,6 +202,7 @@ pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
                     eps_n,
                     eps,
                     dt: p.dt,
+                    length: p.length,
                 },
                 &state_n,
                 &mut state,

@@ -165,6 +165,26 @@ pub struct Analysis {
     pub tolerance: f64,
     /// Iteration limit per step.
     pub max_iterations: usize,
+    /// Relative tolerance on the last displacement correction.
+    pub displacement_tolerance: f64,
+    /// How a state-dependent tangent is followed.
+    pub iteration: IterationMethod,
+    /// Step cuts allowed (each halves `h`) before a run stops.
+    pub max_cuts: usize,
+}
+
+/// How the equilibrium iterations of materials with a state-dependent tangent pay
+/// for the linear solves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum IterationMethod {
+    /// Refactorise every iteration with the material tangent (consistent for
+    /// plasticity; the secant `(1 − D) C` for damage: the paper's fixed point).
+    #[default]
+    Newton,
+    /// Factorise once per step (tangent at the start of the step) and move the
+    /// stiffness change to the right-hand side.
+    Fixed,
 }
 
 impl Analysis {

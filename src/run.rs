@@ -92,7 +92,12 @@ impl Recorder {
     ) -> Result<()> {
         if let Some(vtk) = &mut self.vtk {
             if step % model.analysis.vtk_every == 0 {
-                vtk.write(step, t, u, v, &cell_stress(model, u, points))?;
+                let extra = if points.is_empty() {
+                    Vec::new()
+                } else {
+                    crate::output::post::cell_history_fields(model, points)
+                };
+                vtk.write(step, t, u, v, &cell_stress(model, u, points), &extra)?;
             }
         }
         Ok(())
@@ -135,6 +140,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             backend: opts.backend.name().into(),
             factorizations: 0,
             iterations: 0,
+            step_cuts: 0,
             factor_nnz: None,
         },
     };
@@ -173,7 +179,16 @@ fn run_dynamic(
     rec.vtk(model, 0, 0.0, &s.u, &s.v, &s.points)?;
     let pb = progress(n_steps, opts.progress);
     let mut outcome = Ok(());
-    for _ in 0..n_steps {
+    // Adaptive step: halve on non-convergence (up to `max_cuts` times in a row), grow
+    // back by doubling after four easy steps, never beyond the requested `dt`.
+    let (h0, t_end) = (model.analysis.dt, model.analysis.t_end);
+    let mut h = h0;
+    let (mut cuts_in_row, mut easy) = (0usize, 0usize);
+    while s.t < t_end - 1e-9 * h0 {
+        let h_try = h.min(t_end - s.t);
+        if (h_try - be.h).abs() > 1e-12 * h0 {
+            be.set_step(h_try)?;
+        }
         match be.step(&mut s) {
             Ok(report) => {
                 summary.solver.iterations += report.iterations;
@@ -186,17 +201,32 @@ fn run_dynamic(
                     &s.u,
                 )?;
                 rec.vtk(model, s.step, s.t, &s.u, &s.v, &s.points)?;
+                cuts_in_row = 0;
+                if h < h0 {
+                    easy += 1;
+                    if easy >= 4 {
+                        h = (2.0 * h).min(h0);
+                        easy = 0;
+                    }
+                }
+                pb.set_position(((s.t / t_end) * n_steps as f64) as u64);
+            }
+            Err(Error::Stepping(msg)) if cuts_in_row < model.analysis.max_cuts => {
+                cuts_in_row += 1;
+                summary.solver.step_cuts += 1;
+                easy = 0;
+                h *= 0.5;
+                pb.set_message(format!("step cut to h = {h:.3e} ({msg})"));
             }
             Err(e) => {
                 outcome = Err(Error::Stepping(format!(
-                    "step {} (t = {:.6e}) failed: {e}",
+                    "step {} (t = {:.6e}) failed after {cuts_in_row} step cuts: {e}",
                     s.step + 1,
                     s.t + be.h
                 )));
                 break;
             }
         }
-        pb.inc(1);
     }
     pb.finish_and_clear();
     summary.steps = s.step;

@@ -227,7 +227,12 @@ fn material_driver_writes_curves_and_rejects_bad_parameters() {
     let dir = tempfile::tempdir().unwrap();
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/materials/sls_relaxation.toml");
     let out = dir.path().join("m");
-    let (ok, _, err) = rothe(&["material", file.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let (ok, _, err) = rothe(&[
+        "material",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(ok, "{err}");
     let csv = std::fs::read_to_string(out.join("material.csv")).unwrap();
     let header = csv.lines().next().unwrap();
@@ -238,13 +243,27 @@ fn material_driver_writes_curves_and_rejects_bad_parameters() {
     assert_eq!(csv.lines().count(), 1002);
     let text = std::fs::read_to_string(&file).unwrap();
     for (bad, words) in [
-        (text.replace("beta = 1.0e-3", "beta = -1.0"), vec!["material.beta", "positive"]),
-        (text.replace("alpha = 0.5\n", ""), vec!["missing field `alpha`"]),
-        (text.replace("kind = \"uniaxial_stress\"", "kind = \"twisted\""), vec!["unknown variant `twisted`"]),
+        (
+            text.replace("beta = 1.0e-3", "beta = -1.0"),
+            vec!["material.beta", "positive"],
+        ),
+        (
+            text.replace("alpha = 0.5\n", ""),
+            vec!["missing field `alpha`"],
+        ),
+        (
+            text.replace("kind = \"uniaxial_stress\"", "kind = \"twisted\""),
+            vec!["unknown variant `twisted`"],
+        ),
     ] {
         let f = dir.path().join("bad.toml");
         std::fs::write(&f, bad).unwrap();
-        let (ok, _, err) = rothe(&["material", f.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let (ok, _, err) = rothe(&[
+            "material",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
         assert!(!ok);
         assert!(!err.contains("panicked"), "{err}");
         for w in words {

@@ -150,11 +150,22 @@ fn element_points<F>(
             // SAFETY: point g belongs to element e only.
             unsafe { t.slice(3 * g, 3) }.copy_from_slice(&[eps, 0.0, 0.0]);
             unsafe { t.slice(store.eps.len() + 3 * g, 3) }.copy_from_slice(&resp.sigma);
+            let slot = unsafe { t.slice(2 * store.eps.len() + g, 1) };
+            slot[0] = store.dissipated[g];
         }
         point(g, cx.section * l, &resp, None, &x[..2], resp.sigma);
         return;
     }
     let rule = stiffness_rule(cx.kind);
+    // Element size for crack-band regularisation: the square root of its area.
+    let area = 0.5
+        * (0..nn)
+            .map(|a| {
+                let b = (a + 1) % nn;
+                x[a][0] * x[b][1] - x[b][0] * x[a][1]
+            })
+            .sum::<f64>();
+    let length = area.abs().sqrt();
     for (q, &(xi, wq)) in rule.iter().enumerate() {
         let g = e * rule.len() + q;
         let k = kinematics(cx.kind, &x[..nn], xi);
@@ -168,18 +179,28 @@ fn element_points<F>(
                 cx.dt,
             )
         };
-        let step = StrainStep { eps_n, eps, dt };
+        let step = StrainStep {
+            eps_n,
+            eps,
+            dt,
+            length,
+        };
         let committed = &store.committed[g * ns..(g + 1) * ns];
         let mut pred = [0.0; 3];
         let resp = match trial {
             Some(t) => {
                 // SAFETY: point g belongs to element e only. The trial buffer holds
-                // strains, stresses, then history (see `internal_force`).
+                // strains, stresses, dissipation densities, then history (see
+                // `internal_force`).
                 let n3 = store.eps.len();
+                let np = n3 / 3;
                 unsafe { t.slice(3 * g, 3) }.copy_from_slice(&eps);
-                let hist = unsafe { t.slice(2 * n3 + g * ns, ns) };
+                let hist = unsafe { t.slice(2 * n3 + np + g * ns, ns) };
                 let r = cx.mat.update(cx.plane, &step, committed, hist);
                 unsafe { t.slice(n3 + 3 * g, 3) }.copy_from_slice(&r.sigma);
+                let d = &r.dissipation;
+                let slot = unsafe { t.slice(2 * n3 + g, 1) };
+                slot[0] = store.dissipated[g] + d.viscous + d.damage + d.plastic;
                 if cx.predict {
                     pred = cx.mat.predicted_stress(cx.plane, &eps, hist, cx.dt);
                 }
@@ -263,6 +284,7 @@ impl Assembler {
             let mut buf = std::mem::take(&mut store.eps_trial);
             let n_eps = buf.len();
             buf.append(&mut std::mem::take(&mut store.sigma_trial));
+            buf.append(&mut std::mem::take(&mut store.dissipated_trial));
             buf.append(&mut std::mem::take(&mut store.trial));
             let tp = Shared(buf.as_mut_ptr());
             let cx = Ctx {
@@ -318,10 +340,12 @@ impl Assembler {
                     .reduce(PointTotals::default, PointTotals::add);
                 totals = totals.add(part);
             }
-            let hist = buf.split_off(2 * n_eps);
+            let hist = buf.split_off(2 * n_eps + n_eps / 3);
+            let dissipated = buf.split_off(2 * n_eps);
             let sigma = buf.split_off(n_eps);
             store.eps_trial = buf;
             store.sigma_trial = sigma;
+            store.dissipated_trial = dissipated;
             store.trial = hist;
         }
         totals

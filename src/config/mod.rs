@@ -91,6 +91,25 @@ pub struct AnalysisSpec {
     /// Iteration limit per step. Default 30.
     #[serde(default = "default_max_iterations")]
     pub max_iterations: usize,
+    /// Relative tolerance on the last displacement correction of nonlinear models.
+    /// Default 1e-6.
+    #[serde(default = "default_displacement_tolerance")]
+    pub displacement_tolerance: f64,
+    /// `newton` (default: refactorise every iteration) or `fixed` (factorise once
+    /// per step).
+    #[serde(default)]
+    pub iteration: crate::model::IterationMethod,
+    /// Step cuts (each halving `h`) allowed before the run stops. Default 8.
+    #[serde(default = "default_max_cuts")]
+    pub max_cuts: usize,
+}
+
+fn default_displacement_tolerance() -> f64 {
+    1e-6
+}
+
+fn default_max_cuts() -> usize {
+    8
 }
 
 fn default_tolerance() -> f64 {
@@ -170,6 +189,57 @@ pub enum MaterialSpec {
         /// Relaxation time (s).
         beta: f64,
     },
+    /// Mazars damage (eqs. 11-13 of the paper, or the classic 1984 law).
+    Mazars {
+        /// Young's modulus (Pa).
+        #[serde(rename = "E")]
+        e: f64,
+        /// Poisson's ratio.
+        nu: f64,
+        /// Density (kg/m³).
+        rho: f64,
+        /// `paper` (default) or `classic`.
+        #[serde(default = "default_variant")]
+        variant: String,
+        /// Tensile threshold `ε_t^0` (classic: `κ_0`).
+        eps_t0: f64,
+        /// Compressive threshold `ε_c^0` (paper variant; default `eps_t0`).
+        #[serde(default)]
+        eps_c0: Option<f64>,
+        /// `A_t`.
+        #[serde(rename = "A_t")]
+        a_t: f64,
+        /// `B_t`.
+        #[serde(rename = "B_t")]
+        b_t: f64,
+        /// `A_c`.
+        #[serde(rename = "A_c")]
+        a_c: f64,
+        /// `B_c`.
+        #[serde(rename = "B_c")]
+        b_c: f64,
+        /// Classic weight exponent `β` (default 1.06, the usual value).
+        #[serde(default = "default_mazars_beta")]
+        beta: f64,
+        /// Damage cap (default 0.99999, as NOTES.md fixes).
+        #[serde(default = "default_d_max")]
+        d_max: f64,
+    },
+    /// Rankine-Hill plasticity (plane stress): Rankine in tension, von Mises (Hill,
+    /// isotropic) in compression.
+    RankineHill {
+        /// Young's modulus (Pa).
+        #[serde(rename = "E")]
+        e: f64,
+        /// Poisson's ratio.
+        nu: f64,
+        /// Density (kg/m³).
+        rho: f64,
+        /// Tension law.
+        tension: HardeningSpec,
+        /// Compression law.
+        compression: HardeningSpec,
+    },
     /// Kelvin: the SLS without the branch spring, i.e. `σ = C ε + β C ε̇`.
     Kelvin {
         /// Young's modulus (Pa).
@@ -181,6 +251,48 @@ pub enum MaterialSpec {
         rho: f64,
         /// Dashpot time (s).
         beta: f64,
+    },
+}
+
+fn default_variant() -> String {
+    "paper".into()
+}
+
+fn default_mazars_beta() -> f64 {
+    1.06
+}
+
+fn default_d_max() -> f64 {
+    0.99999
+}
+
+/// A strength law of one yield surface.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "law", rename_all = "snake_case", deny_unknown_fields)]
+pub enum HardeningSpec {
+    /// Yield at `strength`, post-yield modulus `post_yield_modulus` (Pa) in the
+    /// uniaxial diagram.
+    Bilinear {
+        /// Yield stress (Pa, positive).
+        strength: f64,
+        /// Post-yield modulus (Pa), below `E`.
+        post_yield_modulus: f64,
+    },
+    /// Eurocode 2 compression curve.
+    Ec2 {
+        /// Mean compressive strength (Pa).
+        f_cm: f64,
+        /// Strain at peak (positive).
+        eps_c1: f64,
+        /// Ultimate strain (positive).
+        eps_cu1: f64,
+    },
+    /// Linear tension softening by fracture energy over the element size.
+    LinearSoftening {
+        /// Tensile strength (Pa).
+        strength: f64,
+        /// Fracture energy (N/m).
+        fracture_energy: f64,
     },
 }
 

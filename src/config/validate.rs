@@ -72,6 +72,75 @@ fn check_function(field: &str, f: &TimeFunction) -> Result<()> {
     }
 }
 
+fn hardening(
+    field: &str,
+    spec: &super::HardeningSpec,
+    e: f64,
+) -> Result<crate::material::Hardening> {
+    use super::HardeningSpec as S;
+    use crate::material::Hardening as H;
+    Ok(match *spec {
+        S::Bilinear {
+            strength,
+            post_yield_modulus,
+        } => {
+            positive(&format!("{field}.strength"), strength)?;
+            if !(post_yield_modulus > -e && post_yield_modulus < e)
+                || !post_yield_modulus.is_finite()
+            {
+                return Err(Error::config(
+                    format!("{field}.post_yield_modulus"),
+                    format!("must lie in (-E, E), got {post_yield_modulus}"),
+                ));
+            }
+            H::Bilinear {
+                strength,
+                post_yield_modulus,
+            }
+        }
+        S::Ec2 {
+            f_cm,
+            eps_c1,
+            eps_cu1,
+        } => {
+            positive(&format!("{field}.f_cm"), f_cm)?;
+            positive(&format!("{field}.eps_c1"), eps_c1)?;
+            if !(eps_cu1 > eps_c1) {
+                return Err(Error::config(
+                    format!("{field}.eps_cu1"),
+                    format!("must exceed eps_c1 = {eps_c1}, got {eps_cu1}"),
+                ));
+            }
+            let k = 1.05 * e * eps_c1 / f_cm;
+            if k <= 1.05 {
+                return Err(Error::config(
+                    field,
+                    format!(
+                        "E ε_c1 / f_cm = {:.3} must exceed 1 for the curve to start elastic",
+                        k / 1.05
+                    ),
+                ));
+            }
+            H::Ec2 {
+                f_cm,
+                eps_c1,
+                eps_cu1,
+            }
+        }
+        S::LinearSoftening {
+            strength,
+            fracture_energy,
+        } => {
+            positive(&format!("{field}.strength"), strength)?;
+            positive(&format!("{field}.fracture_energy"), fracture_energy)?;
+            H::LinearSoftening {
+                strength,
+                fracture_energy,
+            }
+        }
+    })
+}
+
 /// Validates one material spec into a [`Material`]; `field` prefixes error paths.
 pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material> {
     use crate::material::{Model, Viscosity};
@@ -146,6 +215,87 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                 },
             )
         }
+        MaterialSpec::Mazars {
+            e,
+            nu,
+            rho,
+            ref variant,
+            eps_t0,
+            eps_c0,
+            a_t,
+            b_t,
+            a_c,
+            b_c,
+            beta,
+            d_max,
+        } => {
+            use crate::material::{MazarsParams, MazarsVariant};
+            let variant = match variant.as_str() {
+                "paper" => MazarsVariant::Paper,
+                "classic" => MazarsVariant::Classic,
+                v => {
+                    return Err(Error::config(
+                        format!("{field}.variant"),
+                        format!("unknown variant `{v}` (expected paper or classic)"),
+                    ))
+                }
+            };
+            positive(&format!("{field}.eps_t0"), eps_t0)?;
+            let eps_c0 = eps_c0.unwrap_or(eps_t0);
+            positive(&format!("{field}.eps_c0"), eps_c0)?;
+            for (k, v) in [("A_t", a_t), ("A_c", a_c)] {
+                if !(0.0..=2.0).contains(&v) {
+                    return Err(Error::config(
+                        format!("{field}.{k}"),
+                        format!("must lie in [0, 2], got {v}"),
+                    ));
+                }
+            }
+            positive(&format!("{field}.B_t"), b_t)?;
+            positive(&format!("{field}.B_c"), b_c)?;
+            positive(&format!("{field}.beta"), beta)?;
+            if !(d_max > 0.0 && d_max < 1.0) {
+                return Err(Error::config(
+                    format!("{field}.d_max"),
+                    format!("must lie in (0, 1), got {d_max}"),
+                ));
+            }
+            with(
+                e,
+                nu,
+                rho,
+                Model::Mazars(MazarsParams {
+                    variant,
+                    eps_t0,
+                    eps_c0,
+                    a_t,
+                    b_t,
+                    a_c,
+                    b_c,
+                    beta,
+                    d_max,
+                }),
+            )
+        }
+        MaterialSpec::RankineHill {
+            e,
+            nu,
+            rho,
+            ref tension,
+            ref compression,
+        } => {
+            let tension = hardening(&format!("{field}.tension"), tension, e)?;
+            let compression = hardening(&format!("{field}.compression"), compression, e)?;
+            with(
+                e,
+                nu,
+                rho,
+                Model::RankineHill(crate::material::RankineHillParams {
+                    tension,
+                    compression,
+                }),
+            )
+        }
         MaterialSpec::Kelvin { e, nu, rho, beta } => {
             viscosity("beta", beta)?;
             with(
@@ -194,6 +344,7 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
         ));
     }
     positive("analysis.tolerance", a.tolerance)?;
+    positive("analysis.displacement_tolerance", a.displacement_tolerance)?;
     if a.max_iterations == 0 {
         return Err(Error::config(
             "analysis.max_iterations",
@@ -220,6 +371,13 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
     for (name, spec) in &s.materials {
         mat_index.insert(name.clone(), materials.len());
         materials.push(material(name, &format!("materials.{name}"), spec)?);
+    }
+    for m in &materials {
+        if matches!(m.model, crate::material::Model::RankineHill(_))
+            && a.plane == crate::fe::Plane::Strain
+        {
+            return Err(Error::config(format!("materials.{}", m.name), "Rankine-Hill plasticity is formulated in plane stress; set analysis.plane = \"stress\""));
+        }
     }
     let find_material = |field: String, name: &str| -> Result<usize> {
         mat_index.get(name).copied().ok_or_else(|| {
@@ -470,6 +628,9 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
             vtk_every: a.vtk_every,
             tolerance: a.tolerance,
             max_iterations: a.max_iterations,
+            displacement_tolerance: a.displacement_tolerance,
+            iteration: a.iteration,
+            max_cuts: a.max_cuts,
         },
     })
 }

@@ -9,8 +9,17 @@
 //! the plane idealisation chosen for the run.
 
 pub mod elastic;
+pub mod hardening;
+pub mod linalg;
+pub mod mazars;
+pub mod principal;
+pub mod rankine_hill;
 pub mod store;
 pub mod viscoelastic;
+
+pub use hardening::Hardening;
+pub use mazars::{MazarsParams, MazarsVariant};
+pub use rankine_hill::RankineHillParams;
 
 use crate::fe::{elasticity, Plane};
 
@@ -51,6 +60,9 @@ pub struct StrainStep {
     pub eps: [f64; 3],
     /// Time step size.
     pub dt: f64,
+    /// Characteristic size of the element the point belongs to (m): the crack-band
+    /// length of softening laws.
+    pub length: f64,
 }
 
 /// The viscosity of a Kelvin-Voigt material.
@@ -80,6 +92,10 @@ pub enum Model {
         /// Whether the parallel spring `C` is present.
         parallel: bool,
     },
+    /// Mazars damage `σ = (1 − D) C ε`.
+    Mazars(MazarsParams),
+    /// Rankine-Hill plasticity (plane stress).
+    RankineHill(RankineHillParams),
 }
 
 /// A material: elastic constants, density and constitutive model.
@@ -124,7 +140,8 @@ impl Material {
     pub fn n_state(&self) -> usize {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) => 0,
-            Model::Sls { .. } => 3,
+            Model::Sls { .. } | Model::Mazars(_) => 3,
+            Model::RankineHill(_) => 5,
         }
     }
 
@@ -133,6 +150,21 @@ impl Material {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) => &[],
             Model::Sls { .. } => &["eps_d_xx", "eps_d_yy", "gamma_d_xy"],
+            Model::Mazars(MazarsParams {
+                variant: MazarsVariant::Paper,
+                ..
+            }) => &["eps_t_max", "eps_c_max", "damage"],
+            Model::Mazars(_) => &["kappa", "unused", "damage"],
+            Model::RankineHill(_) => &["eps_p_xx", "eps_p_yy", "gamma_p_xy", "kappa_t", "kappa_c"],
+        }
+    }
+
+    /// Damage and equivalent plastic strain `κ_t + κ_c` of a point state, for output.
+    pub fn output_fields(&self, state: &[f64]) -> (f64, f64) {
+        match self.model {
+            Model::Mazars(_) => (state[2], 0.0),
+            Model::RankineHill(_) => (0.0, state[3] + state[4]),
+            _ => (0.0, 0.0),
         }
     }
 
@@ -163,7 +195,21 @@ impl Material {
     ) -> [f64; 3] {
         let c = self.c(plane);
         match self.model {
-            Model::Elastic | Model::KelvinVoigt(_) => mul3(&c, eps),
+            Model::Elastic | Model::KelvinVoigt(_) | Model::Mazars(_) | Model::RankineHill(_) => {
+                let mut st = vec![0.0; self.n_state()];
+                self.update(
+                    plane,
+                    &StrainStep {
+                        eps_n: *eps,
+                        eps: *eps,
+                        dt,
+                        length: 1.0,
+                    },
+                    state,
+                    &mut st,
+                )
+                .sigma
+            }
             Model::Sls {
                 alpha,
                 beta,
@@ -214,6 +260,10 @@ impl Material {
                 state_n,
                 state,
             ),
+            Model::Mazars(p) => mazars::update(&p, &c, self.nu, plane, step, state_n, state),
+            Model::RankineHill(p) => {
+                rankine_hill::update(&p, &c, self.e, self.nu, step, state_n, state)
+            }
         }
     }
 }

@@ -17,6 +17,10 @@ pub struct StateStore {
     pub sigma: Vec<f64>,
     /// Trial stress per point.
     pub sigma_trial: Vec<f64>,
+    /// Committed cumulative dissipation density (viscous + damage + plastic) per point.
+    pub dissipated: Vec<f64>,
+    /// Trial cumulative dissipation density.
+    pub dissipated_trial: Vec<f64>,
 }
 
 impl StateStore {
@@ -30,6 +34,8 @@ impl StateStore {
             eps_trial: vec![0.0; n_points * 3],
             sigma: vec![0.0; n_points * 3],
             sigma_trial: vec![0.0; n_points * 3],
+            dissipated: vec![0.0; n_points],
+            dissipated_trial: vec![0.0; n_points],
         }
     }
 
@@ -39,6 +45,7 @@ impl StateStore {
         std::mem::swap(&mut self.committed, &mut self.trial);
         std::mem::swap(&mut self.eps, &mut self.eps_trial);
         std::mem::swap(&mut self.sigma, &mut self.sigma_trial);
+        std::mem::swap(&mut self.dissipated, &mut self.dissipated_trial);
     }
 
     /// Number of points.

@@ -54,6 +54,7 @@ pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64;
                         eps_n: eps,
                         eps,
                         dt: 1.0,
+                        length: 1.0,
                     },
                     &[],
                     &mut st,
@@ -66,4 +67,32 @@ pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64;
         }
     }
     out
+}
+
+/// Element averages of the point fields of materials with history: damage,
+/// equivalent plastic strain `κ_t + κ_c`, and cumulative dissipation density (J/m³).
+pub fn cell_history_fields(model: &Model, points: &[StateStore]) -> Vec<(&'static str, Vec<f64>)> {
+    let (mut damage, mut eqp, mut diss) = (Vec::new(), Vec::new(), Vec::new());
+    for (block, store) in model.mesh.blocks.iter().zip(points) {
+        let mat = &model.materials[block.material];
+        let ng = points_per_element(block.elements.kind);
+        let ns = store.n_state;
+        for e in 0..block.elements.len() {
+            let (mut d, mut p, mut w) = (0.0, 0.0, 0.0);
+            for g in e * ng..(e + 1) * ng {
+                let (dd, pp) = mat.output_fields(&store.committed[g * ns..(g + 1) * ns]);
+                d += dd / ng as f64;
+                p += pp / ng as f64;
+                w += store.dissipated[g] / ng as f64;
+            }
+            damage.push(d);
+            eqp.push(p);
+            diss.push(w);
+        }
+    }
+    vec![
+        ("damage", damage),
+        ("equivalent_plastic_strain", eqp),
+        ("dissipation_density", diss),
+    ]
 }

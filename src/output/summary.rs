@@ -109,6 +109,8 @@ pub struct SolverSummary {
     pub factorizations: usize,
     /// Linear solves (iterations) over the run.
     pub iterations: usize,
+    /// Steps cut back (halved) after non-convergence.
+    pub step_cuts: usize,
     /// Nonzeros of the Cholesky factor.
     pub factor_nnz: Option<usize>,
 }

@@ -52,7 +52,8 @@ impl VtkSeries {
         })
     }
 
-    /// Writes step `step` at time `t` with nodal `u`, `v` and cell `stress`.
+    /// Writes step `step` at time `t` with nodal `u`, `v`, cell `stress` and further
+    /// scalar cell fields `extra`.
     pub fn write(
         &mut self,
         step: usize,
@@ -60,6 +61,7 @@ impl VtkSeries {
         u: &[f64],
         v: &[f64],
         stress: &[[f64; 3]],
+        extra: &[(&str, Vec<f64>)],
     ) -> Result<()> {
         let vec3 = |x: &[f64]| -> IOBuffer {
             x.chunks_exact(2)
@@ -89,7 +91,7 @@ impl VtkSeries {
                         data: vec3(v),
                     }),
                 ],
-                cell: vec![Attribute::DataArray(DataArray {
+                cell: std::iter::once(Attribute::DataArray(DataArray {
                     name: "stress".into(),
                     elem: ElementType::Generic(3),
                     data: stress
@@ -98,7 +100,18 @@ impl VtkSeries {
                         .copied()
                         .collect::<Vec<f64>>()
                         .into(),
-                })],
+                }))
+                .chain(extra.iter().map(|(name, values)| {
+                    Attribute::DataArray(DataArray {
+                        name: (*name).into(),
+                        elem: ElementType::Scalars {
+                            num_comp: 1,
+                            lookup_table: None,
+                        },
+                        data: values.clone().into(),
+                    })
+                }))
+                .collect(),
             },
         };
         let name = format!("step_{step:07}.vtu");

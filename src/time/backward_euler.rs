@@ -22,7 +22,7 @@ use crate::error::{Error, Result};
 use crate::linsolve::{Backend, SymmetricSolver};
 use crate::material::store::StateStore;
 use crate::material::Dissipation;
-use crate::model::Model;
+use crate::model::{IterationMethod, Model};
 
 /// The state of a dynamic run after a step.
 #[derive(Clone, Debug)]
@@ -78,6 +78,12 @@ pub struct BackwardEuler<'m> {
     pub tolerance: f64,
     /// Iteration limit per step.
     pub max_iterations: usize,
+    /// Relative tolerance on the last displacement correction (nonlinear models).
+    pub displacement_tolerance: f64,
+    /// How the effective matrix follows a state-dependent tangent.
+    pub iteration: IterationMethod,
+    /// Every material has a constant tangent (for a fixed `h`).
+    constant_tangent: bool,
     /// Mass matrix.
     pub mass: Mass,
     gravity: Option<Vec<f64>>,
@@ -106,11 +112,6 @@ pub struct BackwardEuler<'m> {
 impl<'m> BackwardEuler<'m> {
     /// Assembles `K`, `M`, the effective matrix, analyses and factorises it.
     pub fn new(model: &'m Model, backend: Backend) -> Result<Self> {
-        if model.materials.iter().any(|m| !m.has_constant_tangent()) {
-            return Err(Error::Stepping(
-                "materials with a state-dependent tangent are not supported yet".into(),
-            ));
-        }
         let a = &model.analysis;
         let h = a.dt;
         let t0 = Instant::now();
@@ -152,6 +153,9 @@ impl<'m> BackwardEuler<'m> {
             kt,
             tolerance: a.tolerance,
             max_iterations: a.max_iterations,
+            displacement_tolerance: a.displacement_tolerance,
+            iteration: a.iteration,
+            constant_tangent: model.materials.iter().all(|m| m.has_constant_tangent()),
             mass,
             gravity,
             reduced,
@@ -204,7 +208,7 @@ impl<'m> BackwardEuler<'m> {
         let mut fext = vec![0.0; n];
         external_force(model, self.gravity.as_deref(), 0.0, &mut fext);
         let e_kin0 = 0.5 * dot(&v, &mv);
-        let mut fpred = if self.kt.is_some() {
+        let mut fpred = if self.kt.is_some() && self.constant_tangent {
             vec![0.0; n]
         } else {
             Vec::new()
@@ -214,7 +218,12 @@ impl<'m> BackwardEuler<'m> {
             (0.5 * dot(&u, &fint), Vec::new())
         } else {
             let mut points = new_stores(&model.mesh, &model.materials);
-            let totals = self.internal(&u, true, &mut points, &mut fint, Some(&mut fpred));
+            let pred = if fpred.is_empty() {
+                None
+            } else {
+                Some(&mut fpred[..])
+            };
+            let totals = self.internal(&u, true, &mut points, &mut fint, pred);
             points.iter_mut().for_each(StateStore::commit);
             (totals.psi, points)
         };
@@ -404,6 +413,12 @@ impl<'m> BackwardEuler<'m> {
         let mut history: Vec<f64> = Vec::new();
         let mut iterations = 0;
         let constant = !s.fpred.is_empty();
+        if !constant && self.iteration == IterationMethod::Fixed {
+            // Pay once per step: the tangent at the start of the step.
+            let u_start = u1.clone();
+            self.refactor_tangent(&u_start, &s.points)?;
+        }
+        let mut last_correction = 0.0f64;
         if constant {
             // First solve from the predicted force, without a Gauss-point pass:
             // r(u_s + Δu_c) = −M v_s/h + f_pred − f_ext¹ + K_eff Δu_c.
@@ -462,22 +477,59 @@ impl<'m> BackwardEuler<'m> {
                 r2.sqrt()
             };
             history.push(nl);
-            if nl <= self.tolerance || r2 == 0.0 {
+            let du_norm = self
+                .dofs
+                .free
+                .iter()
+                .map(|&d| self.du[d] * self.du[d])
+                .sum::<f64>()
+                .sqrt();
+            let small_correction = constant
+                || iterations == 0
+                || last_correction <= self.displacement_tolerance * du_norm.max(f64::MIN_POSITIVE);
+            if (nl <= self.tolerance && small_correction) || r2 == 0.0 {
                 break (totals, nl);
             }
-            if iterations >= self.max_iterations {
-                // The trial states are simply not committed: the step leaves no trace.
-                return Err(Error::Stepping(format!(
-                    "no convergence at t = {t1:.6e} after {iterations} iterations; relative residuals {}",
+            let failure = if iterations >= self.max_iterations || !nl.is_finite() {
+                let worst = self
+                    .rhs
+                    .iter()
+                    .enumerate()
+                    .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                    .map(|(eq, r)| {
+                        format!(
+                            "; largest residual {:.3e} N at {}",
+                            r.abs(),
+                            self.locate_dof(self.dofs.free[eq])
+                        )
+                    })
+                    .unwrap_or_default();
+                Some(Error::Stepping(format!(
+                    "no convergence at t = {t1:.6e} (h = {h:.3e}) after {iterations} iterations; relative residuals [{}]{worst}",
                     history.iter().map(|r| format!("{r:.2e}")).collect::<Vec<_>>().join(", ")
-                )));
+                )))
+            } else if !constant && self.iteration == IterationMethod::Newton {
+                self.refactor_tangent(&u1, &s.points).err()
+            } else {
+                None
+            };
+            if let Some(e) = failure {
+                // The trial states are simply not committed: the step leaves no trace.
+                self.u1 = u1;
+                self.fint1 = fint1;
+                self.fpred1 = fpred1;
+                self.kv = kv;
+                return Err(e);
             }
             let ts = Instant::now();
             self.solver.solve_in_place(&mut self.rhs)?;
             solve_s += ts.elapsed().as_secs_f64();
+            let mut c2 = 0.0;
             for (eq, &d) in self.dofs.free.iter().enumerate() {
                 u1[d] += self.rhs[eq];
+                c2 += self.rhs[eq] * self.rhs[eq];
             }
+            last_correction = c2.sqrt();
             iterations += 1;
         };
 
@@ -526,11 +578,59 @@ impl<'m> BackwardEuler<'m> {
         (self.c_m, self.c_k)
     }
 
+    /// Assembles the tangent at `u` from the committed history of `points`, refills
+    /// the effective matrix and refactorises it.
+    fn refactor_tangent(&mut self, u: &[f64], points: &[StateStore]) -> Result<()> {
+        let t = Instant::now();
+        let m = self.model;
+        let kt = self
+            .asm
+            .tangent(&m.mesh, &m.materials, m.plane, u, self.h, points);
+        self.reduced.fill(
+            &self.dofs,
+            self.c_m,
+            &self.mass,
+            &[(self.damp_k / self.h, &self.k), (1.0, &kt)],
+        );
+        self.kt = Some(kt);
+        let res = self.solver.factorize(&self.reduced.csc);
+        self.factorizations += 1;
+        self.timing.factorization_s += t.elapsed().as_secs_f64();
+        res.map_err(|e| {
+            Error::Stepping(format!(
+                "the effective matrix lost positive definiteness ({e})"
+            ))
+        })
+    }
+
+    /// Where dof `d` sits: node, coordinates, body and one element holding it.
+    pub fn locate_dof(&self, d: usize) -> String {
+        let mesh = &self.model.mesh;
+        let n = d / 2;
+        let body = &self.model.bodies[mesh.node_body[n]].name;
+        let element = mesh.blocks.iter().enumerate().find_map(|(bi, b)| {
+            (0..b.elements.len())
+                .find(|&e| b.elements.element(e).contains(&n))
+                .map(|e| format!("block {bi} element {e}"))
+        });
+        format!(
+            "node {n} at ({:.4}, {:.4}) of body `{body}`, {}, component {}",
+            mesh.coords[n][0],
+            mesh.coords[n][1],
+            element.unwrap_or_else(|| "no element".into()),
+            if d % 2 == 0 { "x" } else { "y" }
+        )
+    }
+
     /// Refactorises after a change of `h` (same pattern, new values).
     pub fn set_step(&mut self, h: f64) -> Result<()> {
         self.h = h;
         self.c_m = 1.0 / (h * h) + self.damp_m / h;
         self.c_k = 1.0 + self.damp_k / h;
+        if !self.constant_tangent {
+            // The matrix follows the state: it is rebuilt at the next step anyway.
+            return Ok(());
+        }
         let t = Instant::now();
         let m = self.model;
         if self.kt.is_some() {

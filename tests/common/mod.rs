@@ -33,6 +33,9 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
             vtk_every: 0,
             tolerance: 1e-8,
             max_iterations: 30,
+            displacement_tolerance: 1e-6,
+            iteration: rothe::model::IterationMethod::Newton,
+            max_cuts: 8,
         },
     }
 }

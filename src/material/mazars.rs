@@ -1,0 +1,192 @@
+//! Mazars damage: `σ = (1 − D) C ε`, `D` non-decreasing, `D ≤ D_max < 1`.
+//!
+//! Two variants (see `theory/damage.md`):
+//! - `Paper`: eqs. (11)-(13). Equivalent strains `ε_t = I/(2(1−2ν)) + √J/(2(1+ν))`,
+//!   `ε_c = I/(5(1−2ν)) + 6√J/(5(1+ν))` from the three principal strains, their
+//!   maxima over the history (from the thresholds), the triaxiality `r` of the
+//!   effective stress `C ε`, `ε* = r ε_t* + (1−r) ε_c*`, and
+//!   `D = 1 − (1−A) ε*_0/ε* − A exp(−B(ε* − ε*_0))` with `A, B, ε*_0` mixed by `r`
+//!   (the reading of `NOTES.md`).
+//! - `Classic` (Mazars 1984): `ε̃ = √Σ⟨ε_i⟩₊²`, `κ = max ε̃` from `κ_0`,
+//!   `D = α_t^β D_t(κ) + α_c^β D_c(κ)` with the weights `α_t, α_c` from the split of the
+//!   effective stress into its positive and negative parts.
+//!
+//! The strain of the third direction enters the invariants: `ε_zz = −ν/(1−ν)(ε_xx+ε_yy)`
+//! in plane stress, 0 in plane strain. The update returns the secant `(1 − D) C` as
+//! its tangent: the paper's fixed-point linearisation. Damage dissipation is
+//! `ΔW_d = ½(Yⁿ + Yⁿ⁺¹) ΔD`, `Y = ½ ε:C:ε`.
+
+use super::{dot3, mul3, Dissipation, PointResponse, StrainStep};
+use crate::fe::Plane;
+
+/// Which Mazars law.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MazarsVariant {
+    /// Eqs. (11)-(13) of the paper.
+    Paper,
+    /// Mazars (1984), as other FE codes ship it.
+    Classic,
+}
+
+/// Mazars parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MazarsParams {
+    /// Variant.
+    pub variant: MazarsVariant,
+    /// Tensile threshold `ε_t^0` (classic: `κ_0`).
+    pub eps_t0: f64,
+    /// Compressive threshold `ε_c^0` (paper variant only).
+    pub eps_c0: f64,
+    /// `A_t`.
+    pub a_t: f64,
+    /// `B_t`.
+    pub b_t: f64,
+    /// `A_c`.
+    pub a_c: f64,
+    /// `B_c`.
+    pub b_c: f64,
+    /// Exponent `β` of the classic weights.
+    pub beta: f64,
+    /// Cap `D_max < 1`.
+    pub d_max: f64,
+}
+
+/// The damage law `1 − (1−A) κ_0/κ − A exp(−B(κ − κ_0))` above the threshold.
+#[inline]
+pub fn damage_law(kappa: f64, kappa0: f64, a: f64, b: f64) -> f64 {
+    if kappa <= kappa0 {
+        0.0
+    } else {
+        1.0 - (1.0 - a) * kappa0 / kappa - a * (-b * (kappa - kappa0)).exp()
+    }
+}
+
+/// Three principal strains, the third being the out-of-plane one.
+fn principal3(eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
+    let (e1, e2, _) = super::principal::principal_strain(eps);
+    let ezz = match plane {
+        Plane::Stress => -nu / (1.0 - nu) * (eps[0] + eps[1]),
+        Plane::Strain => 0.0,
+    };
+    [e1, e2, ezz]
+}
+
+/// Three principal effective stresses `C ε` (the third out of plane).
+fn principal_stress3(c: &[[f64; 3]; 3], eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
+    let s = mul3(c, eps);
+    let (s1, s2, _) = super::principal::principal_stress(&s);
+    let szz = match plane {
+        Plane::Stress => 0.0,
+        Plane::Strain => nu * (s[0] + s[1]),
+    };
+    [s1, s2, szz]
+}
+
+/// Damage at strain `eps` given the history `(k1, k2)`: returns `(D_candidate, k1', k2')`.
+fn damage(
+    p: &MazarsParams,
+    c: &[[f64; 3]; 3],
+    nu: f64,
+    plane: Plane,
+    eps: &[f64; 3],
+    k1: f64,
+    k2: f64,
+) -> (f64, f64, f64) {
+    let e = principal3(eps, nu, plane);
+    match p.variant {
+        MazarsVariant::Paper => {
+            let i1 = e[0] + e[1] + e[2];
+            let j = 0.5 * ((e[0] - e[1]).powi(2) + (e[1] - e[2]).powi(2) + (e[2] - e[0]).powi(2));
+            let sj = j.max(0.0).sqrt();
+            let et = i1 / (2.0 * (1.0 - 2.0 * nu)) + sj / (2.0 * (1.0 + nu));
+            let ec = i1 / (5.0 * (1.0 - 2.0 * nu)) + 6.0 * sj / (5.0 * (1.0 + nu));
+            let kt = k1.max(et).max(p.eps_t0);
+            let kc = k2.max(ec).max(p.eps_c0);
+            let s = principal_stress3(c, eps, nu, plane);
+            let den: f64 = s.iter().map(|x| x.abs()).sum();
+            let r = if den > 0.0 {
+                s.iter().map(|x| x.max(0.0)).sum::<f64>() / den
+            } else {
+                1.0
+            };
+            let es = r * kt + (1.0 - r) * kc;
+            let es0 = r * p.eps_t0 + (1.0 - r) * p.eps_c0;
+            let a = r * p.a_t + (1.0 - r) * p.a_c;
+            let b = r * p.b_t + (1.0 - r) * p.b_c;
+            (damage_law(es, es0, a, b), kt, kc)
+        }
+        MazarsVariant::Classic => {
+            let et2: f64 = e.iter().map(|x| x.max(0.0).powi(2)).sum();
+            let kappa = k1.max(et2.sqrt()).max(p.eps_t0);
+            let dt = damage_law(kappa, p.eps_t0, p.a_t, p.b_t);
+            let dc = damage_law(kappa, p.eps_t0, p.a_c, p.b_c);
+            // Weights from the strains of the positive / negative effective stresses.
+            let s = principal_stress3(c, eps, nu, plane);
+            let ee = e_modulus(c, nu, plane);
+            let (sp, sn): (f64, f64) = (
+                s.iter().map(|x| x.max(0.0)).sum(),
+                s.iter().map(|x| x.min(0.0)).sum(),
+            );
+            let (mut at, mut ac) = (0.0, 0.0);
+            if et2 > 0.0 {
+                for i in 0..3 {
+                    let eti = ((1.0 + nu) * s[i].max(0.0) - nu * sp) / ee;
+                    let eci = ((1.0 + nu) * s[i].min(0.0) - nu * sn) / ee;
+                    let pos = e[i].max(0.0);
+                    at += pos * eti;
+                    ac += pos * eci;
+                }
+                at = (at / et2).clamp(0.0, 1.0);
+                ac = (ac / et2).clamp(0.0, 1.0);
+            }
+            (at.powf(p.beta) * dt + ac.powf(p.beta) * dc, kappa, 0.0)
+        }
+    }
+}
+
+/// Young's modulus back from the plane `C` (for the classic split).
+fn e_modulus(c: &[[f64; 3]; 3], nu: f64, plane: Plane) -> f64 {
+    match plane {
+        Plane::Stress => c[0][0] * (1.0 - nu * nu),
+        Plane::Strain => c[0][0] * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu),
+    }
+}
+
+/// Mazars update. State: `[k1, k2, D]` (paper: `ε_t*, ε_c*`; classic: `κ, 0`).
+pub fn update(
+    p: &MazarsParams,
+    c: &[[f64; 3]; 3],
+    nu: f64,
+    plane: Plane,
+    step: &StrainStep,
+    state_n: &[f64],
+    state: &mut [f64],
+) -> PointResponse {
+    let (k1n, k2n, dn) = (state_n[0], state_n[1], state_n[2]);
+    let (dcand, k1, k2) = damage(p, c, nu, plane, &step.eps, k1n, k2n);
+    let d = dcand.max(dn).clamp(0.0, p.d_max);
+    state[0] = k1;
+    state[1] = k2;
+    state[2] = d;
+    let ce = mul3(c, &step.eps);
+    let y1 = 0.5 * dot3(&step.eps, &ce);
+    let y0 = 0.5 * dot3(&step.eps_n, &mul3(c, &step.eps_n));
+    let de = [
+        step.eps[0] - step.eps_n[0],
+        step.eps[1] - step.eps_n[1],
+        step.eps[2] - step.eps_n[2],
+    ];
+    let dd = d - dn;
+    let w = 1.0 - d;
+    PointResponse {
+        sigma: [w * ce[0], w * ce[1], w * ce[2]],
+        tangent: c.map(|row| row.map(|x| w * x)),
+        psi: w * y1,
+        dissipation: Dissipation {
+            damage: 0.5 * (y0 + y1) * dd,
+            // σ¹:Δε − Δψ − ΔW_d in closed form (theory/damage.md).
+            numerical: 0.5 * w * dot3(&de, &mul3(c, &de)) - 0.5 * dd * (y1 - y0),
+            ..Default::default()
+        },
+    }
+}

@@ -1,0 +1,423 @@
+//! Rankine-Hill plasticity, isotropic, plane stress (after Lourenço, de Borst & Rots
+//! 1997, isotropic case): Rankine (maximum principal stress) in tension, Hill in
+//! compression, which for an isotropic material is von Mises. Associated flow, one
+//! hardening/softening variable per criterion.
+//!
+//! The return mapping works in the principal frame of the trial stress (isotropy
+//! keeps the return coaxial): surfaces `R1: σ1 − σ̄_t(κ_t)`, `R2: σ2 − σ̄_t(κ_t)`,
+//! `VM: q(σ) − σ̄_c(κ_c)` with `q = √(σ1² − σ1σ2 + σ2²)`; `κ_t = Σ Δλ_R`, `κ_c = Σ Δλ_VM`.
+//! Closest-point projection by Newton on `(σ1, σ2, Δλ_active)` with an active-set
+//! loop (corners: R1+VM, R1+R2, R1+R2+VM); consistent tangent from the local
+//! Jacobian plus the spectral shear term. Plastic dissipation
+//! `ΔW_p = ½(σⁿ + σⁿ⁺¹):Δεᵖ`. See `theory/plasticity.md`.
+
+use super::hardening::Hardening;
+use super::linalg::{inverse_small, solve_small};
+use super::principal::{
+    principal_stress, strain_from_principal, strain_to_frame, strain_transform,
+    stress_from_principal,
+};
+use super::{dot3, mul3, Dissipation, PointResponse, StrainStep};
+
+/// Rankine-Hill parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RankineHillParams {
+    /// Tension law (Rankine surfaces).
+    pub tension: Hardening,
+    /// Compression law (von Mises surface).
+    pub compression: Hardening,
+}
+
+/// Surfaces of the composite criterion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Surface {
+    R1,
+    R2,
+    Vm,
+}
+
+/// Outcome of a return in the principal frame.
+struct Return {
+    sigma: [f64; 2],
+    dlambda: [f64; 3],
+    /// Algorithmic tangent `∂σ_p/∂ε_p` (2x2) in the principal frame.
+    d_alg: [[f64; 2]; 2],
+}
+
+fn q_and_n(s: &[f64; 2]) -> (f64, [f64; 2]) {
+    let q = (s[0] * s[0] - s[0] * s[1] + s[1] * s[1]).max(0.0).sqrt();
+    if q == 0.0 {
+        return (0.0, [0.0, 0.0]);
+    }
+    (
+        q,
+        [
+            (2.0 * s[0] - s[1]) / (2.0 * q),
+            (2.0 * s[1] - s[0]) / (2.0 * q),
+        ],
+    )
+}
+
+fn normal(surf: Surface, s: &[f64; 2]) -> [f64; 2] {
+    match surf {
+        Surface::R1 => [1.0, 0.0],
+        Surface::R2 => [0.0, 1.0],
+        Surface::Vm => q_and_n(s).1,
+    }
+}
+
+/// Hessian of `q`: `G/(2q) − n⊗n/q`, `G = [[2,−1],[−1,2]]`.
+fn vm_hessian(s: &[f64; 2]) -> [[f64; 2]; 2] {
+    let (q, n) = q_and_n(s);
+    if q == 0.0 {
+        return [[0.0; 2]; 2];
+    }
+    [
+        [1.0 / q - n[0] * n[0] / q, -0.5 / q - n[0] * n[1] / q],
+        [-0.5 / q - n[1] * n[0] / q, 1.0 / q - n[1] * n[1] / q],
+    ]
+}
+
+struct Ctx<'a> {
+    p: &'a RankineHillParams,
+    e: f64,
+    h: f64,
+    /// Plane-stress elasticity in the principal frame (normal part) and its inverse.
+    d: [[f64; 2]; 2],
+    dinv: [[f64; 2]; 2],
+    kt_n: f64,
+    kc_n: f64,
+}
+
+impl Ctx<'_> {
+    fn f(&self, surf: Surface, s: &[f64; 2], kt: f64, kc: f64) -> (f64, f64) {
+        match surf {
+            Surface::R1 => {
+                let (y, hh) = self.p.tension.strength(kt, self.e, self.h);
+                (s[0] - y, hh)
+            }
+            Surface::R2 => {
+                let (y, hh) = self.p.tension.strength(kt, self.e, self.h);
+                (s[1] - y, hh)
+            }
+            Surface::Vm => {
+                let (y, hh) = self.p.compression.strength(kc, self.e, self.h);
+                (q_and_n(s).0 - y, hh)
+            }
+        }
+    }
+
+    fn kappas(&self, active: &[Surface], dl: &[f64]) -> (f64, f64) {
+        let (mut kt, mut kc) = (self.kt_n, self.kc_n);
+        for (a, l) in active.iter().zip(dl) {
+            match a {
+                Surface::Vm => kc += l,
+                _ => kt += l,
+            }
+        }
+        (kt, kc)
+    }
+
+    /// Closest-point projection for a fixed active set; `None` if Newton fails.
+    fn project(
+        &self,
+        s_tr: &[f64; 2],
+        active: &[Surface],
+    ) -> Option<(Vec<f64>, [f64; 2], Vec<Vec<f64>>)> {
+        let m = active.len();
+        let mut s = *s_tr;
+        let mut dl = vec![0.0; m];
+        let scale = s_tr[0]
+            .abs()
+            .max(s_tr[1].abs())
+            .max(self.p.tension.initial(self.e))
+            .max(1.0);
+        for _ in 0..60 {
+            let (kt, kc) = self.kappas(active, &dl);
+            // Residuals.
+            let mut r = vec![0.0; 2 + m];
+            let ds = [s[0] - s_tr[0], s[1] - s_tr[1]];
+            for i in 0..2 {
+                r[i] = self.dinv[i][0] * ds[0] + self.dinv[i][1] * ds[1];
+            }
+            let mut hs = [[0.0; 2]; 2];
+            let mut jac = vec![vec![0.0; 2 + m]; 2 + m];
+            let mut hard = vec![0.0; m];
+            for (a, surf) in active.iter().enumerate() {
+                let n = normal(*surf, &s);
+                r[0] += dl[a] * n[0];
+                r[1] += dl[a] * n[1];
+                let (f, hh) = self.f(*surf, &s, kt, kc);
+                r[2 + a] = f;
+                hard[a] = hh;
+                if *surf == Surface::Vm {
+                    let hv = vm_hessian(&s);
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            hs[i][j] += dl[a] * hv[i][j];
+                        }
+                    }
+                }
+                jac[0][2 + a] = n[0];
+                jac[1][2 + a] = n[1];
+                jac[2 + a][0] = n[0];
+                jac[2 + a][1] = n[1];
+            }
+            for i in 0..2 {
+                for j in 0..2 {
+                    jac[i][j] = self.dinv[i][j] + hs[i][j];
+                }
+            }
+            // ∂f_a/∂Δλ_b = −H_a when a, b drive the same variable.
+            for (a, sa) in active.iter().enumerate() {
+                for (b, sb) in active.iter().enumerate() {
+                    if (*sa == Surface::Vm) == (*sb == Surface::Vm) {
+                        jac[2 + a][2 + b] = -hard[a];
+                    }
+                }
+            }
+            let norm = (r[0].abs() + r[1].abs()) * self.d[0][0]
+                + r[2..].iter().map(|x| x.abs()).sum::<f64>();
+            if norm <= 1e-12 * scale {
+                // Algorithmic tangent: A = [D⁻¹ + Σ Δλ ∂n/∂σ]⁻¹, D_alg = A − A N (NᵀAN + H)⁻¹ NᵀA.
+                let a_inv = vec![vec![jac[0][0], jac[0][1]], vec![jac[1][0], jac[1][1]]];
+                let a = inverse_small(&a_inv)?;
+                let mut an = vec![[0.0; 2]; m]; // A n_b
+                for (b, surf) in active.iter().enumerate() {
+                    let n = normal(*surf, &s);
+                    an[b] = [
+                        a[0][0] * n[0] + a[0][1] * n[1],
+                        a[1][0] * n[0] + a[1][1] * n[1],
+                    ];
+                }
+                let mut g = vec![vec![0.0; m]; m];
+                for (x, sx) in active.iter().enumerate() {
+                    let nx = normal(*sx, &s);
+                    for y in 0..m {
+                        g[x][y] = nx[0] * an[y][0] + nx[1] * an[y][1] - jac[2 + x][2 + y];
+                    }
+                }
+                let gi = inverse_small(&g)?;
+                let mut d_alg = vec![vec![0.0; 2]; 2];
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let mut v = a[i][j];
+                        for x in 0..m {
+                            for y in 0..m {
+                                v -= an[x][i] * gi[x][y] * an[y][j];
+                            }
+                        }
+                        d_alg[i][j] = v;
+                    }
+                }
+                return Some((dl, s, d_alg));
+            }
+            let neg: Vec<f64> = r.iter().map(|x| -x).collect();
+            let dx = solve_small(jac, neg)?;
+            s[0] += dx[0];
+            s[1] += dx[1];
+            for a in 0..m {
+                dl[a] += dx[2 + a];
+            }
+        }
+        None
+    }
+
+    /// Active-set return: starts from the surfaces violated at the trial state, drops
+    /// surfaces with negative multipliers, adds violated ones, until KKT holds.
+    fn ret(&self, s_tr: &[f64; 2]) -> Option<Return> {
+        let tol = 1e-10
+            * self
+                .p
+                .compression
+                .initial(self.e)
+                .max(self.p.tension.initial(self.e))
+                .max(1.0);
+        let all = [Surface::R1, Surface::R2, Surface::Vm];
+        let mut active: Vec<Surface> = all
+            .iter()
+            .copied()
+            .filter(|s| self.f(*s, s_tr, self.kt_n, self.kc_n).0 > tol)
+            .collect();
+        let candidates: [&[Surface]; 7] = [
+            &[Surface::R1],
+            &[Surface::Vm],
+            &[Surface::R1, Surface::Vm],
+            &[Surface::R1, Surface::R2],
+            &[Surface::R2, Surface::Vm],
+            &[Surface::R2],
+            &[Surface::R1, Surface::R2, Surface::Vm],
+        ];
+        let admissible = |set: &[Surface]| -> Option<Return> {
+            let (dl, s, d_alg) = self.project(s_tr, set)?;
+            if dl.iter().any(|&l| l < -tol / self.d[0][0]) {
+                return None;
+            }
+            let (kt, kc) = self.kappas(set, &dl);
+            if all
+                .iter()
+                .any(|x| !set.contains(x) && self.f(*x, &s, kt, kc).0 > tol)
+            {
+                return None;
+            }
+            let mut lam = [0.0; 3];
+            for (a, sf) in set.iter().enumerate() {
+                lam[all.iter().position(|x| x == sf).expect("known surface")] = dl[a];
+            }
+            Some(Return {
+                sigma: s,
+                dlambda: lam,
+                d_alg: [[d_alg[0][0], d_alg[0][1]], [d_alg[1][0], d_alg[1][1]]],
+            })
+        };
+        active.sort_by_key(|s| all.iter().position(|x| x == s));
+        if let Some(r) = admissible(&active) {
+            return Some(r);
+        }
+        candidates.iter().find_map(|set| admissible(set))
+    }
+}
+
+/// Rankine-Hill update. State: `[εᵖ_xx, εᵖ_yy, γᵖ_xy, κ_t, κ_c]`.
+pub fn update(
+    p: &RankineHillParams,
+    c: &[[f64; 3]; 3],
+    e: f64,
+    nu: f64,
+    step: &StrainStep,
+    state_n: &[f64],
+    state: &mut [f64],
+) -> PointResponse {
+    let ep_n = [state_n[0], state_n[1], state_n[2]];
+    let (kt_n, kc_n) = (state_n[3], state_n[4]);
+    let ee_tr = [
+        step.eps[0] - ep_n[0],
+        step.eps[1] - ep_n[1],
+        step.eps[2] - ep_n[2],
+    ];
+    let s_tr = mul3(c, &ee_tr);
+    let ee_n = [
+        step.eps_n[0] - ep_n[0],
+        step.eps_n[1] - ep_n[1],
+        step.eps_n[2] - ep_n[2],
+    ];
+    let sigma_n = mul3(c, &ee_n);
+    let (s1, s2, theta) = principal_stress(&s_tr);
+    let cc = c[0][0];
+    let ctx = Ctx {
+        p,
+        e,
+        h: step.length,
+        d: [[cc, cc * nu], [cc * nu, cc]],
+        dinv: [[1.0 / e, -nu / e], [-nu / e, 1.0 / e]],
+        kt_n,
+        kc_n,
+    };
+    state.copy_from_slice(state_n);
+    let elastic = |state: &mut [f64]| {
+        let _ = state;
+        PointResponse {
+            sigma: s_tr,
+            tangent: *c,
+            psi: 0.5 * dot3(&ee_tr, &s_tr),
+            dissipation: Dissipation {
+                numerical: numerical_elastic(c, &step.eps, &step.eps_n),
+                ..Default::default()
+            },
+        }
+    };
+    let trial_ok = ctx.f(Surface::R1, &[s1, s2], kt_n, kc_n).0 <= 0.0
+        && ctx.f(Surface::Vm, &[s1, s2], kt_n, kc_n).0 <= 0.0;
+    if trial_ok {
+        return elastic(state);
+    }
+    let Some(ret) = ctx.ret(&[s1, s2]) else {
+        // No admissible return (should not happen): keep the trial state elastic and
+        // let the global residual reveal it.
+        return elastic(state);
+    };
+    // Plastic strain increment in the principal frame: D⁻¹(σ_tr − σ).
+    let dsp = [s1 - ret.sigma[0], s2 - ret.sigma[1]];
+    let dep1 = (dsp[0] - nu * dsp[1]) / e;
+    let dep2 = (dsp[1] - nu * dsp[0]) / e;
+    let dep = strain_from_principal(dep1, dep2, theta);
+    for i in 0..3 {
+        state[i] = ep_n[i] + dep[i];
+    }
+    state[3] = kt_n + ret.dlambda[0] + ret.dlambda[1];
+    state[4] = kc_n + ret.dlambda[2];
+    let sigma = stress_from_principal(ret.sigma[0], ret.sigma[1], theta);
+    // Tangent: principal-frame normal block plus the spectral shear term.
+    let et = strain_to_frame(&ee_tr, theta);
+    let gap = et[0] - et[1];
+    let g_alg = if gap.abs() > 1e-12 * (et[0].abs() + et[1].abs()).max(1e-30) {
+        (ret.sigma[0] - ret.sigma[1]) / (2.0 * gap)
+    } else {
+        0.5 * (ret.d_alg[0][0] - ret.d_alg[0][1])
+    };
+    let dp = [
+        [ret.d_alg[0][0], ret.d_alg[0][1], 0.0],
+        [ret.d_alg[1][0], ret.d_alg[1][1], 0.0],
+        [0.0, 0.0, g_alg],
+    ];
+    let t = strain_transform(theta);
+    let mut tangent = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            let mut v = 0.0;
+            for k in 0..3 {
+                for l in 0..3 {
+                    v += t[k][i] * dp[k][l] * t[l][j];
+                }
+            }
+            tangent[i][j] = v;
+        }
+    }
+    let ee = [
+        step.eps[0] - state[0],
+        step.eps[1] - state[1],
+        step.eps[2] - state[2],
+    ];
+    let psi = 0.5 * dot3(&ee, &sigma);
+    let psi_n = 0.5 * dot3(&ee_n, &sigma_n);
+    let plastic = 0.5
+        * ((sigma_n[0] + sigma[0]) * dep[0]
+            + (sigma_n[1] + sigma[1]) * dep[1]
+            + (sigma_n[2] + sigma[2]) * dep[2]);
+    let de = [
+        step.eps[0] - step.eps_n[0],
+        step.eps[1] - step.eps_n[1],
+        step.eps[2] - step.eps_n[2],
+    ];
+    let work = dot3(&sigma, &de);
+    PointResponse {
+        sigma,
+        tangent,
+        psi,
+        dissipation: Dissipation {
+            plastic,
+            numerical: work - (psi - psi_n) - plastic,
+            ..Default::default()
+        },
+    }
+}
+
+fn numerical_elastic(c: &[[f64; 3]; 3], eps: &[f64; 3], eps_n: &[f64; 3]) -> f64 {
+    let de = [eps[0] - eps_n[0], eps[1] - eps_n[1], eps[2] - eps_n[2]];
+    0.5 * dot3(&de, &mul3(c, &de))
+}
+
+/// Values of the yield functions `(f_t, f_c)` at a stress for given `κ_t, κ_c`.
+pub fn yield_values(
+    p: &RankineHillParams,
+    e: f64,
+    h: f64,
+    sigma: &[f64; 3],
+    kt: f64,
+    kc: f64,
+) -> (f64, f64) {
+    let (s1, s2, _) = principal_stress(sigma);
+    let (yt, _) = p.tension.strength(kt, e, h);
+    let (yc, _) = p.compression.strength(kc, e, h);
+    (s1 - yt, q_and_n(&[s1, s2]).0 - yc)
+}
