@@ -57,7 +57,13 @@ impl Hardening {
                 post_yield_modulus,
             } => {
                 let hh = e * post_yield_modulus / (e - post_yield_modulus);
-                (strength + hh * kappa, hh)
+                let y = strength + hh * kappa;
+                // A softening diagram ends at zero strength.
+                if y > 0.0 {
+                    (y, hh)
+                } else {
+                    (0.0, 0.0)
+                }
             }
             Hardening::LinearSoftening {
                 strength,
@@ -89,21 +95,20 @@ impl Hardening {
                 for _ in 0..100 {
                     let (s, ds) = ec2_curve(f_cm, eps_c1, k, eps);
                     let g = eps - s / e - kappa;
+                    if g.abs() < 1e-15 * eps_cu1 {
+                        break;
+                    }
                     if g > 0.0 {
                         hi = eps;
                     } else {
                         lo = eps;
                     }
-                    let dg = 1.0 - ds / e;
-                    let next = eps - g / dg;
+                    let next = eps - g / (1.0 - ds / e);
                     eps = if next > lo && next < hi {
                         next
                     } else {
                         0.5 * (lo + hi)
                     };
-                    if g.abs() < 1e-15 * eps_cu1 {
-                        break;
-                    }
                 }
                 let (s, ds) = ec2_curve(f_cm, eps_c1, k, eps);
                 (s, ds / (1.0 - ds / e))

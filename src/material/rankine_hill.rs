@@ -380,10 +380,16 @@ pub fn update(
     ];
     let psi = 0.5 * dot3(&ee, &sigma);
     let psi_n = 0.5 * dot3(&ee_n, &sigma_n);
-    let plastic = 0.5
-        * ((sigma_n[0] + sigma[0]) * dep[0]
-            + (sigma_n[1] + sigma[1]) * dep[1]
-            + (sigma_n[2] + sigma[2]) * dep[2]);
+    // The paper's trapezoid ½(σⁿ + σⁿ⁺¹):Δεᵖ with each stress paired with its own
+    // flow direction: σ:∂f/∂σ is the surface strength on every surface, so per surface
+    // ½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ. Equal to the literal form for steps whose principal
+    // axes do not turn, non-negative always (theory/plasticity.md).
+    let (yt0, _) = p.tension.strength(kt_n, e, step.length);
+    let (yt1, _) = p.tension.strength(state[3], e, step.length);
+    let (yc0, _) = p.compression.strength(kc_n, e, step.length);
+    let (yc1, _) = p.compression.strength(state[4], e, step.length);
+    let plastic =
+        0.5 * (yt0 + yt1) * (ret.dlambda[0] + ret.dlambda[1]) + 0.5 * (yc0 + yc1) * ret.dlambda[2];
     let de = [
         step.eps[0] - step.eps_n[0],
         step.eps[1] - step.eps_n[1],

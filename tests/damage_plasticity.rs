@@ -1,0 +1,353 @@
+//! Mazars damage and Rankine-Hill plasticity: material-point curves against closed
+//! forms, unloading, corner returns with KKT, consistent tangent against finite
+//! differences, properties over random paths, and global runs (localisation past
+//! peak, ledger closure to the iteration tolerance, step cuts, failure reports).
+
+use proptest::prelude::*;
+use rothe::config::MaterialSpec;
+use rothe::driver::{run_path, Control, PathKind, PathSpec};
+use rothe::fe::Plane;
+use rothe::material::mazars::damage_law;
+use rothe::material::rankine_hill::yield_values;
+use rothe::material::{Material, Model, StrainStep};
+use rothe::model::TimeFunction;
+
+const E: f64 = 33e9;
+const NU: f64 = 0.2;
+const MAZARS: &str = "eps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
+const RH_BILINEAR: &str = "tension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }";
+
+fn mat(text: &str) -> Material {
+    let spec: MaterialSpec =
+        toml::from_str(&format!("{text}\nE = {E}\nnu = {NU}\nrho = 2400.0")).unwrap();
+    rothe::config::material("m", "material", &spec).unwrap()
+}
+
+/// Strain-controlled uniaxial-stress path through the table `points` (t, ε_xx).
+fn uniaxial(m: &Material, points: Vec<[f64; 2]>, n: usize) -> Vec<rothe::driver::PointRecord> {
+    let t_end = points.last().unwrap()[0];
+    let p = PathSpec {
+        kind: PathKind::UniaxialStress,
+        plane: Plane::Stress,
+        control: Control::Strain,
+        amplitude: 1.0,
+        function: TimeFunction::Table { points },
+        ratio: 1.0,
+        t_end,
+        dt: t_end / n as f64,
+        times: vec![],
+        strains: vec![],
+        length: 0.1,
+    };
+    run_path(m, &p).unwrap()
+}
+
+#[test]
+fn mazars_paper_uniaxial_curves_match_closed_form() {
+    // Reference: eqs. (11)-(13) in uniaxial stress: principal strains (ε, −νε, −νε)
+    // give ε_t = ε in tension (r = 1) and ε_c = |ε| in compression (r = 0), so
+    // σ = (1 − D(ε*)) E ε with D = 1 − (1−A)ε0/ε* − A e^{−B(ε*−ε0)} and the tension or
+    // compression A, B. Checked along the whole curve (peak and post-peak), and the
+    // peak in tension is E ε0 for A_t = 1.
+    let m = mat(&format!("model = \"mazars\"\n{MAZARS}"));
+    let recs = uniaxial(&m, vec![[0.0, 0.0], [1.0, 1e-3]], 1000);
+    let mut peak: f64 = 0.0;
+    for r in &recs[1..] {
+        let e = r.eps[0];
+        let want = (1.0 - damage_law(e, 1e-4, 1.0, 1e4).min(0.99999)) * E * e;
+        assert!(
+            (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
+            "tension at ε = {e}"
+        );
+        peak = peak.max(r.response.sigma[0]);
+    }
+    assert!((peak - E * 1e-4).abs() < 1e-6 * peak);
+    let recs = uniaxial(&m, vec![[0.0, 0.0], [1.0, -5e-3]], 1000);
+    for r in &recs[1..] {
+        let e = r.eps[0];
+        // With A_c > 1 the law dips below zero just past the threshold: D ≥ 0 holds.
+        let want = (1.0 - damage_law(-e, 1e-4, 1.2, 1.5e3).clamp(0.0, 0.99999)) * E * e;
+        assert!(
+            (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
+            "compression at ε = {e}"
+        );
+    }
+}
+
+#[test]
+fn mazars_classic_uniaxial_curves_match_closed_form() {
+    // Reference: Mazars (1984): in tension ε̃ = ε, α_t = 1, σ = (1 − D_t(ε)) E ε; in
+    // compression the positive strains are the lateral ones, ε̃ = √2 ν |ε| (NOTES.md),
+    // α_c = 1, σ = (1 − D_c(√2 ν|ε|)) E ε.
+    let m = mat(&format!(
+        "model = \"mazars\"\nvariant = \"classic\"\n{MAZARS}"
+    ));
+    for r in &uniaxial(&m, vec![[0.0, 0.0], [1.0, 1e-3]], 500)[1..] {
+        let e = r.eps[0];
+        let want = (1.0 - damage_law(e, 1e-4, 1.0, 1e4).min(0.99999)) * E * e;
+        assert!(
+            (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
+            "tension at ε = {e}"
+        );
+    }
+    for r in &uniaxial(&m, vec![[0.0, 0.0], [1.0, -8e-3]], 500)[1..] {
+        let e = r.eps[0];
+        let k = 2f64.sqrt() * NU * e.abs();
+        let want = (1.0 - damage_law(k, 1e-4, 1.2, 1.5e3).clamp(0.0, 0.99999)) * E * e;
+        assert!(
+            (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
+            "compression at ε = {e}"
+        );
+    }
+}
+
+#[test]
+fn mazars_unloads_to_the_origin_and_damage_only_grows() {
+    for variant in ["paper", "classic"] {
+        let m = mat(&format!(
+            "model = \"mazars\"\nvariant = \"{variant}\"\n{MAZARS}"
+        ));
+        let recs = uniaxial(
+            &m,
+            vec![
+                [0.0, 0.0],
+                [1.0, 4e-4],
+                [2.0, 1e-4],
+                [3.0, 6e-4],
+                [4.0, 0.0],
+            ],
+            800,
+        );
+        let mut d_prev = 0.0;
+        for w in recs.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let d = b.state[2];
+            assert!(d >= d_prev && d < 1.0, "{variant}: damage {d_prev} -> {d}");
+            d_prev = d;
+            if b.eps[0] < a.eps[0] && b.eps[0] > 0.0 {
+                // Unloading: secant, σ/ε = (1 − D) E with D frozen.
+                let secant = b.response.sigma[0] / b.eps[0];
+                assert!(
+                    (secant - (1.0 - d) * E).abs() < 1e-9 * E,
+                    "{variant}: secant unloading"
+                );
+                assert_eq!(b.state[2], a.state[2]);
+            }
+        }
+        let last = recs.last().unwrap();
+        assert!(
+            last.response.sigma[0].abs() < 1e-9 * E * 1e-4,
+            "back to the origin"
+        );
+        assert!(last.dissipated[1] > 0.0);
+    }
+}
+
+#[test]
+fn rankine_hill_uniaxial_yield_hardening_and_elastic_unloading() {
+    // Bilinear diagram (NOTES.md benchmark 1): yield at f_ct = 2.9 MPa in tension and
+    // f_c = 30 MPa in compression, slope E_t = 0.05 E after yield, elastic slope E on
+    // unloading.
+    let m = mat(&format!("model = \"rankine_hill\"\n{RH_BILINEAR}"));
+    let et = 1.65e9;
+    for (fy, sign) in [(2.9e6, 1.0), (30e6, -1.0)] {
+        let ey = fy / E;
+        // Unload by half the yield strain: elastic in both cases.
+        let recs = uniaxial(
+            &m,
+            vec![[0.0, 0.0], [1.0, sign * 5.0 * ey], [1.5, sign * 4.5 * ey]],
+            1500,
+        );
+        for w in recs.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let e = b.eps[0].abs();
+            let s = b.response.sigma[0] * sign;
+            if b.t <= 1.0 {
+                let want = if e <= ey { E * e } else { fy + et * (e - ey) };
+                assert!(
+                    (s - want).abs() < 1e-6 * fy,
+                    "loading at ε = {e}: {s} vs {want}"
+                );
+            } else {
+                let slope = (b.response.sigma[0] - a.response.sigma[0]) / (b.eps[0] - a.eps[0]);
+                assert!((slope - E).abs() < 1e-6 * E, "unloading slope {slope}");
+            }
+        }
+        // At the end of loading the plastic work is ∫σ̄ dκ = f_y κ + ½ H κ² exactly
+        // (the trapezoid is exact for a linear hardening law).
+        let top = recs.iter().find(|r| (r.t - 1.0).abs() < 1e-12).unwrap();
+        let h = E * et / (E - et);
+        let kappa = if sign > 0.0 {
+            top.state[3]
+        } else {
+            top.state[4]
+        };
+        let want = fy * kappa + 0.5 * h * kappa * kappa;
+        assert!(
+            (top.dissipated[2] - want).abs() < 1e-9 * want,
+            "plastic work {} vs {want}",
+            top.dissipated[2]
+        );
+        assert!(recs.last().unwrap().dissipated[2] > 0.0);
+    }
+}
+
+fn rh_point(
+    m: &Material,
+    eps_n: [f64; 3],
+    eps: [f64; 3],
+    state_n: &[f64],
+) -> (rothe::material::PointResponse, Vec<f64>) {
+    let mut st = vec![0.0; 5];
+    let r = m.update(
+        Plane::Stress,
+        &StrainStep {
+            eps_n,
+            eps,
+            dt: 1e-4,
+            length: 0.1,
+        },
+        state_n,
+        &mut st,
+    );
+    (r, st)
+}
+
+#[test]
+fn rankine_hill_corner_return_satisfies_kkt() {
+    // A trial state beyond the Rankine/von Mises corner (tension in x, strong
+    // compression in y): both criteria end active, f_t = f_c = 0, Δλ_t, Δλ_c ≥ 0, and
+    // the plastic strain increment lies in the normal cone, coaxial with the stress:
+    // Δεᵖ = Δλ_t (1, 0) + Δλ_c ∂q/∂σ in the principal frame.
+    let m = mat(&format!("model = \"rankine_hill\"\n{RH_BILINEAR}"));
+    let Model::RankineHill(p) = m.model else {
+        unreachable!()
+    };
+    for (ex, ey, g) in [
+        (1.5e-3, -1.6e-3, 0.0),
+        (1.2e-3, -1.4e-3, 3e-4),
+        (2e-3, -2e-3, -5e-4),
+    ] {
+        let (r, st) = rh_point(&m, [0.0; 3], [ex, ey, g], &[0.0; 5]);
+        let (ft, fc) = yield_values(&p, E, 0.1, &r.sigma, st[3], st[4]);
+        let tol = 1e-6 * 30e6;
+        assert!(
+            ft.abs() < tol && fc.abs() < tol,
+            "corner: f_t = {ft}, f_c = {fc}"
+        );
+        assert!(
+            st[3] > 0.0 && st[4] > 0.0,
+            "both multipliers positive: {:?}",
+            &st[3..]
+        );
+        let (s1, s2, th) = rothe::material::principal::principal_stress(&r.sigma);
+        let dep = rothe::material::principal::strain_to_frame(&[st[0], st[1], st[2]], th);
+        assert!(
+            dep[2].abs() < 1e-9 * (dep[0].abs() + dep[1].abs()),
+            "coaxial"
+        );
+        let q = (s1 * s1 - s1 * s2 + s2 * s2).sqrt();
+        let n = [(2.0 * s1 - s2) / (2.0 * q), (2.0 * s2 - s1) / (2.0 * q)];
+        // dep = λt (1,0) + λc n  →  λc = dep[1]/n[1], λt = dep[0] − λc n[0].
+        let lc = dep[1] / n[1];
+        let lt = dep[0] - lc * n[0];
+        assert!(
+            (lc - st[4]).abs() < 1e-6 * st[4] && (lt - st[3]).abs() < 1e-6 * st[3],
+            "normal cone: {lt} {lc} vs {:?}",
+            &st[3..]
+        );
+        assert!(r.dissipation.plastic > 0.0);
+    }
+}
+
+fn fd_tangent_check(m: &Material, eps_n: [f64; 3], eps: [f64; 3], state_n: &[f64]) {
+    let (r, _) = rh_point(m, eps_n, eps, state_n);
+    let h = 1e-9;
+    for j in 0..3 {
+        let (mut ep, mut em) = (eps, eps);
+        ep[j] += h;
+        em[j] -= h;
+        let sp = rh_point(m, eps_n, ep, state_n).0.sigma;
+        let sm = rh_point(m, eps_n, em, state_n).0.sigma;
+        for i in 0..3 {
+            let fd = (sp[i] - sm[i]) / (2.0 * h);
+            assert!(
+                (fd - r.tangent[i][j]).abs() < 1e-4 * E,
+                "D[{i}][{j}] = {} vs finite difference {fd} at ε = {eps:?}",
+                r.tangent[i][j]
+            );
+        }
+    }
+}
+
+#[test]
+fn rankine_hill_consistent_tangent_matches_finite_differences() {
+    // Elastic, Rankine only, von Mises only, and corner states, from virgin and from
+    // hardened histories; central differences with δε = 1e-9.
+    let m = mat(&format!("model = \"rankine_hill\"\n{RH_BILINEAR}"));
+    let soft = mat("model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 140.0 }\ncompression = { law = \"ec2\", f_cm = 38e6, eps_c1 = 0.0022, eps_cu1 = 0.0035 }");
+    let hardened = [1e-5, -2e-5, 1e-5, 2e-5, 1e-4];
+    for mm in [&m, &soft] {
+        for (eps, st) in [
+            ([3e-5, 1e-5, 0.0], [0.0; 5]),
+            ([3e-4, 5e-5, 1e-4], [0.0; 5]),
+            ([2e-4, 2e-4, 3e-5], [0.0; 5]),
+            ([-2e-3, -4e-4, 6e-4], [0.0; 5]),
+            ([6e-4, -1.6e-3, 2e-4], [0.0; 5]),
+            ([4e-4, -1e-4, 2e-4], hardened),
+            ([-2.5e-3, -1e-3, -5e-4], hardened),
+        ] {
+            fd_tangent_check(mm, [0.0; 3], eps, &st);
+        }
+    }
+}
+
+fn path_strategy() -> impl Strategy<Value = Vec<[f64; 3]>> {
+    proptest::collection::vec(proptest::array::uniform3(-2e-4f64..2e-4), 2..60).prop_map(|incs| {
+        let mut e = [0.0; 3];
+        incs.iter()
+            .map(|d| {
+                for i in 0..3 {
+                    e[i] += d[i];
+                }
+                e
+            })
+            .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn random_paths_keep_the_invariants(path in path_strategy(), variant in 0usize..4) {
+        // Damage never decreases and stays below 1; dissipation per step is
+        // non-negative; after every return the stress is admissible.
+        let text = match variant {
+            0 => format!("model = \"mazars\"\n{MAZARS}"),
+            1 => format!("model = \"mazars\"\nvariant = \"classic\"\n{MAZARS}"),
+            2 => format!("model = \"rankine_hill\"\n{RH_BILINEAR}"),
+            _ => "model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 140.0 }\ncompression = { law = \"ec2\", f_cm = 38e6, eps_c1 = 0.0022, eps_cu1 = 0.0035 }".to_string(),
+        };
+        let m = mat(&text);
+        let ns = m.n_state();
+        let (mut st_n, mut st) = (vec![0.0; ns], vec![0.0; ns]);
+        let mut eps_n = [0.0; 3];
+        for eps in &path {
+            let r = m.update(Plane::Stress, &StrainStep { eps_n, eps: *eps, dt: 1e-4, length: 0.1 }, &st_n, &mut st);
+            let d = r.dissipation;
+            prop_assert!(d.damage >= 0.0 && d.plastic >= 0.0, "dissipation {:?}", d);
+            match m.model {
+                Model::Mazars(_) => prop_assert!(st[2] >= st_n[2] && st[2] < 1.0),
+                Model::RankineHill(p) => {
+                    let (ft, fc) = yield_values(&p, E, 0.1, &r.sigma, st[3], st[4]);
+                    prop_assert!(ft <= 1e-6 * 2.9e6 && fc <= 1e-6 * 30e6, "f_t = {}, f_c = {}", ft, fc);
+                    prop_assert!(st[3] >= st_n[3] && st[4] >= st_n[4]);
+                }
+                _ => unreachable!(),
+            }
+            eps_n = *eps;
+            st_n.clone_from(&st);
+        }
+    }
+}
