@@ -17,7 +17,7 @@ use crate::output::history::History;
 use crate::output::post::cell_stress;
 use crate::output::summary::{EnergySummary, ProbeSummary, SolverSummary, Summary, TimingSummary};
 use crate::output::vtk::VtkSeries;
-use crate::time::backward_euler::BackwardEuler;
+use crate::time::backward_euler::{BackwardEuler, DynState, StepReport};
 use crate::time::{statics, Timing};
 
 /// How to run.
@@ -178,19 +178,11 @@ fn run_dynamic(
     rec.record(model, 0.0, &s.ledger, 0, 0.0, &s.u)?;
     rec.vtk(model, 0, 0.0, &s.u, &s.v, &s.points)?;
     let pb = progress(n_steps, opts.progress);
-    let mut outcome = Ok(());
-    // Adaptive step: halve on non-convergence (up to `max_cuts` times in a row), grow
-    // back by doubling after four easy steps, never beyond the requested `dt`.
-    let (h0, t_end) = (model.analysis.dt, model.analysis.t_end);
-    let mut h = h0;
-    let (mut cuts_in_row, mut easy) = (0usize, 0usize);
-    while s.t < t_end - 1e-9 * h0 {
-        let h_try = h.min(t_end - s.t);
-        if (h_try - be.h).abs() > 1e-12 * h0 {
-            be.set_step(h_try)?;
-        }
-        match be.step(&mut s) {
-            Ok(report) => {
+    let t_end = model.analysis.t_end;
+    let mut step_cuts = 0;
+    let outcome = march(&mut be, &mut s, |s, report| {
+        match report {
+            Marched::Step(report) => {
                 summary.solver.iterations += report.iterations;
                 rec.record(
                     model,
@@ -201,33 +193,16 @@ fn run_dynamic(
                     &s.u,
                 )?;
                 rec.vtk(model, s.step, s.t, &s.u, &s.v, &s.points)?;
-                cuts_in_row = 0;
-                if h < h0 {
-                    easy += 1;
-                    if easy >= 4 {
-                        h = (2.0 * h).min(h0);
-                        easy = 0;
-                    }
-                }
                 pb.set_position(((s.t / t_end) * n_steps as f64) as u64);
             }
-            Err(Error::Stepping(msg)) if cuts_in_row < model.analysis.max_cuts => {
-                cuts_in_row += 1;
-                summary.solver.step_cuts += 1;
-                easy = 0;
-                h *= 0.5;
-                pb.set_message(format!("step cut to h = {h:.3e} ({msg})"));
-            }
-            Err(e) => {
-                outcome = Err(Error::Stepping(format!(
-                    "step {} (t = {:.6e}) failed after {cuts_in_row} step cuts: {e}",
-                    s.step + 1,
-                    s.t + be.h
-                )));
-                break;
+            Marched::Cut { h, reason } => {
+                step_cuts += 1;
+                pb.set_message(format!("step cut to h = {h:.3e} ({reason})"));
             }
         }
-    }
+        Ok(())
+    });
+    summary.solver.step_cuts = step_cuts;
     pb.finish_and_clear();
     summary.steps = s.step;
     summary.t_end = s.t;
@@ -236,6 +211,68 @@ fn run_dynamic(
     summary.solver.backend = be.backend().into();
     summary.solver.factorizations = be.factorizations;
     outcome
+}
+
+/// What [`march`] reports to its observer.
+pub enum Marched<'a> {
+    /// A step was accepted.
+    Step(&'a StepReport),
+    /// A step did not converge and `h` was halved.
+    Cut {
+        /// The new step size.
+        h: f64,
+        /// Why the step failed.
+        reason: String,
+    },
+}
+
+/// Integrates `s` to the model's `t_end` with adaptive steps: a step that does not
+/// converge is halved (up to `max_cuts` times in a row) and retried from the same
+/// state; after four accepted steps at a reduced size the step doubles back, never
+/// beyond the requested `dt`. `observe` sees every accepted step and every cut; an
+/// error from it stops the march. On failure the error names the step and time, and
+/// `s` holds the last accepted state.
+pub fn march<F>(be: &mut BackwardEuler, s: &mut DynState, mut observe: F) -> Result<()>
+where
+    F: FnMut(&DynState, Marched) -> Result<()>,
+{
+    let a = &be.model().analysis;
+    let (h0, t_end, max_cuts) = (a.dt, a.t_end, a.max_cuts);
+    let mut h = h0;
+    let (mut cuts_in_row, mut easy) = (0usize, 0usize);
+    while s.t < t_end - 1e-9 * h0 {
+        let h_try = h.min(t_end - s.t);
+        if (h_try - be.h).abs() > 1e-12 * h0 {
+            be.set_step(h_try)?;
+        }
+        match be.step(s) {
+            Ok(report) => {
+                observe(s, Marched::Step(&report))?;
+                cuts_in_row = 0;
+                if h < h0 {
+                    easy += 1;
+                    if easy >= 4 {
+                        h = (2.0 * h).min(h0);
+                        easy = 0;
+                    }
+                }
+            }
+            Err(Error::Stepping(msg)) if cuts_in_row < max_cuts => {
+                cuts_in_row += 1;
+                easy = 0;
+                h *= 0.5;
+                observe(s, Marched::Cut { h, reason: msg })?;
+            }
+            Err(e) => {
+                return Err(Error::Stepping(format!(
+                    "step {} (t = {:.6e}) failed after {cuts_in_row} step cuts: {e}",
+                    s.step + 1,
+                    s.t + be.h
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn run_static(

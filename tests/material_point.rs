@@ -36,6 +36,7 @@ fn path(
         dt,
         times: vec![],
         strains: vec![],
+        length: 0.1,
     }
 }
 
@@ -317,8 +318,8 @@ proptest! {
         let (mut eps_n, mut reps_n) = ([0.0; 3], [0.0; 3]);
         for eps in &path {
             let reps = rotate(*eps, theta);
-            let r = m.update(Plane::Stress, &StrainStep { eps_n, eps: *eps, dt }, &st_n, &mut st);
-            let q = m.update(Plane::Stress, &StrainStep { eps_n: reps_n, eps: reps, dt }, &rt_n, &mut rt);
+            let r = m.update(Plane::Stress, &StrainStep { eps_n, eps: *eps, dt, length: 0.1 }, &st_n, &mut st);
+            let q = m.update(Plane::Stress, &StrainStep { eps_n: reps_n, eps: reps, dt, length: 0.1 }, &rt_n, &mut rt);
             let d = r.dissipation;
             prop_assert!(d.viscous >= 0.0 && d.numerical >= 0.0 && d.damage == 0.0 && d.plastic == 0.0);
             let want = rotate_stress(r.sigma, theta);
@@ -353,6 +354,7 @@ fn predicted_stress_is_the_update_at_unchanged_strain() {
                 eps_n: [0.0; 3],
                 eps,
                 dt: 1e-4,
+                length: 0.1,
             },
             &vec![0.0; ns],
             &mut s1,
@@ -364,6 +366,7 @@ fn predicted_stress_is_the_update_at_unchanged_strain() {
                     eps_n: eps,
                     eps,
                     dt: 1e-4,
+                    length: 0.1,
                 },
                 &s1,
                 &mut s2,

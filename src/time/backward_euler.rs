@@ -183,6 +183,11 @@ impl<'m> BackwardEuler<'m> {
         })
     }
 
+    /// The model being integrated.
+    pub fn model(&self) -> &'m Model {
+        self.model
+    }
+
     /// Solver backend name.
     pub fn backend(&self) -> &'static str {
         self.solver.name()
