@@ -231,7 +231,7 @@ pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
                     a[ii][jj] = resp.tangent[i][j];
                 }
             }
-            let d = solve_small(a, r).ok_or_else(|| {
+            let d = crate::material::linalg::solve_small(a, r).ok_or_else(|| {
                 Error::Stepping(format!("material point: singular tangent at t = {t:e}"))
             })?;
             for (ii, &i) in free.iter().enumerate() {
@@ -259,31 +259,6 @@ pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
         state_n.clone_from(&state);
     }
     Ok(out)
-}
-
-/// Gaussian elimination with partial pivoting for the tiny mixed-control systems.
-fn solve_small(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
-    let n = b.len();
-    for c in 0..n {
-        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
-        if a[p][c] == 0.0 {
-            return None;
-        }
-        a.swap(c, p);
-        b.swap(c, p);
-        for r in c + 1..n {
-            let f = a[r][c] / a[c][c];
-            for k in c..n {
-                a[r][k] -= f * a[c][k];
-            }
-            b[r] -= f * b[c];
-        }
-    }
-    let mut x = vec![0.0; n];
-    for c in (0..n).rev() {
-        x[c] = (b[c] - (c + 1..n).map(|k| a[c][k] * x[k]).sum::<f64>()) / a[c][c];
-    }
-    Some(x)
 }
 
 /// Reads a driver file, runs it and writes `out/material.csv`.

@@ -17,6 +17,10 @@
 //! parallel scatter, loads), [`linsolve`] (faer and CHOLMOD Cholesky behind one
 //! trait). [`run`] ties them together the way the `rothe` command does.
 
+// Element and material kernels index small fixed-size arrays by component: index
+// loops read like the formulas they implement.
+#![allow(clippy::needless_range_loop)]
+
 pub mod assembly;
 pub mod config;
 pub mod driver;

@@ -1,5 +1,6 @@
 //! The `rothe` command as a user meets it: a run writes its files; bad input gives a
 //! clear message naming the field and a non-zero exit, never a panic.
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

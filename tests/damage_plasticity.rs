@@ -2,6 +2,7 @@
 //! forms, unloading, corner returns with KKT, consistent tangent against finite
 //! differences, properties over random paths, and global runs (localisation past
 //! peak, ledger closure to the iteration tolerance, step cuts, failure reports).
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;

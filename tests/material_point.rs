@@ -1,6 +1,7 @@
 //! Material-point verification of the viscoelastic models against closed forms, with
 //! observed orders in the step size, energy per cycle against the analytic loss, the
 //! exact point energy identity, and properties over random parameters and paths.
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;

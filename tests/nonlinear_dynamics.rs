@@ -2,6 +2,7 @@
 //! localises, dissipation bounded by the work of internal forces), ledgers closing to
 //! the iteration tolerance for both ways of paying for the iterations, step cuts that
 //! recover, and a failure that names the step and the node and keeps its output.
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 use rothe::linsolve::Backend;
 use rothe::run::{run, RunOptions};

@@ -1,5 +1,6 @@
 //! Verification against analytic and manufactured solutions and conservation laws.
 //! Each test opens with its reference, what it checks, mesh, loading and parameters.
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! Global checks of the viscoelastic models: free-vibration decay against the damping
 //! ratio the material implies, ledger closure, monotone dissipation, one
 //! factorisation per run.
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 use rothe::linsolve::Backend;
 use rothe::time::backward_euler::BackwardEuler;

@@ -86,6 +86,8 @@ impl Assembler {
             let nn = block.elements.kind.nodes();
             for colour in &self.colours[bi] {
                 colour.par_chunks(256).for_each(|chunk| {
+                    // Capture the whole wrapper (Send + Sync), not its raw-pointer field.
+                    #[allow(clippy::redundant_locals)]
                     let shared = shared;
                     let mut ke = [0.0; 64];
                     let mut x = [[0.0; 2]; 4];

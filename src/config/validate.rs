@@ -85,9 +85,7 @@ fn hardening(
             post_yield_modulus,
         } => {
             positive(&format!("{field}.strength"), strength)?;
-            if !(post_yield_modulus > -e && post_yield_modulus < e)
-                || !post_yield_modulus.is_finite()
-            {
+            if !post_yield_modulus.is_finite() || post_yield_modulus.abs() >= e {
                 return Err(Error::config(
                     format!("{field}.post_yield_modulus"),
                     format!("must lie in (-E, E), got {post_yield_modulus}"),
@@ -105,7 +103,7 @@ fn hardening(
         } => {
             positive(&format!("{field}.f_cm"), f_cm)?;
             positive(&format!("{field}.eps_c1"), eps_c1)?;
-            if !(eps_cu1 > eps_c1) {
+            if eps_cu1.is_nan() || eps_cu1 <= eps_c1 {
                 return Err(Error::config(
                     format!("{field}.eps_cu1"),
                     format!("must exceed eps_c1 = {eps_c1}, got {eps_cu1}"),

@@ -78,6 +78,9 @@ fn vm_hessian(s: &[f64; 2]) -> [[f64; 2]; 2] {
     ]
 }
 
+/// Multipliers, principal stresses and the 2x2 algorithmic tangent of a projection.
+type Projection = (Vec<f64>, [f64; 2], Vec<Vec<f64>>);
+
 struct Ctx<'a> {
     p: &'a RankineHillParams,
     e: f64,
@@ -119,11 +122,7 @@ impl Ctx<'_> {
     }
 
     /// Closest-point projection for a fixed active set; `None` if Newton fails.
-    fn project(
-        &self,
-        s_tr: &[f64; 2],
-        active: &[Surface],
-    ) -> Option<(Vec<f64>, [f64; 2], Vec<Vec<f64>>)> {
+    fn project(&self, s_tr: &[f64; 2], active: &[Surface]) -> Option<Projection> {
         let m = active.len();
         let mut s = *s_tr;
         let mut dl = vec![0.0; m];
