@@ -76,5 +76,28 @@ fn sls(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, assembly, factorisation_and_step, sls);
+fn nonlinear(c: &mut Criterion) {
+    // Cost per step of the damage and plasticity variants (10 steps from the state
+    // after the first cracking, each bench iteration from a copy of that state).
+    let mut g = c.benchmark_group("w1_nonlinear");
+    g.sample_size(10);
+    let ny = 25;
+    for variant in ["elastic", "mazars", "mazars-fixed", "rankine-hill"] {
+        let model = rothe::workload::w1_variant(ny, variant).unwrap();
+        let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
+        let mut s0 = be.initial_state();
+        for _ in 0..10 {
+            be.step(&mut s0).unwrap();
+        }
+        g.bench_with_input(BenchmarkId::new(variant, ny), &ny, |b, _| {
+            b.iter(|| {
+                let mut s = s0.clone();
+                rothe::run::march_steps(&mut be, &mut s, 10).unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, assembly, factorisation_and_step, sls, nonlinear);
 criterion_main!(benches);

@@ -1,7 +1,8 @@
 //! Workload W1 at any size and backend, printing the figures the README reports:
-//! `cargo run --release --example w1 -- [NY] [faer|cholmod] [elastic|sls]` (defaults
-//! 100, faer, elastic). Add `--features cholmod` for the CHOLMOD backend; `sls` puts
-//! the standard linear solid in place of elasticity (Gauss-point history path).
+//! `cargo run --release --example w1 -- [NY] [faer|cholmod] [VARIANT]` (defaults 100,
+//! faer, elastic). Add `--features cholmod` for the CHOLMOD backend. VARIANT puts
+//! another material in place of elasticity: `sls`, `mazars` (secant refactorised every
+//! iteration), `mazars-fixed` (one factorisation per step), `rankine-hill` (Newton).
 
 use std::time::Instant;
 
@@ -35,27 +36,29 @@ fn main() -> rothe::Result<()> {
         .map(|s| s.parse().expect("backend is faer or cholmod"))
         .unwrap_or_default();
     let t0 = Instant::now();
-    let sls = args.get(2).map(|s| s == "sls").unwrap_or(false);
-    let model = if sls {
-        rothe::workload::w1_with(ny, rothe::workload::W1_SLS)?
-    } else {
-        rothe::workload::w1(ny)?
-    };
+    let variant = args.get(2).map(String::as_str).unwrap_or("elastic");
+    let model = rothe::workload::w1_variant(ny, variant)?;
     let setup_s = t0.elapsed().as_secs_f64();
     let mut be = BackwardEuler::new(&model, backend)?;
     let mut s = be.initial_state();
     let t_steps = Instant::now();
-    let n = model.analysis.n_steps();
-    let mut solves = 0;
-    for _ in 0..n {
-        solves += be.step(&mut s)?.iterations;
-    }
+    let (mut solves, mut n, mut cuts) = (0, 0, 0);
+    rothe::run::march(&mut be, &mut s, |_, m| {
+        match m {
+            rothe::run::Marched::Step(r) => {
+                solves += r.iterations;
+                n += 1;
+            }
+            rothe::run::Marched::Cut { .. } => cuts += 1,
+        }
+        Ok(())
+    })?;
     let steps_s = t_steps.elapsed().as_secs_f64();
     let tip = model.probes[0].node;
     let nnz_l = be.factor_nnz().unwrap_or(0);
     let n_el = model.mesh.n_elements();
     println!(
-        "W1 ny = {ny} ({} dofs, {} elements), backend {}",
+        "W1 ny = {ny} ({} dofs, {} elements), backend {}, variant {variant}",
         model.mesh.n_dofs(),
         n_el,
         be.backend()
@@ -67,9 +70,10 @@ fn main() -> rothe::Result<()> {
         n_el as f64 / be.timing.assembly_s
     );
     println!(
-        "  factorisation        {:.3} s  (nnz(L) = {:.2}M)",
+        "  factorisation        {:.3} s  (nnz(L) = {:.2}M, {} factorisations, {cuts} step cuts)",
         be.timing.factorization_s,
-        nnz_l as f64 / 1e6
+        nnz_l as f64 / 1e6,
+        be.factorizations
     );
     println!(
         "  mean step            {:.2} ms (solve {:.2} ms, rest {:.2} ms)",

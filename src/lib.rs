@@ -29,6 +29,7 @@ pub mod error;
 pub mod fe;
 pub mod linsolve;
 pub mod material;
+pub mod memory;
 pub mod mesh;
 pub mod model;
 pub mod output;

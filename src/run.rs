@@ -264,8 +264,12 @@ where
                 observe(s, Marched::Cut { h, reason: msg })?;
             }
             Err(e) => {
+                let why = match e {
+                    Error::Stepping(m) => m,
+                    other => other.to_string(),
+                };
                 return Err(Error::Stepping(format!(
-                    "step {} (t = {:.6e}) failed after {cuts_in_row} step cuts: {e}",
+                    "step {} (t = {:.6e}) failed after {cuts_in_row} step cuts: {why}",
                     s.step + 1,
                     s.t + be.h
                 )));
@@ -273,6 +277,16 @@ where
         }
     }
     Ok(())
+}
+
+/// Takes `n` accepted steps of the current `h` (no cuts): for benches and studies.
+/// Returns the number of linear solves.
+pub fn march_steps(be: &mut BackwardEuler, s: &mut DynState, n: usize) -> Result<usize> {
+    let mut solves = 0;
+    for _ in 0..n {
+        solves += be.step(s)?.iterations;
+    }
+    Ok(solves)
 }
 
 fn run_static(

@@ -7,9 +7,39 @@ use crate::error::Result;
 use crate::model::Model;
 
 /// The W1 material block with the standard linear solid of eq. (10) in place of
-/// elasticity (`α = 0.5`, `β = 1e-4 s`), for the cost comparison of issue-level
-/// benchmarks.
+/// elasticity (`α = 0.5`, `β = 1e-4 s`), for cost comparisons.
 pub const W1_SLS: &str = "model = \"sls\"\nalpha = 0.5\nbeta = 1.0e-4";
+
+/// The W1 material block with Mazars damage (NOTES.md parameters for concrete): the
+/// 1 MPa step cracks the clamped end, so the iterations have work to do.
+pub const W1_MAZARS: &str =
+    "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
+
+/// The W1 material block with Rankine-Hill plasticity (bilinear C30/37 diagram).
+pub const W1_RANKINE_HILL: &str = "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.5e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.5e9 }";
+
+/// A W1 variant by name: `elastic`, `sls`, `mazars` (secant refactorised every
+/// iteration), `mazars-fixed` (one factorisation per step), `rankine-hill` (Newton).
+pub fn w1_variant(ny: usize, name: &str) -> Result<Model> {
+    let (lines, iteration) = match name {
+        "elastic" => ("model = \"elastic\"", "newton"),
+        "sls" => (W1_SLS, "newton"),
+        "mazars" => (W1_MAZARS, "newton"),
+        "mazars-fixed" => (W1_MAZARS, "fixed"),
+        "rankine-hill" => (W1_RANKINE_HILL, "newton"),
+        other => return Err(crate::error::Error::config(
+            "variant",
+            format!(
+                "unknown W1 variant `{other}` (elastic, sls, mazars, mazars-fixed, rankine-hill)"
+            ),
+        )),
+    };
+    let text = w1_scenario_with(ny, lines).replace(
+        "vtk_every = 0",
+        &format!("vtk_every = 0\niteration = \"{iteration}\""),
+    );
+    crate::config::from_str(&text, std::path::Path::new("."))
+}
 
 /// The W1 scenario text for `ny` cells across the height.
 pub fn w1_scenario(ny: usize) -> String {

@@ -80,7 +80,7 @@ impl Assembler {
     where
         F: Fn(usize, usize, &[[f64; 2]], &mut [f64]) + Sync,
     {
-        let mut values = vec![0.0; self.pattern.nnz()];
+        let mut values = crate::memory::zeroed(self.pattern.nnz());
         let shared = SharedValues(values.as_mut_ptr());
         for (bi, block) in mesh.blocks.iter().enumerate() {
             let nn = block.elements.kind.nodes();

@@ -110,6 +110,16 @@ fn hardening(
                 ));
             }
             let k = 1.05 * e * eps_c1 / f_cm;
+            // The curve must stay positive (η < k) and finite (η < 1/(2−k) if k < 2)
+            // up to ε_cu1.
+            let eta_u = eps_cu1 / eps_c1;
+            let eta_max = if k < 2.0 { k.min(1.0 / (2.0 - k)) } else { k };
+            if eta_u >= eta_max {
+                return Err(Error::config(
+                    format!("{field}.eps_cu1"),
+                    format!("the EC2 curve reaches zero strength before eps_cu1 (eps_cu1/eps_c1 = {eta_u:.3} must stay below {eta_max:.3})"),
+                ));
+            }
             if k <= 1.05 {
                 return Err(Error::config(
                     field,
@@ -137,6 +147,49 @@ fn hardening(
             }
         }
     })
+}
+
+/// Linear tension softening needs elements smaller than `2 G_f E / f_t²`, or the
+/// softening branch turns back on itself (snap-back) and the return has no solution.
+fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()> {
+    use crate::material::{Hardening, Model};
+    for (bi, b) in mesh.blocks.iter().enumerate() {
+        let mat = &materials[b.material];
+        let Model::RankineHill(p) = &mat.model else {
+            continue;
+        };
+        let Hardening::LinearSoftening {
+            strength,
+            fracture_energy,
+        } = p.tension
+        else {
+            continue;
+        };
+        let limit = 2.0 * fracture_energy * mat.e / (strength * strength);
+        for e in 0..b.elements.len() {
+            let x: Vec<[f64; 2]> = b
+                .elements
+                .element(e)
+                .iter()
+                .map(|&n| mesh.coords[n])
+                .collect();
+            let area = 0.5
+                * (0..x.len())
+                    .map(|a| {
+                        let c = (a + 1) % x.len();
+                        x[a][0] * x[c][1] - x[c][0] * x[a][1]
+                    })
+                    .sum::<f64>();
+            let h = area.abs().sqrt();
+            if h >= limit {
+                return Err(Error::config(
+                    format!("materials.{}.tension.fracture_energy", mat.name),
+                    format!("element {e} of block {bi} is {h:.3} m across, beyond the crack-band limit 2 G_f E / f_t² = {limit:.3} m: refine the mesh or raise G_f"),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Validates one material spec into a [`Material`]; `field` prefixes error paths.
@@ -464,6 +517,7 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
             .insert(format!("{}.{}", bar.body, bar.name), nodes);
     }
     mesh.check_elements()?;
+    check_crack_band(&mesh, &materials)?;
 
     // Supports and prescribed displacements; a dof named twice keeps the last.
     let mut by_dof: BTreeMap<usize, Constraint> = BTreeMap::new();

@@ -57,7 +57,7 @@ impl SymmetricSolver for FaerCholesky {
             backend: NAME,
             message: format!("out of memory allocating the {what}"),
         };
-        self.l_values = vec![0.0; sym.len_val()];
+        self.l_values = crate::memory::zeroed(sym.len_val());
         let freq = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
         let sreq = StackReq::any_of(&[sym.solve_in_place_scratch::<f64>(1, Par::Seq)]);
         self.factor_scratch = Some(MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?);

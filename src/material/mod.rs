@@ -32,9 +32,10 @@ pub struct Dissipation {
     pub damage: f64,
     /// Plastic dissipation.
     pub plastic: f64,
-    /// The time scheme's own algorithmic loss at the point, given by each model in
-    /// closed form (a sum of squares for the linear models); it equals
-    /// `σ_{n+1}:Δε − Δψ − (viscous + damage + plastic)` up to round-off.
+    /// The time scheme's own algorithmic loss at the point:
+    /// `σ_{n+1}:Δε − Δψ − (viscous + damage + plastic)`, in closed form for the
+    /// elastic, viscoelastic and damage models (a sum of squares for the linear ones)
+    /// and by that difference for plasticity.
     pub numerical: f64,
 }
 

@@ -8,8 +8,9 @@
 //! `VM: q(σ) − σ̄_c(κ_c)` with `q = √(σ1² − σ1σ2 + σ2²)`; `κ_t = Σ Δλ_R`, `κ_c = Σ Δλ_VM`.
 //! Closest-point projection by Newton on `(σ1, σ2, Δλ_active)` with an active-set
 //! loop (corners: R1+VM, R1+R2, R1+R2+VM); consistent tangent from the local
-//! Jacobian plus the spectral shear term. Plastic dissipation
-//! `ΔW_p = ½(σⁿ + σⁿ⁺¹):Δεᵖ`. See `theory/plasticity.md`.
+//! Jacobian plus the spectral shear term. Plastic dissipation: the paper's trapezoid
+//! `½(σⁿ + σⁿ⁺¹):Δεᵖ` evaluated per surface as `½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ`, each stress
+//! paired with its own flow direction. See `theory/plasticity.md`.
 
 use super::hardening::Hardening;
 use super::linalg::{inverse_small, solve_small};
@@ -331,9 +332,18 @@ pub fn update(
         return elastic(state);
     }
     let Some(ret) = ctx.ret(&[s1, s2]) else {
-        // No admissible return (should not happen): keep the trial state elastic and
-        // let the global residual reveal it.
-        return elastic(state);
+        // No admissible return (an exhausted strength, or a softening too steep for
+        // the element): poison the response so the equilibrium iteration fails, the
+        // step is cut, and a persisting failure stops the run with its location.
+        return PointResponse {
+            sigma: [f64::NAN; 3],
+            tangent: *c,
+            psi: f64::NAN,
+            dissipation: Dissipation {
+                numerical: f64::NAN,
+                ..Default::default()
+            },
+        };
     };
     // Plastic strain increment in the principal frame: D⁻¹(σ_tr − σ).
     let dsp = [s1 - ret.sigma[0], s2 - ret.sigma[1]];
@@ -381,8 +391,9 @@ pub fn update(
     let psi_n = 0.5 * dot3(&ee_n, &sigma_n);
     // The paper's trapezoid ½(σⁿ + σⁿ⁺¹):Δεᵖ with each stress paired with its own
     // flow direction: σ:∂f/∂σ is the surface strength on every surface, so per surface
-    // ½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ. Equal to the literal form for steps whose principal
-    // axes do not turn, non-negative always (theory/plasticity.md).
+    // ½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ. Equal to the literal form for steps that start on the
+    // surface with fixed principal axes (and a radial path for von Mises), never
+    // above it, and non-negative always (theory/plasticity.md).
     let (yt0, _) = p.tension.strength(kt_n, e, step.length);
     let (yt1, _) = p.tension.strength(state[3], e, step.length);
     let (yc0, _) = p.compression.strength(kc_n, e, step.length);

@@ -87,7 +87,7 @@ impl ReducedMatrix {
                 n: nf,
                 col_ptr,
                 row_idx,
-                values: vec![0.0; nnz],
+                values: crate::memory::zeroed(nnz),
             },
             src,
             diag_pos,

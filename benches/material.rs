@@ -1,0 +1,67 @@
+//! Criterion bench of single Gauss-point updates (updates per second) for every
+//! material model, along a fixed pseudo-random strain path of 1000 increments.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use rothe::config::MaterialSpec;
+use rothe::fe::Plane;
+use rothe::material::StrainStep;
+
+const MODELS: [(&str, &str); 6] = [
+    ("elastic", "model = \"elastic\""),
+    ("kelvin_voigt", "model = \"kelvin_voigt\"\nbeta = 1e6"),
+    ("sls", "model = \"sls\"\nalpha = 0.5\nbeta = 1e-3"),
+    ("mazars", "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3"),
+    ("mazars_classic", "model = \"mazars\"\nvariant = \"classic\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3"),
+    ("rankine_hill", "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }"),
+];
+
+fn updates(c: &mut Criterion) {
+    let mut g = c.benchmark_group("gauss_point_update");
+    let n = 1000;
+    // A cyclic biaxial path with shear reaching about 3x the cracking strain.
+    let path: Vec<[f64; 3]> = (0..n)
+        .map(|k| {
+            let t = k as f64 / n as f64 * 6.0 * std::f64::consts::PI;
+            [
+                3e-4 * t.sin(),
+                -1e-4 * (1.3 * t).cos(),
+                2e-4 * (0.7 * t).sin(),
+            ]
+        })
+        .collect();
+    g.throughput(Throughput::Elements(n as u64));
+    for (name, text) in MODELS {
+        let spec: MaterialSpec =
+            toml::from_str(&format!("{text}\nE = 33e9\nnu = 0.2\nrho = 2400.0")).unwrap();
+        let m = rothe::config::material(name, "material", &spec).unwrap();
+        let ns = m.n_state();
+        g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+            b.iter(|| {
+                let (mut st_n, mut st) = (vec![0.0; ns], vec![0.0; ns]);
+                let mut eps_n = [0.0; 3];
+                let mut acc = 0.0;
+                for eps in &path {
+                    let r = m.update(
+                        Plane::Stress,
+                        &StrainStep {
+                            eps_n,
+                            eps: *eps,
+                            dt: 1e-5,
+                            length: 0.1,
+                        },
+                        &st_n,
+                        &mut st,
+                    );
+                    acc += r.sigma[0];
+                    eps_n = *eps;
+                    std::mem::swap(&mut st_n, &mut st);
+                }
+                acc
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, updates);
+criterion_main!(benches);
