@@ -27,12 +27,14 @@ pub fn w1_variant(ny: usize, name: &str) -> Result<Model> {
         "mazars" => (W1_MAZARS, "newton"),
         "mazars-fixed" => (W1_MAZARS, "fixed"),
         "rankine-hill" => (W1_RANKINE_HILL, "newton"),
-        other => return Err(crate::error::Error::config(
-            "variant",
-            format!(
+        other => {
+            return Err(crate::error::Error::config(
+                "variant",
+                format!(
                 "unknown W1 variant `{other}` (elastic, sls, mazars, mazars-fixed, rankine-hill)"
             ),
-        )),
+            ))
+        }
     };
     let text = w1_scenario_with(ny, lines).replace(
         "vtk_every = 0",
