@@ -51,18 +51,35 @@ pub fn w1_scenario(ny: usize) -> String {
 /// The W1 scenario with another material model line block (`model = ...` plus its
 /// parameters; `E, nu, rho` stay W1's).
 pub fn w1_scenario_with(ny: usize, model_lines: &str) -> String {
+    cantilever_scenario(
+        [4 * ny, ny],
+        1e-5,
+        1e-3,
+        &format!("{model_lines}\nE = 30e9\nnu = 0.2\nrho = 2400.0"),
+        "mass = \"consistent\"\nvtk_every = 0",
+    )
+}
+
+/// The cantilever wall behind W1 and many tests: 2.0 m x 0.5 m x 0.2 m, `divisions`
+/// Q4 cells, left edge clamped, a step traction of 1 MPa down on the top edge, probe
+/// `tip` at (2.0, 0.25). `material_lines` is the body of `[materials.concrete]`
+/// (model, parameters, `E`, `nu`, `rho`); `analysis_extra` adds lines to `[analysis]`.
+/// Step sizes print as `1.0e-5`.
+pub fn cantilever_scenario(
+    divisions: [usize; 2],
+    dt: f64,
+    t_end: f64,
+    material_lines: &str,
+    analysis_extra: &str,
+) -> String {
     format!(
         r#"
 [analysis]
-t_end = 1.0e-3
-dt = 1.0e-5
-mass = "consistent"
-vtk_every = 0
+t_end = {t_end:.1e}
+dt = {dt:.1e}
+{analysis_extra}
 [materials.concrete]
-{model_lines}
-E = 30e9
-nu = 0.2
-rho = 2400.0
+{material_lines}
 [[bodies]]
 name = "beam"
 material = "concrete"
@@ -80,7 +97,8 @@ function = {{ kind = "step", at = 0.0 }}
 name = "tip"
 at = [2.0, 0.25]
 "#,
-        nx = 4 * ny
+        nx = divisions[0],
+        ny = divisions[1]
     )
 }
 

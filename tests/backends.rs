@@ -83,43 +83,12 @@ fn residual(a: &LowerCsc, x: &[f64], b: &[f64]) -> f64 {
 }
 
 fn cantilever_text(kind: &str, divisions: [usize; 2], t_end: f64) -> String {
-    format!(
-        r#"
-[analysis]
-kind = "{kind}"
-t_end = {t_end:e}
-dt = 1.0e-5
-plane = "stress"
-mass = "consistent"
-vtk_every = 0
-
-[materials.concrete]
-model = "elastic"
-E = 30e9
-nu = 0.2
-rho = 2400.0
-
-[[bodies]]
-name = "beam"
-material = "concrete"
-thickness = 0.2
-mesh = {{ kind = "rectangle", size = [2.0, 0.5], divisions = [{}, {}] }}
-
-[[supports]]
-set = "beam.left"
-fix = ["x", "y"]
-
-[[loads]]
-kind = "traction"
-set = "beam.top"
-value = [0.0, -1.0e6]
-function = {{ kind = "step", at = 0.0 }}
-
-[[probes]]
-name = "tip"
-at = [2.0, 0.25]
-"#,
-        divisions[0], divisions[1]
+    rothe::workload::cantilever_scenario(
+        divisions,
+        1e-5,
+        t_end,
+        "model = \"elastic\"\nE = 30e9\nnu = 0.2\nrho = 2400.0",
+        &format!("kind = \"{kind}\"\nplane = \"stress\"\nmass = \"consistent\"\nvtk_every = 0"),
     )
 }
 

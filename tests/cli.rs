@@ -5,32 +5,15 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const GOOD: &str = r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-5
-vtk_every = 5
-[materials.concrete]
-model = "elastic"
-E = 30e9
-nu = 0.2
-rho = 2400.0
-[[bodies]]
-name = "beam"
-material = "concrete"
-thickness = 0.2
-mesh = { kind = "rectangle", size = [2.0, 0.5], divisions = [8, 2] }
-[[supports]]
-set = "beam.left"
-fix = ["x", "y"]
-[[loads]]
-kind = "traction"
-set = "beam.top"
-value = [0.0, -1.0e6]
-[[probes]]
-name = "tip"
-at = [2.0, 0.25]
-"#;
+fn good() -> String {
+    rothe::workload::cantilever_scenario(
+        [8, 2],
+        1e-5,
+        1e-4,
+        "model = \"elastic\"\nE = 30e9\nnu = 0.2\nrho = 2400.0",
+        "vtk_every = 5",
+    )
+}
 
 fn rothe(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_rothe"))
@@ -53,7 +36,7 @@ fn scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
 #[test]
 fn run_writes_history_summary_and_vtk() {
     let dir = tempfile::tempdir().unwrap();
-    let sc = scenario(dir.path(), "s.toml", GOOD);
+    let sc = scenario(dir.path(), "s.toml", &good());
     let out = dir.path().join("out");
     let (ok, _, err) = rothe(&[
         "run",
@@ -111,7 +94,7 @@ fn run_writes_history_summary_and_vtk() {
 #[test]
 fn check_prints_size_and_cfl() {
     let dir = tempfile::tempdir().unwrap();
-    let sc = scenario(dir.path(), "s.toml", GOOD);
+    let sc = scenario(dir.path(), "s.toml", &good());
     let (ok, out, err) = rothe(&["check", sc.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(out.contains("dofs        54 (48 free)"), "{out}");
@@ -124,72 +107,75 @@ fn check_prints_size_and_cfl() {
 fn bad_input_gives_clear_errors() {
     let cases: Vec<(String, Vec<&str>)> = vec![
         (
-            GOOD.replace("vtk_every = 5", "vtk_every = 5\ncolour = 3"),
+            good().replace("vtk_every = 5", "vtk_every = 5\ncolour = 3"),
             vec!["unknown field `colour`"],
         ),
         (
-            GOOD.replace("E = 30e9", "E = -1.0"),
+            good().replace("E = 30e9", "E = -1.0"),
             vec!["materials.concrete.E", "positive"],
         ),
         (
-            GOOD.replace("nu = 0.2", "nu = 0.5"),
+            good().replace("nu = 0.2", "nu = 0.5"),
             vec!["materials.concrete.nu", "(-1, 0.5)"],
         ),
         (
-            GOOD.replace("rho = 2400.0", "rho = 0.0"),
+            good().replace("rho = 2400.0", "rho = 0.0"),
             vec!["materials.concrete.rho"],
         ),
-        (GOOD.replace("dt = 1.0e-5", "dt = 0.0"), vec!["analysis.dt"]),
         (
-            GOOD.replace("set = \"beam.left\"", "set = \"beam.west\""),
+            good().replace("dt = 1.0e-5", "dt = 0.0"),
+            vec!["analysis.dt"],
+        ),
+        (
+            good().replace("set = \"beam.left\"", "set = \"beam.west\""),
             vec!["supports[0].set", "unknown node set `beam.west`"],
         ),
         (
-            GOOD.replace("set = \"beam.top\"", "set = \"beam.roof\""),
+            good().replace("set = \"beam.top\"", "set = \"beam.roof\""),
             vec!["loads[0].set", "unknown edge set"],
         ),
         (
-            GOOD.replace("material = \"concrete\"", "material = \"steel\""),
+            good().replace("material = \"concrete\"", "material = \"steel\""),
             vec!["bodies[0].material", "unknown material `steel`"],
         ),
         (
-            GOOD.replace("thickness = 0.2", "thickness = -0.2"),
+            good().replace("thickness = 0.2", "thickness = -0.2"),
             vec!["bodies[0].thickness"],
         ),
         (
-            GOOD.replace(
+            good().replace(
                 "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
                 "mesh = { kind = \"gmsh\", file = \"missing.msh\" }",
             ),
             vec!["bodies[0].mesh.file", "does not exist"],
         ),
         (
-            GOOD.replace(
+            good().replace(
                 "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
                 "mesh = { kind = \"gmsh\", file = \"broken.msh\" }",
             ),
             vec!["bodies[0].mesh.file", "not a valid MSH"],
         ),
         (
-            GOOD.replace(
+            good().replace(
                 "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
                 "mesh = { kind = \"gmsh\", file = \"flat.msh\" }",
             ),
             vec!["inverted or degenerate"],
         ),
     ];
-    let rh_soft = GOOD.replace("model = \"elastic\"", "model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 10.0 }\ncompression = { law = \"bilinear\", strength = 30e6, post_yield_modulus = 1e9 }");
-    let rh_ec2 = GOOD.replace("model = \"elastic\"", "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1e9 }\ncompression = { law = \"ec2\", f_cm = 38e6, eps_c1 = 0.0022, eps_cu1 = 0.02 }");
-    let rh_strain = GOOD
+    let rh_soft = good().replace("model = \"elastic\"", "model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 10.0 }\ncompression = { law = \"bilinear\", strength = 30e6, post_yield_modulus = 1e9 }");
+    let rh_ec2 = good().replace("model = \"elastic\"", "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1e9 }\ncompression = { law = \"ec2\", f_cm = 38e6, eps_c1 = 0.0022, eps_cu1 = 0.02 }");
+    let rh_strain = good()
         .replace("model = \"elastic\"", "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1e9 }\ncompression = { law = \"ec2\", f_cm = 38e6, eps_c1 = 0.0022, eps_cu1 = 0.0035 }")
         .replace("vtk_every = 5", "vtk_every = 5\nplane = \"strain\"");
     let more: Vec<(String, Vec<&str>)> = vec![
         (rh_soft, vec!["tension.fracture_energy", "crack-band limit"]),
         (rh_ec2, vec!["compression.eps_cu1", "zero strength"]),
         (rh_strain, vec!["plane stress"]),
-        (GOOD.replace("model = \"elastic\"", "model = \"sls\"\nbeta = 1e-3"), vec!["missing field `alpha`"]),
+        (good().replace("model = \"elastic\"", "model = \"sls\"\nbeta = 1e-3"), vec!["missing field `alpha`"]),
         (
-            GOOD.replace("model = \"elastic\"", "model = \"mazars\"\neps_t0 = 1e-4\nA_t = 1.0\nB_t = 1e4\nA_c = 1.2\nB_c = 1.5e3\nd_max = 1.0"),
+            good().replace("model = \"elastic\"", "model = \"mazars\"\neps_t0 = 1e-4\nA_t = 1.0\nB_t = 1e4\nA_c = 1.2\nB_c = 1.5e3\nd_max = 1.0"),
             vec!["d_max"],
         ),
     ];

@@ -12,34 +12,12 @@ const MAZARS: &str =
 const RH: &str = "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }";
 
 fn cantilever(material: &str, extra: &str) -> String {
-    format!(
-        r#"
-[analysis]
-t_end = 1.0e-3
-dt = 1.0e-5
-vtk_every = 0
-{extra}
-[materials.concrete]
-{material}
-E = 33e9
-nu = 0.2
-rho = 2400.0
-[[bodies]]
-name = "beam"
-material = "concrete"
-thickness = 0.2
-mesh = {{ kind = "rectangle", size = [2.0, 0.5], divisions = [16, 4] }}
-[[supports]]
-set = "beam.left"
-fix = ["x", "y"]
-[[loads]]
-kind = "traction"
-set = "beam.top"
-value = [0.0, -1.0e6]
-[[probes]]
-name = "tip"
-at = [2.0, 0.25]
-"#
+    rothe::workload::cantilever_scenario(
+        [16, 4],
+        1e-5,
+        1e-3,
+        &format!("{material}\nE = 33e9\nnu = 0.2\nrho = 2400.0"),
+        &format!("vtk_every = 0\n{extra}"),
     )
 }
 

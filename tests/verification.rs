@@ -414,30 +414,15 @@ fn run_ledger(text: &str) -> rothe::energy::Ledger {
     s.ledger
 }
 
-const CANTILEVER: &str = r#"
-[analysis]
-t_end = 2.0e-3
-dt = 2.0e-5
-vtk_every = 0
-[materials.concrete]
-model = "elastic"
-E = 30e9
-nu = 0.2
-rho = 2400.0
-[[bodies]]
-name = "beam"
-material = "concrete"
-thickness = 0.2
-mesh = { kind = "rectangle", size = [2.0, 0.5], divisions = [16, 4] }
-[[supports]]
-set = "beam.left"
-fix = ["x", "y"]
-[[loads]]
-kind = "traction"
-set = "beam.top"
-value = [0.0, -1.0e6]
-function = { kind = "step", at = 0.0 }
-"#;
+fn cantilever() -> String {
+    rothe::workload::cantilever_scenario(
+        [16, 4],
+        2e-5,
+        2e-3,
+        "model = \"elastic\"\nE = 30e9\nnu = 0.2\nrho = 2400.0",
+        "vtk_every = 0",
+    )
+}
 
 #[test]
 fn ledger_closes_undamped() {
@@ -445,7 +430,7 @@ fn ledger_closes_undamped() {
     // Cantilever 2 x 0.5 x 0.2, 16x4 Q4, E = 30e9, ν = 0.2, ρ = 2400, step traction
     // 1 MPa on the top edge, h = 2e-5, 100 steps. No damping: all loss is numerical,
     // and for a linear step it is a sum of squares, hence positive.
-    let l = run_ledger(CANTILEVER);
+    let l = run_ledger(&cantilever());
     assert_eq!(l.dissipated.mass, 0.0);
     assert!(l.dissipated.numerical > 0.0);
     assert!(
@@ -455,7 +440,7 @@ fn ledger_closes_undamped() {
         l.elastic
     );
     // Free vibration from an initial velocity: total energy only decreases.
-    let free = CANTILEVER
+    let free = cantilever()
         .replace("value = [0.0, -1.0e6]", "value = [0.0, 0.0]")
         .replace(
             "thickness = 0.2\n",
@@ -470,13 +455,13 @@ fn ledger_closes_undamped() {
 fn ledger_closes_with_mass_and_rayleigh_damping() {
     // Same cantilever with zeta = 50 1/s and Rayleigh a_m = 10 1/s, a_k = 1e-5 s: the
     // mass-damping line takes the physical loss, and the balance still closes.
-    let text = CANTILEVER.replace(
+    let text = cantilever().replace(
         "vtk_every = 0",
         "vtk_every = 0\nzeta = 50.0\nrayleigh = [10.0, 1.0e-5]",
     );
     let l = run_ledger(&text);
     assert!(l.dissipated.mass > 0.0);
-    let undamped = run_ledger(CANTILEVER);
+    let undamped = run_ledger(&cantilever());
     assert!(l.kinetic + l.elastic < undamped.kinetic + undamped.elastic);
 }
 
@@ -485,7 +470,7 @@ fn ledger_closes_with_prescribed_motion_and_bars() {
     // Prescribed displacement history (a ramp on the right edge) does work through the
     // support reactions, which enter W_ext; plus gravity, an initial velocity, lumped
     // mass and a steel bar along the bottom sharing the concrete's nodes.
-    let text = CANTILEVER
+    let text = cantilever()
         .replace(
             "vtk_every = 0",
             "vtk_every = 0\nmass = \"lumped\"\ngravity = [0.0, -9.81]",
