@@ -96,6 +96,8 @@ struct Ctx<'a> {
     /// Evaluate the state at rest at `u` (the initial state): `ε_n = ε`, no
     /// history evolution, no dissipation.
     at_rest: bool,
+    /// The material's elasticity matrix in this plane idealisation.
+    c: [[f64; 3]; 3],
 }
 
 /// Evaluates element `e` at displacements `u`: calls `point(g, w, &resp, &kin, x,
@@ -196,19 +198,21 @@ fn element_points<F>(
                 let np = n3 / 3;
                 unsafe { t.slice(3 * g, 3) }.copy_from_slice(&eps);
                 let hist = unsafe { t.slice(2 * n3 + np + g * ns, ns) };
-                let r = cx.mat.update(cx.plane, &step, committed, hist);
+                let r = cx.mat.update_with(&cx.c, cx.plane, &step, committed, hist);
                 unsafe { t.slice(n3 + 3 * g, 3) }.copy_from_slice(&r.sigma);
                 let d = &r.dissipation;
                 let slot = unsafe { t.slice(2 * n3 + g, 1) };
                 slot[0] = store.dissipated[g] + d.viscous + d.damage + d.plastic;
                 if cx.predict {
-                    pred = cx.mat.predicted_stress(cx.plane, &eps, hist, cx.dt);
+                    pred = cx
+                        .mat
+                        .predicted_stress_with(&cx.c, cx.plane, &eps, hist, cx.dt);
                 }
                 r
             }
             None => cx
                 .mat
-                .update(cx.plane, &step, committed, &mut scratch[..ns]),
+                .update_with(&cx.c, cx.plane, &step, committed, &mut scratch[..ns]),
         };
         point(
             g,
@@ -296,6 +300,7 @@ impl Assembler {
                 dt,
                 predict,
                 at_rest,
+                c: materials[block.material].c(plane),
             };
             let store_ref: &StateStore = store;
             for colour in &self.colours[bi] {
@@ -373,6 +378,7 @@ impl Assembler {
                 dt,
                 predict: false,
                 at_rest: false,
+                c: materials[block.material].c(plane),
             };
             let nodes = block.elements.element(e);
             let nd = 2 * nodes.len();

@@ -194,7 +194,19 @@ impl Material {
         state: &[f64],
         dt: f64,
     ) -> [f64; 3] {
-        let c = self.c(plane);
+        self.predicted_stress_with(&self.c(plane), plane, eps, state, dt)
+    }
+
+    /// [`Material::predicted_stress`] with the elasticity matrix `c = self.c(plane)`
+    /// computed by the caller (once per element block in the Gauss-point loop).
+    pub fn predicted_stress_with(
+        &self,
+        c: &[[f64; 3]; 3],
+        plane: Plane,
+        eps: &[f64; 3],
+        state: &[f64],
+        dt: f64,
+    ) -> [f64; 3] {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) | Model::Mazars(_) | Model::RankineHill(_) => {
                 let mut st = vec![0.0; self.n_state()];
@@ -219,7 +231,7 @@ impl Material {
                 let k = dt * alpha / beta;
                 let p = if parallel { 1.0 } else { 0.0 };
                 let ee = [eps[0] - state[0], eps[1] - state[1], eps[2] - state[2]];
-                let (ce, cee) = (mul3(&c, eps), mul3(&c, &ee));
+                let (ce, cee) = (mul3(c, eps), mul3(c, &ee));
                 let a = alpha / (1.0 + k);
                 [
                     p * ce[0] + a * cee[0],
@@ -238,7 +250,20 @@ impl Material {
         state_n: &[f64],
         state: &mut [f64],
     ) -> PointResponse {
-        let c = self.c(plane);
+        self.update_with(&self.c(plane), plane, step, state_n, state)
+    }
+
+    /// [`Material::update`] with the elasticity matrix `c = self.c(plane)` computed by
+    /// the caller (once per element block in the Gauss-point loop).
+    pub fn update_with(
+        &self,
+        c: &[[f64; 3]; 3],
+        plane: Plane,
+        step: &StrainStep,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse {
+        let c = *c;
         match self.model {
             Model::Elastic => elastic::update(&c, step),
             Model::KelvinVoigt(Viscosity::Proportional(alpha)) => {

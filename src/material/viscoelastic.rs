@@ -64,10 +64,11 @@ pub fn standard_linear_solid(
 ) -> PointResponse {
     let h = step.dt;
     let k = h * alpha / beta;
+    let inv = 1.0 / (1.0 + k);
     let ed_n = [eps_d_n[0], eps_d_n[1], eps_d_n[2]];
     let mut ed = [0.0; 3];
     for i in 0..3 {
-        ed[i] = (ed_n[i] + k * step.eps[i]) / (1.0 + k);
+        ed[i] = (ed_n[i] + k * step.eps[i]) * inv;
         eps_d[i] = ed[i];
     }
     let ee = sub(&step.eps, &ed); // branch elastic strain
