@@ -150,8 +150,8 @@ fn element_points<F>(
         };
         if let Some(t) = trial {
             // SAFETY: point g belongs to element e only.
-            unsafe { t.slice(3 * g, 3) }.copy_from_slice(&[eps, 0.0, 0.0]);
-            unsafe { t.slice(store.eps.len() + 3 * g, 3) }.copy_from_slice(&resp.sigma);
+            write3(unsafe { t.slice(3 * g, 3) }, &[eps, 0.0, 0.0]);
+            write3(unsafe { t.slice(store.eps.len() + 3 * g, 3) }, &resp.sigma);
             let slot = unsafe { t.slice(2 * store.eps.len() + g, 1) };
             slot[0] = store.dissipated[g];
         }
@@ -196,10 +196,10 @@ fn element_points<F>(
                 // `internal_force`).
                 let n3 = store.eps.len();
                 let np = n3 / 3;
-                unsafe { t.slice(3 * g, 3) }.copy_from_slice(&eps);
+                write3(unsafe { t.slice(3 * g, 3) }, &eps);
                 let hist = unsafe { t.slice(2 * n3 + np + g * ns, ns) };
                 let r = cx.mat.update_with(&cx.c, cx.plane, &step, committed, hist);
-                unsafe { t.slice(n3 + 3 * g, 3) }.copy_from_slice(&r.sigma);
+                write3(unsafe { t.slice(n3 + 3 * g, 3) }, &r.sigma);
                 let d = &r.dissipation;
                 let slot = unsafe { t.slice(2 * n3 + g, 1) };
                 slot[0] = store.dissipated[g] + d.viscous + d.damage + d.plastic;
@@ -223,6 +223,14 @@ fn element_points<F>(
             pred,
         );
     }
+}
+
+/// Writes a Voigt triple (element by element: no call to `memcpy` on the hot path).
+#[inline(always)]
+fn write3(out: &mut [f64], v: &[f64; 3]) {
+    out[0] = v[0];
+    out[1] = v[1];
+    out[2] = v[2];
 }
 
 /// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`.

@@ -66,33 +66,48 @@ pub fn standard_linear_solid(
     let k = h * alpha / beta;
     let inv = 1.0 / (1.0 + k);
     let ed_n = [eps_d_n[0], eps_d_n[1], eps_d_n[2]];
-    let mut ed = [0.0; 3];
-    for i in 0..3 {
-        ed[i] = (ed_n[i] + k * step.eps[i]) * inv;
-        eps_d[i] = ed[i];
-    }
-    let ee = sub(&step.eps, &ed); // branch elastic strain
-    let ee_n = sub(&step.eps_n, &ed_n);
-    let ce = mul3(c, &step.eps);
-    let c_ee = mul3(c, &ee);
-    let tau = [alpha * c_ee[0], alpha * c_ee[1], alpha * c_ee[2]];
-    let sigma = [
-        parallel * ce[0] + tau[0],
-        parallel * ce[1] + tau[1],
-        parallel * ce[2] + tau[2],
+    let ed = [
+        (ed_n[0] + k * step.eps[0]) * inv,
+        (ed_n[1] + k * step.eps[1]) * inv,
+        (ed_n[2] + k * step.eps[2]) * inv,
     ];
+    eps_d[..3].copy_from_slice(&ed);
+    // Four products with C; every other one follows by linearity.
+    let ce = mul_iso(c, &step.eps);
+    let ce_n = mul_iso(c, &step.eps_n);
+    let ced = mul_iso(c, &ed);
+    let ced_n = mul_iso(c, &ed_n);
+    let ee = sub(&step.eps, &ed); // branch elastic strain
+    let c_ee = sub(&ce, &ced);
     let de = sub(&step.eps, &step.eps_n);
-    let dee = sub(&ee, &ee_n);
+    let c_de = sub(&ce, &ce_n);
     let ded = sub(&ed, &ed_n);
+    let c_ded = sub(&ced, &ced_n);
+    let dee = sub(&de, &ded);
+    let c_dee = sub(&c_de, &c_ded);
+    let sigma = [
+        parallel * ce[0] + alpha * c_ee[0],
+        parallel * ce[1] + alpha * c_ee[1],
+        parallel * ce[2] + alpha * c_ee[2],
+    ];
     PointResponse {
         sigma,
-        tangent: add_scaled(c, parallel, c, alpha / (1.0 + k)),
+        tangent: add_scaled(c, parallel, c, alpha * inv),
         psi: 0.5 * parallel * dot3(&step.eps, &ce) + 0.5 * alpha * dot3(&ee, &c_ee),
         dissipation: Dissipation {
-            viscous: beta * dot3(&ded, &mul3(c, &ded)) / h,
-            numerical: 0.5 * parallel * dot3(&de, &mul3(c, &de))
-                + 0.5 * alpha * dot3(&dee, &mul3(c, &dee)),
+            viscous: beta * dot3(&ded, &c_ded) / h,
+            numerical: 0.5 * parallel * dot3(&de, &c_de) + 0.5 * alpha * dot3(&dee, &c_dee),
             ..Default::default()
         },
     }
+}
+
+/// `C x` for an isotropic plane elasticity matrix (no normal-shear coupling).
+#[inline]
+fn mul_iso(c: &[[f64; 3]; 3], x: &[f64; 3]) -> [f64; 3] {
+    [
+        c[0][0] * x[0] + c[0][1] * x[1],
+        c[1][0] * x[0] + c[1][1] * x[1],
+        c[2][2] * x[2],
+    ]
 }

@@ -13,6 +13,8 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use super::system::{DofMap, ReducedMatrix};
 use super::{external_force, gravity_force, Timing};
 use crate::assembly::internal::{new_stores, PointTotals};
@@ -458,10 +460,14 @@ impl<'m> BackwardEuler<'m> {
                 None
             };
             let totals = self.internal(&u1, false, &mut s.points, &mut fint1, pred);
-            for i in 0..n {
-                self.du[i] = u1[i] - s.u[i];
-                self.v1[i] = self.du[i] / h;
-            }
+            self.du
+                .par_iter_mut()
+                .zip(self.v1.par_iter_mut())
+                .zip(u1.par_iter().zip(s.u.par_iter()))
+                .for_each(|((du, v), (a, b))| {
+                    *du = a - b;
+                    *v = *du / h;
+                });
             self.mass.matvec(&self.asm.pattern, &self.v1, &mut self.mv1);
             if self.damp_k != 0.0 {
                 self.asm.pattern.matvec(&self.k, &self.v1, &mut kv);
@@ -482,16 +488,18 @@ impl<'m> BackwardEuler<'m> {
                 r2.sqrt()
             };
             history.push(nl);
-            let du_norm = self
-                .dofs
-                .free
-                .iter()
-                .map(|&d| self.du[d] * self.du[d])
-                .sum::<f64>()
-                .sqrt();
-            let small_correction = constant
-                || iterations == 0
-                || last_correction <= self.displacement_tolerance * du_norm.max(f64::MIN_POSITIVE);
+            // The displacement test matters only while a state-dependent tangent
+            // iterates; it is skipped (and its pass over the dofs with it) otherwise.
+            let small_correction = constant || iterations == 0 || {
+                let du_norm = self
+                    .dofs
+                    .free
+                    .iter()
+                    .map(|&d| self.du[d] * self.du[d])
+                    .sum::<f64>()
+                    .sqrt();
+                last_correction <= self.displacement_tolerance * du_norm.max(f64::MIN_POSITIVE)
+            };
             if (nl <= self.tolerance && small_correction) || r2 == 0.0 {
                 break (totals, nl);
             }
@@ -538,28 +546,47 @@ impl<'m> BackwardEuler<'m> {
             iterations += 1;
         };
 
-        let mut inc = StepIncrements {
+        // The step's ledger terms, in parallel over the dofs (sums of products of
+        // the vectors the iterations left behind).
+        let (damp_m, damp_k, eq) = (self.damp_m, self.damp_k, &self.dofs.eq);
+        let (mv1, v1, du, f1) = (&self.mv1, &self.v1, &self.du, &self.f1);
+        let (mv0, v0, fint0) = (&s.mv, &s.v, &s.fint);
+        let sums = s
+            .fext
+            .par_iter_mut()
+            .enumerate()
+            .fold(
+                || [0.0f64; 6],
+                |mut acc, (i, fext0)| {
+                    let cv1 = damp_m * mv1[i] + damp_k * kv[i];
+                    let fext1 = if eq[i] == usize::MAX {
+                        (mv1[i] - mv0[i]) / h + cv1 + fint1[i]
+                    } else {
+                        f1[i]
+                    };
+                    let d = du[i];
+                    acc[0] += 0.5 * v1[i] * mv1[i];
+                    acc[1] += 0.5 * d * (fint0[i] + fint1[i]);
+                    acc[2] += 0.5 * d * (*fext0 + fext1);
+                    acc[3] += 0.5 * d * (fext1 - *fext0);
+                    acc[4] += d * cv1;
+                    acc[5] += 0.5 * (v1[i] - v0[i]) * (mv1[i] - mv0[i]);
+                    *fext0 = fext1;
+                    acc
+                },
+            )
+            .reduce(|| [0.0; 6], |a, b| std::array::from_fn(|k| a[k] + b[k]));
+        let inc = StepIncrements {
             elastic: totals.psi,
             material: totals.dissipation,
-            ..Default::default()
+            kinetic: sums[0],
+            internal_work: sums[1],
+            external_work: sums[2],
+            load_jump: sums[3],
+            mass_damping: sums[4],
+            kinetic_loss: sums[5],
+            contact: 0.0,
         };
-        for i in 0..n {
-            let cv1 = self.damp_m * self.mv1[i] + self.damp_k * kv[i];
-            let fext1 = if self.dofs.eq[i] == usize::MAX {
-                let inertia = (self.mv1[i] - s.mv[i]) / h;
-                inertia + cv1 + fint1[i]
-            } else {
-                self.f1[i]
-            };
-            let du = self.du[i];
-            inc.kinetic += 0.5 * self.v1[i] * self.mv1[i];
-            inc.internal_work += 0.5 * du * (s.fint[i] + fint1[i]);
-            inc.external_work += 0.5 * du * (s.fext[i] + fext1);
-            inc.load_jump += 0.5 * du * (fext1 - s.fext[i]);
-            inc.mass_damping += du * cv1;
-            inc.kinetic_loss += 0.5 * (self.v1[i] - s.v[i]) * (self.mv1[i] - s.mv[i]);
-            s.fext[i] = fext1;
-        }
         self.u1 = std::mem::replace(&mut s.u, u1);
         self.fint1 = std::mem::replace(&mut s.fint, fint1);
         self.fpred1 = std::mem::replace(&mut s.fpred, fpred1);
