@@ -182,6 +182,11 @@ fn step_cuts_recover_and_failures_keep_their_output() {
     }
     let hist = std::fs::read_to_string(out.join("history.csv")).unwrap();
     assert!(hist.lines().count() >= 2);
+    assert!(hist
+        .lines()
+        .next()
+        .unwrap()
+        .contains("iterations,nl_residual"));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["status"], "failed");
@@ -189,4 +194,44 @@ fn step_cuts_recover_and_failures_keep_their_output() {
         .as_str()
         .unwrap()
         .contains("no convergence"));
+}
+
+#[test]
+fn vtk_carries_damage_plastic_strain_and_dissipation_density() {
+    let dir = tempfile::tempdir().unwrap();
+    for (material, field) in [(MAZARS, "damage"), (RH, "equivalent_plastic_strain")] {
+        let out = dir.path().join(field);
+        let text = cantilever(material, "").replace("vtk_every = 0", "vtk_every = 50");
+        run_text(&text, &out).unwrap();
+        // Read the file back as a VTK reader would and look at the cell arrays.
+        let vtk = vtkio::Vtk::import(out.join("vtk/step_0000100.vtu")).unwrap();
+        let vtkio::model::DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+            panic!("not a grid")
+        };
+        let vtkio::model::Piece::Inline(piece) = &pieces[0] else {
+            panic!("piece not inline")
+        };
+        let array = |name: &str| -> Vec<f64> {
+            piece
+                .data
+                .cell
+                .iter()
+                .find_map(|a| match a {
+                    vtkio::model::Attribute::DataArray(d) if d.name == name => {
+                        d.data.clone().cast_into::<f64>()
+                    }
+                    _ => None,
+                })
+                .unwrap_or_else(|| panic!("{field}: no {name} array"))
+        };
+        let values = array(field);
+        assert_eq!(values.len(), 64, "one value per element");
+        assert!(
+            values.iter().cloned().fold(0.0, f64::max) > 0.0,
+            "{field} is zero everywhere"
+        );
+        let density = array("dissipation_density");
+        assert!(density.iter().all(|&w| w >= 0.0) && density.iter().any(|&w| w > 0.0));
+        assert_eq!(array("stress").len(), 3 * 64);
+    }
 }
