@@ -102,6 +102,10 @@ pub struct AnalysisSpec {
     /// Step cuts (each halving `h`) allowed before the run stops. Default 8.
     #[serde(default = "default_max_cuts")]
     pub max_cuts: usize,
+    /// Ordering of the faer backend: `auto` (default: nested dissection from 400k
+    /// free dofs), `amd` or `nested_dissection`.
+    #[serde(default)]
+    pub ordering: crate::model::Ordering,
 }
 
 fn default_displacement_tolerance() -> f64 {

@@ -683,6 +683,7 @@ pub fn build(s: &Scenario, dir: &Path) -> Result<Model> {
             displacement_tolerance: a.displacement_tolerance,
             iteration: a.iteration,
             max_cuts: a.max_cuts,
+            ordering: a.ordering,
         },
     })
 }

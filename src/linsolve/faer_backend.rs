@@ -5,8 +5,9 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
@@ -24,6 +25,7 @@ pub struct FaerCholesky {
     factor_scratch: Option<MemBuffer>,
     solve_scratch: Option<MemBuffer>,
     factorized: bool,
+    ordering: Option<(Vec<usize>, Vec<usize>)>,
 }
 
 impl FaerCholesky {
@@ -43,10 +45,16 @@ impl SymmetricSolver for FaerCholesky {
     }
 
     fn analyze(&mut self, a: &LowerCsc) -> Result<()> {
+        let ordering = match &self.ordering {
+            Some((fwd, inv)) if fwd.len() == a.n => {
+                SymmetricOrdering::Custom(PermRef::new_checked(fwd, inv, a.n))
+            }
+            _ => SymmetricOrdering::Amd,
+        };
         let sym = factorize_symbolic_cholesky(
             Self::pattern(a),
             Side::Lower,
-            Default::default(),
+            ordering,
             Default::default(),
         )
         .map_err(|e| Error::Solver {
@@ -106,6 +114,14 @@ impl SymmetricSolver for FaerCholesky {
             stack,
         );
         Ok(())
+    }
+
+    fn set_ordering(&mut self, order: Vec<usize>) {
+        let mut inv = vec![0usize; order.len()];
+        for (k, &v) in order.iter().enumerate() {
+            inv[v] = k;
+        }
+        self.ordering = Some((order, inv));
     }
 
     fn factor_nnz(&self) -> Option<usize> {

@@ -8,6 +8,7 @@
 //! `cholmod` feature, [`cholmod_backend::CholmodCholesky`] (SuiteSparse).
 
 pub mod faer_backend;
+pub mod ordering;
 
 #[cfg(feature = "cholmod")]
 pub mod cholmod_backend;
@@ -106,6 +107,9 @@ pub trait SymmetricSolver: Send {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()>;
     /// Number of nonzeros of the factor `L`, once analysed.
     fn factor_nnz(&self) -> Option<usize>;
+    /// Proposes an elimination order (`order[k]` eliminated `k`-th) for the next
+    /// [`SymmetricSolver::analyze`]; backends that order by themselves ignore it.
+    fn set_ordering(&mut self, _order: Vec<usize>) {}
 }
 
 pub(crate) fn not_analysed(backend: &'static str) -> Error {

@@ -142,6 +142,9 @@ impl<'m> BackwardEuler<'m> {
 
         let t1 = Instant::now();
         let mut solver = backend.solver()?;
+        if a.ordering.nested_dissection(dofs.n_free()) {
+            solver.set_ordering(reduced.nested_dissection(&dofs, &model.mesh.coords));
+        }
         solver.analyze(&reduced.csc)?;
         solver.factorize(&reduced.csc)?;
         let factorization_s = t1.elapsed().as_secs_f64();

@@ -48,6 +48,9 @@ pub fn solve(model: &Model, backend: Backend, times: &[f64]) -> Result<Vec<Stati
     let assembly_s = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let mut solver = backend.solver()?;
+    if model.analysis.ordering.nested_dissection(dofs.n_free()) {
+        solver.set_ordering(reduced.nested_dissection(&dofs, &model.mesh.coords));
+    }
     solver.analyze(&reduced.csc)?;
     solver.factorize(&reduced.csc)?;
     let factorization_s = t1.elapsed().as_secs_f64();

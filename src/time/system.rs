@@ -94,6 +94,12 @@ impl ReducedMatrix {
         }
     }
 
+    /// Nested-dissection elimination order of the free dofs from the node coordinates.
+    pub fn nested_dissection(&self, dofs: &DofMap, coords: &[[f64; 2]]) -> Vec<usize> {
+        let xy: Vec<[f64; 2]> = dofs.free.iter().map(|&d| coords[d / 2]).collect();
+        crate::linsolve::ordering::nested_dissection(&xy, &self.csc.col_ptr, &self.csc.row_idx)
+    }
+
     /// Refills the values with `c_m M + Σ (c_i, A_i)` restricted to the free dofs.
     pub fn fill(&mut self, dofs: &DofMap, c_m: f64, mass: &Mass, terms: &[(f64, &[f64])]) {
         let v = &mut self.csc.values;

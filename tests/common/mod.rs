@@ -36,6 +36,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
             displacement_tolerance: 1e-6,
             iteration: rothe::model::IterationMethod::Newton,
             max_cuts: 8,
+            ordering: rothe::model::Ordering::Auto,
         },
     }
 }
