@@ -1,7 +1,9 @@
-//! faer's sparse Cholesky `L Lᵀ` with AMD ordering through the low-level API, so the
-//! symbolic analysis is done once, the factor values and the scratch memory are owned
-//! here and reused by every refactorisation and solve (no allocation per step).
-//! Runs sequentially: on two cores faer's parallel factorisation measured slower.
+//! faer's sparse Cholesky `L Lᵀ` through the low-level API, so the symbolic analysis
+//! is done once, and the factor values and the scratch memory are owned here and
+//! reused by every refactorisation and solve (no allocation per step). The ordering
+//! is faer's AMD unless an elimination order was proposed with `set_ordering` (the
+//! nested dissection of `super::ordering`). Runs sequentially: on two cores faer's
+//! parallel factorisation measured slower.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
