@@ -100,6 +100,30 @@ struct Ctx<'a> {
     c: [[f64; 3]; 3],
 }
 
+impl<'a> Ctx<'a> {
+    fn new(
+        mesh: &'a Mesh,
+        mat: &'a Material,
+        plane: Plane,
+        block: &crate::mesh::Block,
+        dt: f64,
+        predict: bool,
+        at_rest: bool,
+    ) -> Self {
+        Ctx {
+            mesh,
+            mat,
+            plane,
+            kind: block.elements.kind,
+            section: block.section,
+            dt,
+            predict,
+            at_rest,
+            c: mat.c(plane),
+        }
+    }
+}
+
 /// Evaluates element `e` at displacements `u`: calls `point(g, w, &resp, &kin, x,
 /// σ_pred)` for each of its points (global point index within the block `g`), where
 /// `σ_pred` (when `cx.predict`) is the stress of the next step of the same size at
@@ -299,17 +323,15 @@ impl Assembler {
             buf.append(&mut std::mem::take(&mut store.dissipated_trial));
             buf.append(&mut std::mem::take(&mut store.trial));
             let tp = Shared(buf.as_mut_ptr());
-            let cx = Ctx {
+            let cx = Ctx::new(
                 mesh,
-                mat: &materials[block.material],
+                &materials[block.material],
                 plane,
-                kind: block.elements.kind,
-                section: block.section,
+                block,
                 dt,
                 predict,
                 at_rest,
-                c: materials[block.material].c(plane),
-            };
+            );
             let store_ref: &StateStore = store;
             for colour in &self.colours[bi] {
                 let part = colour
@@ -377,17 +399,15 @@ impl Assembler {
     ) -> Vec<f64> {
         self.assemble(mesh, |bi, e, _x, ke| {
             let block = &mesh.blocks[bi];
-            let cx = Ctx {
+            let cx = Ctx::new(
                 mesh,
-                mat: &materials[block.material],
+                &materials[block.material],
                 plane,
-                kind: block.elements.kind,
-                section: block.section,
+                block,
                 dt,
-                predict: false,
-                at_rest: false,
-                c: materials[block.material].c(plane),
-            };
+                false,
+                false,
+            );
             let nodes = block.elements.element(e);
             let nd = 2 * nodes.len();
             ke[..nd * nd].fill(0.0);
