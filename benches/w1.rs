@@ -66,6 +66,7 @@ fn sls(c: &mut Criterion) {
                     &mut s.points,
                     &mut f,
                     Some(&mut fp),
+                    None,
                 )
             })
         });

@@ -257,6 +257,23 @@ fn write3(out: &mut [f64], v: &[f64; 3]) {
     out[2] = v[2];
 }
 
+/// Adds one point's `w Bᵀ D B` (continuum) or sets the bar stiffness `E A / L`
+/// (bars have one point) in the element matrix `ke`.
+#[inline]
+fn add_point_tangent(
+    k: Option<&crate::fe::PointKinematics>,
+    x: &[[f64; 2]],
+    nn: usize,
+    w: f64,
+    d: &[[f64; 3]; 3],
+    ke: &mut [f64],
+) {
+    match k {
+        Some(k) => element::add_btdb(k, nn, d, w, ke),
+        None => element::bar_stiffness(x, d[0][0] * w / element::bar_axis(x).1, ke),
+    }
+}
+
 /// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`.
 #[inline]
 fn add_bt_sigma(
@@ -291,7 +308,9 @@ impl Assembler {
     /// and the integrated stored energy and dissipation of the step `dt`. With
     /// `f_pred`, also the internal force of the next step at unchanged `u` (see
     /// `element_points`), in the same pass. With `at_rest`, the state at rest at `u`
-    /// is evaluated instead of a step (the initial state: history not evolved).
+    /// is evaluated instead of a step (the initial state: history not evolved). With
+    /// `tangent`, the consistent tangent of the same updates is assembled into it in
+    /// the same pass (what [`Assembler::tangent`] would give at `u`).
     #[allow(clippy::too_many_arguments)]
     pub fn internal_force(
         &self,
@@ -304,8 +323,13 @@ impl Assembler {
         stores: &mut [StateStore],
         f: &mut [f64],
         mut f_pred: Option<&mut [f64]>,
+        mut tangent: Option<&mut [f64]>,
     ) -> PointTotals {
         f.fill(0.0);
+        let kp = tangent.as_mut().map(|k| {
+            k.fill(0.0);
+            super::SharedValues(k.as_mut_ptr())
+        });
         let fp = Shared(f.as_mut_ptr());
         let predict = f_pred.is_some();
         let pp = f_pred.as_mut().map(|v| {
@@ -342,6 +366,7 @@ impl Assembler {
                             let nodes = block.elements.element(e);
                             let mut fe = [0.0; 8];
                             let mut fe_pred = [0.0; 8];
+                            let mut ke = [0.0; 64];
                             element_points(
                                 &cx,
                                 store_ref,
@@ -355,8 +380,21 @@ impl Assembler {
                                     if predict {
                                         add_bt_sigma(k, x, nodes.len(), w, &sp, &mut fe_pred);
                                     }
+                                    if kp.is_some() {
+                                        add_point_tangent(
+                                            k,
+                                            x,
+                                            nodes.len(),
+                                            w,
+                                            &r.tangent,
+                                            &mut ke,
+                                        );
+                                    }
                                 },
                             );
+                            if let Some(kp) = kp {
+                                self.scatter(nodes, &ke, kp);
+                            }
                             for (a, &n) in nodes.iter().enumerate() {
                                 // SAFETY: no two elements of this colour share node n.
                                 let fn_ = unsafe { fp.slice(2 * n, 2) };
@@ -411,20 +449,9 @@ impl Assembler {
             let nodes = block.elements.element(e);
             let nd = 2 * nodes.len();
             ke[..nd * nd].fill(0.0);
-            element_points(
-                &cx,
-                &stores[bi],
-                nodes,
-                u,
-                e,
-                None,
-                |_, w, r, k, x, _| match k {
-                    Some(k) => element::add_btdb(k, nodes.len(), &r.tangent, w, ke),
-                    None => {
-                        element::bar_stiffness(x, r.tangent[0][0] * w / element::bar_axis(x).1, ke)
-                    }
-                },
-            );
+            element_points(&cx, &stores[bi], nodes, u, e, None, |_, w, r, k, x, _| {
+                add_point_tangent(k, x, nodes.len(), w, &r.tangent, ke)
+            });
         })
     }
 }

@@ -54,7 +54,7 @@ pub struct Assembler {
 }
 
 #[derive(Clone, Copy)]
-struct SharedValues(*mut f64);
+pub(crate) struct SharedValues(pub(crate) *mut f64);
 // SAFETY: writes through the pointer happen only for elements of one colour at a
 // time, which share no node and hence no column of the pattern.
 unsafe impl Send for SharedValues {}
@@ -106,7 +106,7 @@ impl Assembler {
     }
 
     #[inline]
-    fn scatter(&self, nodes: &[usize], ke: &[f64], shared: SharedValues) {
+    pub(crate) fn scatter(&self, nodes: &[usize], ke: &[f64], shared: SharedValues) {
         let nn = nodes.len();
         let nd = 2 * nn;
         let p = &self.pattern;

@@ -69,15 +69,6 @@ pub fn continuum_mass(kind: ElementKind, x: &[[f64; 2]], rho_t: f64, me: &mut [f
     }
 }
 
-/// Row-sum lumping of a consistent element mass in place (positive for Quad4/Tri3).
-pub fn lump(nd: usize, me: &mut [f64]) {
-    for r in 0..nd {
-        let s: f64 = me[r * nd..(r + 1) * nd].iter().sum();
-        me[r * nd..(r + 1) * nd].fill(0.0);
-        me[r * nd + r] = s;
-    }
-}
-
 /// Unit axis and length of a bar.
 #[inline]
 pub fn bar_axis(x: &[[f64; 2]]) -> ([f64; 2], f64) {

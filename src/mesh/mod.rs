@@ -33,15 +33,6 @@ impl ElementKind {
             ElementKind::Bar2 => 2,
         }
     }
-
-    /// Number of Gauss points used for the stiffness and internal force.
-    pub fn gauss_points(self) -> usize {
-        match self {
-            ElementKind::Quad4 => 4,
-            ElementKind::Tri3 => 1,
-            ElementKind::Bar2 => 1,
-        }
-    }
 }
 
 /// Elements of one kind with flattened connectivity (`nodes()` indices per element).

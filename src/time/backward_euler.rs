@@ -233,7 +233,7 @@ impl<'m> BackwardEuler<'m> {
             } else {
                 Some(&mut fpred[..])
             };
-            let totals = self.internal(&u, true, &mut points, &mut fint, pred);
+            let totals = self.internal(&u, true, &mut points, &mut fint, pred, None);
             points.iter_mut().for_each(StateStore::commit);
             (totals.psi, points)
         };
@@ -258,6 +258,7 @@ impl<'m> BackwardEuler<'m> {
         points: &mut [StateStore],
         f: &mut [f64],
         f_pred: Option<&mut [f64]>,
+        tangent: Option<&mut [f64]>,
     ) -> PointTotals {
         let m = self.model;
         self.asm.internal_force(
@@ -270,6 +271,7 @@ impl<'m> BackwardEuler<'m> {
             points,
             f,
             f_pred,
+            tangent,
         )
     }
 
@@ -429,6 +431,7 @@ impl<'m> BackwardEuler<'m> {
             self.refactor_tangent(&u_start, &s.points)?;
         }
         let mut last_correction = 0.0f64;
+        let newton = !constant && self.iteration == IterationMethod::Newton;
         if constant {
             // First solve from the predicted force, without a Gauss-point pass:
             // r(u_s + Δu_c) = −M v_s/h + f_pred − f_ext¹ + K_eff Δu_c.
@@ -462,7 +465,16 @@ impl<'m> BackwardEuler<'m> {
             } else {
                 None
             };
-            let totals = self.internal(&u1, false, &mut s.points, &mut fint1, pred);
+            // Newton takes the tangent of the updates this pass makes anyway.
+            let mut kt = if newton { self.kt.take() } else { None };
+            let totals = self.internal(
+                &u1,
+                false,
+                &mut s.points,
+                &mut fint1,
+                pred,
+                kt.as_deref_mut(),
+            );
             self.du
                 .par_iter_mut()
                 .zip(self.v1.par_iter_mut())
@@ -504,9 +516,15 @@ impl<'m> BackwardEuler<'m> {
                 last_correction <= self.displacement_tolerance * du_norm.max(f64::MIN_POSITIVE)
             };
             if (nl <= self.tolerance && small_correction) || r2 == 0.0 {
+                if kt.is_some() {
+                    self.kt = kt;
+                }
                 break (totals, nl);
             }
             let failure = if iterations >= self.max_iterations || !nl.is_finite() {
+                if kt.is_some() {
+                    self.kt = kt.take();
+                }
                 let worst = self
                     .rhs
                     .iter()
@@ -524,8 +542,8 @@ impl<'m> BackwardEuler<'m> {
                     "no convergence at t = {t1:.6e} (h = {h:.3e}) after {iterations} iterations; relative residuals [{}]{worst}",
                     history.iter().map(|r| format!("{r:.2e}")).collect::<Vec<_>>().join(", ")
                 )))
-            } else if !constant && self.iteration == IterationMethod::Newton {
-                self.refactor_tangent(&u1, &s.points).err()
+            } else if let Some(kt) = kt.take() {
+                self.refactor_with(kt).err()
             } else {
                 None
             };
@@ -608,19 +626,20 @@ impl<'m> BackwardEuler<'m> {
         })
     }
 
-    /// Effective-matrix coefficients `(c_M, c_K)`.
-    pub fn coefficients(&self) -> (f64, f64) {
-        (self.c_m, self.c_k)
-    }
-
     /// Assembles the tangent at `u` from the committed history of `points`, refills
     /// the effective matrix and refactorises it.
     fn refactor_tangent(&mut self, u: &[f64], points: &[StateStore]) -> Result<()> {
-        let t = Instant::now();
         let m = self.model;
         let kt = self
             .asm
             .tangent(&m.mesh, &m.materials, m.plane, u, self.h, points);
+        self.refactor_with(kt)
+    }
+
+    /// Refills the effective matrix with the tangent `kt`, keeps it, and
+    /// refactorises.
+    fn refactor_with(&mut self, kt: Vec<f64>) -> Result<()> {
+        let t = Instant::now();
         self.reduced.fill(
             &self.dofs,
             self.c_m,
