@@ -4,9 +4,12 @@
 //! CHOLMOD backend: `cargo run --release --example w1 -- NY [faer|cholmod]`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use rothe::assembly::internal::PointPass;
 use rothe::assembly::Assembler;
 use rothe::linsolve::Backend;
 use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::march::march_steps;
+use rothe::time::Integrator;
 
 fn assembly(c: &mut Criterion) {
     let mut g = c.benchmark_group("w1_assembly");
@@ -38,7 +41,7 @@ fn factorisation_and_step(c: &mut Criterion) {
         });
         let mut s = be.initial_state();
         g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| {
-            b.iter(|| be.step(&mut s).unwrap())
+            b.iter(|| be.step_accepted(&mut s).unwrap())
         });
     }
     g.finish();
@@ -56,13 +59,15 @@ fn sls(c: &mut Criterion) {
         let (mut f, mut fp) = (vec![0.0; n], vec![0.0; n]);
         g.bench_with_input(BenchmarkId::new("gauss_point_loop", ny), &ny, |b, _| {
             b.iter(|| {
-                be.asm.internal_force(
+                be.assembler().internal_force(
                     &model.mesh,
                     &model.materials,
                     model.plane,
-                    &u,
-                    1e-5,
-                    false,
+                    PointPass {
+                        u: &u,
+                        dt: 1e-5,
+                        at_rest: false,
+                    },
                     &mut s.points,
                     &mut f,
                     Some(&mut fp),
@@ -71,7 +76,7 @@ fn sls(c: &mut Criterion) {
             })
         });
         g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| {
-            b.iter(|| be.step(&mut s).unwrap())
+            b.iter(|| be.step_accepted(&mut s).unwrap())
         });
     }
     g.finish();
@@ -88,12 +93,12 @@ fn nonlinear(c: &mut Criterion) {
         let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
         let mut s0 = be.initial_state();
         for _ in 0..10 {
-            be.step(&mut s0).unwrap();
+            be.step_accepted(&mut s0).unwrap();
         }
         g.bench_with_input(BenchmarkId::new(variant, ny), &ny, |b, _| {
             b.iter(|| {
                 let mut s = s0.clone();
-                rothe::run::march_steps(&mut be, &mut s, 10).unwrap()
+                march_steps(&mut be, &mut s, 10).unwrap()
             })
         });
     }

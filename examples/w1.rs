@@ -8,6 +8,8 @@ use std::time::Instant;
 
 use rothe::linsolve::Backend;
 use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::march::{march, Marched, StepControl};
+use rothe::time::Integrator;
 
 fn peak_rss_mb() -> f64 {
     std::fs::read_to_string("/proc/self/status")
@@ -43,17 +45,18 @@ fn main() -> rothe::Result<()> {
     let mut s = be.initial_state();
     let t_steps = Instant::now();
     let (mut solves, mut n, mut cuts) = (0, 0, 0);
-    rothe::run::march(&mut be, &mut s, |_, m| {
+    march(&mut be, &mut s, StepControl::of(&model), |_, m| {
         match m {
-            rothe::run::Marched::Step(r) => {
+            Marched::Step(r) => {
                 solves += r.iterations;
                 n += 1;
             }
-            rothe::run::Marched::Cut { .. } => cuts += 1,
+            Marched::Cut { .. } => cuts += 1,
         }
         Ok(())
     })?;
     let steps_s = t_steps.elapsed().as_secs_f64();
+    let timing = be.timing();
     let tip = model.probes[0].node;
     let nnz_l = be.factor_nnz().unwrap_or(0);
     let n_el = model.mesh.n_elements();
@@ -66,20 +69,20 @@ fn main() -> rothe::Result<()> {
     println!("  mesh + model setup   {setup_s:.3} s");
     println!(
         "  assembly (K, M, K_eff) {:.3} s  ({:.2e} elements/s)",
-        be.timing.assembly_s,
-        n_el as f64 / be.timing.assembly_s
+        timing.assembly_s,
+        n_el as f64 / timing.assembly_s
     );
     println!(
         "  factorisation        {:.3} s  (nnz(L) = {:.2}M, {} factorisations, {cuts} step cuts)",
-        be.timing.factorization_s,
+        timing.factorization_s,
         nnz_l as f64 / 1e6,
-        be.factorizations
+        be.factorizations()
     );
     println!(
         "  mean step            {:.2} ms (solve {:.2} ms, rest {:.2} ms)",
         1e3 * steps_s / n as f64,
-        1e3 * be.timing.solve_s / n as f64,
-        1e3 * be.timing.step_other_s / n as f64
+        1e3 * timing.solve_s / n as f64,
+        1e3 * (steps_s - timing.solve_s) / n as f64
     );
     println!(
         "  factor stream bound  {:.2} ms per solve at 22 GB/s (2 x nnz(L) x 8 B)",

@@ -28,6 +28,17 @@ pub enum Error {
         /// What failed.
         message: String,
     },
+    /// A factorisation met a non-positive pivot: the matrix is not positive definite.
+    #[error("linear solver ({backend}): {message}")]
+    NotPositiveDefinite {
+        /// Backend name.
+        backend: &'static str,
+        /// The column of the matrix handed to the solver (its own numbering) at
+        /// which the factorisation broke down, when the backend tells.
+        column: Option<usize>,
+        /// What failed, with the pivot.
+        message: String,
+    },
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {

@@ -23,7 +23,6 @@
 
 pub mod assembly;
 pub mod config;
-pub mod driver;
 pub mod energy;
 pub mod error;
 pub mod fe;
@@ -32,9 +31,12 @@ pub mod material;
 pub mod memory;
 pub mod mesh;
 pub mod model;
+pub mod nonlinear;
 pub mod output;
 pub mod run;
+pub mod system;
 pub mod time;
+#[doc(hidden)]
 pub mod workload;
 
 pub use error::{Error, Result};

@@ -66,7 +66,7 @@ fn main() -> ExitCode {
             );
             Ok(())
         }),
-        Command::Material { file, out } => rothe::driver::run_file(&file, &out).map(|records| {
+        Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out).map(|records| {
             eprintln!("{} steps; wrote {}", records.len() - 1, out.join("material.csv").display());
         }),
         Command::Check { scenario } => rothe::config::load(&scenario).and_then(|model| check(&model)),
@@ -82,19 +82,22 @@ fn main() -> ExitCode {
 
 fn check(model: &rothe::model::Model) -> rothe::Result<()> {
     use rothe::assembly::Pattern;
-    use rothe::time::system::{DofMap, ReducedMatrix};
+    use rothe::system::{DofMap, EffectiveSystem};
     let mesh = &model.mesh;
     let pattern = Pattern::new(mesh);
     let dofs = DofMap::new(mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let reduced = ReducedMatrix::new(&pattern, &dofs);
-    let mut solver = Backend::Faer.solver()?;
-    let nd = model.analysis.ordering.nested_dissection(dofs.n_free());
-    if nd {
-        solver.set_ordering(reduced.nested_dissection(&dofs, &mesh.coords));
-    }
-    solver.analyze(&reduced.csc)?;
+    let system = EffectiveSystem::new(
+        &pattern,
+        dofs,
+        Backend::Faer,
+        model.analysis.ordering,
+        &mesh.coords,
+    )?;
+    let dofs = system.dofs();
+    let nd = system.nested_dissection();
+    let solver = &system;
     let nnz_l = solver.factor_nnz().unwrap_or(0);
-    let nnz_a = reduced.csc.row_idx.len();
+    let nnz_a = system.matrix().row_idx.len();
     // K and M values (full storage) + adjacency, the reduced lower matrix, the factor.
     let bytes = 2 * pattern.nnz() * 8
         + pattern.adj.len() * 4

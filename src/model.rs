@@ -264,3 +264,37 @@ impl Model {
         v
     }
 }
+
+impl Model {
+    /// Where dof `d` sits, for messages: node, coordinates, body, one element
+    /// holding it, component.
+    pub fn describe_dof(&self, d: usize) -> String {
+        let mesh = &self.mesh;
+        let n = d / 2;
+        let body = &self.bodies[mesh.node_body[n]].name;
+        let element = mesh.blocks.iter().enumerate().find_map(|(bi, b)| {
+            (0..b.elements.len())
+                .find(|&e| b.elements.element(e).contains(&n))
+                .map(|e| format!("block {bi} element {e}"))
+        });
+        format!(
+            "node {n} at ({:.4}, {:.4}) of body `{body}`, {}, component {}",
+            mesh.coords[n][0],
+            mesh.coords[n][1],
+            element.unwrap_or_else(|| "no element".into()),
+            if d % 2 == 0 { "x" } else { "y" }
+        )
+    }
+
+    /// Element `element` of block `block`, for messages: its body, material and the
+    /// coordinates of its first node.
+    pub fn describe_point(&self, block: usize, element: usize) -> String {
+        let b = &self.mesh.blocks[block];
+        let nodes = b.elements.element(element);
+        let x = self.mesh.coords[nodes[0]];
+        format!(
+            "block {block} element {element} (nodes {nodes:?}, first at ({:.4}, {:.4})) of body `{}`, material `{}`",
+            x[0], x[1], self.bodies[b.body].name, self.materials[b.material].name
+        )
+    }
+}

@@ -6,9 +6,9 @@
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
-use rothe::driver::{run_path, Control, PathKind, PathSpec};
 use rothe::fe::Plane;
 use rothe::material::mazars::damage_law;
+use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
 use rothe::material::rankine_hill::yield_values;
 use rothe::material::{Material, Model, StrainStep};
 use rothe::model::TimeFunction;
@@ -25,7 +25,11 @@ fn mat(text: &str) -> Material {
 }
 
 /// Strain-controlled uniaxial-stress path through the table `points` (t, ε_xx).
-fn uniaxial(m: &Material, points: Vec<[f64; 2]>, n: usize) -> Vec<rothe::driver::PointRecord> {
+fn uniaxial(
+    m: &Material,
+    points: Vec<[f64; 2]>,
+    n: usize,
+) -> Vec<rothe::material::point_driver::PointRecord> {
     let t_end = points.last().unwrap()[0];
     let p = PathSpec {
         kind: PathKind::UniaxialStress,

@@ -5,8 +5,8 @@
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
-use rothe::driver::{run_path, Control, PathKind, PathSpec, PointRecord};
 use rothe::fe::Plane;
+use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec, PointRecord};
 use rothe::material::{Material, StrainStep};
 use rothe::model::TimeFunction;
 

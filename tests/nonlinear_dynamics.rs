@@ -71,19 +71,21 @@ function = {{ kind = "ramp", t0 = 0.0, t1 = 2.0e-3 }}
     let model = rothe::config::from_str(&text, std::path::Path::new(".")).unwrap();
     let mut be = rothe::time::backward_euler::BackwardEuler::new(&model, Backend::Faer).unwrap();
     let mut s = be.initial_state();
-    rothe::run::march(&mut be, &mut s, |s, _| {
+    let control = rothe::time::march::StepControl::of(&model);
+    rothe::time::march::march(&mut be, &mut s, control, |s: &rothe::time::State, _| {
         let l = &s.ledger;
         assert!(
-            l.residual.abs() <= 1e-6 * l.scale,
+            l.residual().abs() <= 1e-6 * l.scale(),
             "t = {}: residual {} scale {}",
             s.t,
-            l.residual,
-            l.scale
+            l.residual(),
+            l.scale()
         );
         Ok(())
     })
     .unwrap();
-    let d: Vec<f64> = s.points[0].committed.chunks(3).map(|c| c[2]).collect();
+    let c = s.points[0].committed();
+    let d: Vec<f64> = (0..c.n_points()).map(|g| c.history(g)[2]).collect();
     let dmax = d.iter().cloned().fold(0.0, f64::max);
     let banded = d.iter().filter(|&&x| x > 0.5).count();
     assert!(dmax > 0.9, "peak passed: max damage {dmax}");
@@ -94,10 +96,10 @@ function = {{ kind = "ramp", t0 = 0.0, t1 = 2.0e-3 }}
     );
     let l = &s.ledger;
     assert!(
-        l.dissipated.damage > 0.0 && l.dissipated.damage <= l.internal,
+        l.dissipated().damage > 0.0 && l.dissipated().damage <= l.internal(),
         "D {} vs E_int {}",
-        l.dissipated.damage,
-        l.internal
+        l.dissipated().damage,
+        l.internal()
     );
 }
 

@@ -1,15 +1,29 @@
 //! The Gauss-point loop: strains from displacements, material updates against the
 //! committed history (trial states written, never committed here), internal forces
 //! `f_int = Σ_e ∫ Bᵀ σ t dA`, the consistent tangent, and the step's stored energy
-//! and dissipation summed with the quadrature weights. Parallel by element colours.
+//! and dissipation summed with the quadrature weights. Parallel by element colours;
+//! nothing is allocated per pass (element buffers live on the stack, trial states in
+//! the stores).
 
 use rayon::prelude::*;
 
-use super::Assembler;
-use crate::fe::{element, kinematics, stiffness_rule, strain, Plane};
-use crate::material::store::StateStore;
-use crate::material::{Dissipation, Material, StrainStep};
-use crate::mesh::{ElementKind, Mesh};
+use super::{Assembler, SharedValues};
+use crate::energy::Dissipation;
+use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind, Plane};
+use crate::material::store::{Committed, Layout, StateStore};
+use crate::material::{Material, PointResponse, PointStatus, StrainStep, MAX_STATE};
+use crate::mesh::Mesh;
+
+/// A material point whose update failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointFailure {
+    /// Element block.
+    pub block: usize,
+    /// Element within the block.
+    pub element: usize,
+    /// Point within the block.
+    pub point: usize,
+}
 
 /// Integrated point quantities of one evaluation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -18,26 +32,23 @@ pub struct PointTotals {
     pub psi: f64,
     /// Dissipation increments `Σ ΔD w` by mechanism.
     pub dissipation: Dissipation,
+    /// The first point (lowest block, element) whose update failed, if any.
+    pub failure: Option<PointFailure>,
 }
 
 impl PointTotals {
-    fn add(mut self, o: PointTotals) -> PointTotals {
+    fn merge(mut self, o: PointTotals) -> PointTotals {
         self.psi += o.psi;
-        let (a, b) = (&mut self.dissipation, o.dissipation);
-        a.viscous += b.viscous;
-        a.damage += b.damage;
-        a.plastic += b.plastic;
-        a.numerical += b.numerical;
+        self.dissipation += o.dissipation;
+        self.failure = match (self.failure, o.failure) {
+            (Some(a), Some(b)) => Some(if (b.block, b.element) < (a.block, a.element) {
+                b
+            } else {
+                a
+            }),
+            (a, b) => a.or(b),
+        };
         self
-    }
-
-    fn add_scaled(&mut self, psi: f64, d: &Dissipation, w: f64) {
-        self.psi += w * psi;
-        let a = &mut self.dissipation;
-        a.viscous += w * d.viscous;
-        a.damage += w * d.damage;
-        a.plastic += w * d.plastic;
-        a.numerical += w * d.numerical;
     }
 }
 
@@ -49,7 +60,8 @@ pub fn points_per_element(kind: ElementKind) -> usize {
     }
 }
 
-/// One store per block, sized for its points and its material's history.
+/// One store per block, sized for its points and its material's history, in the
+/// material's initial state.
 pub fn new_stores(mesh: &Mesh, materials: &[Material]) -> Vec<StateStore> {
     mesh.blocks
         .iter()
@@ -57,12 +69,12 @@ pub fn new_stores(mesh: &Mesh, materials: &[Material]) -> Vec<StateStore> {
             let mat = &materials[b.material];
             let n = b.elements.len() * points_per_element(b.elements.kind);
             let mut s = StateStore::new(n, mat.n_state());
-            for chunk in s.committed.chunks_mut(mat.n_state().max(1)) {
-                if mat.n_state() > 0 {
-                    mat.init_state(chunk);
+            if mat.n_state() > 0 {
+                for g in 0..n {
+                    mat.init_state(s.history_mut(g));
                 }
             }
-            s.trial.clone_from(&s.committed);
+            s.reset_trial();
             s
         })
         .collect()
@@ -70,7 +82,7 @@ pub fn new_stores(mesh: &Mesh, materials: &[Material]) -> Vec<StateStore> {
 
 #[derive(Clone, Copy)]
 struct Shared(*mut f64);
-// SAFETY: each element writes only its own points' slots in the stores, and the
+// SAFETY: each element writes only its own points' slots in the trial buffer, and the
 // force entries of its nodes, which no other element of the running colour holds.
 unsafe impl Send for Shared {}
 unsafe impl Sync for Shared {}
@@ -124,28 +136,28 @@ impl<'a> Ctx<'a> {
     }
 }
 
-/// Evaluates element `e` at displacements `u`: calls `point(g, w, &resp, &kin, x,
-/// σ_pred)` for each of its points (global point index within the block `g`), where
-/// `σ_pred` (when `cx.predict`) is the stress of the next step of the same size at
-/// an unchanged strain, from the trial history: for constant-tangent materials
-/// `f_int` of the next step is then `f_pred + K_t Δu` exactly.
+/// Where a point writes its trial state, when it does.
+#[derive(Clone, Copy)]
+struct TrialOut {
+    base: Shared,
+    layout: Layout,
+}
+
+/// Evaluates element `e` at displacements `u`: calls `point(w, &resp, &kin, x,
+/// σ_pred)` for each of its points, where `σ_pred` (when `cx.predict`) is the stress
+/// of the next step of the same size at an unchanged strain, from the trial history:
+/// for constant-tangent materials `f_int` of the next step is then `f_pred + K_t Δu`
+/// exactly. With `trial`, the points' trial states are written.
 fn element_points<F>(
     cx: &Ctx,
-    store: &StateStore,
+    committed: Committed,
     nodes: &[usize],
     u: &[f64],
     e: usize,
-    trial: Option<Shared>,
+    trial: Option<TrialOut>,
     mut point: F,
 ) where
-    F: FnMut(
-        usize,
-        f64,
-        &crate::material::PointResponse,
-        Option<&crate::fe::PointKinematics>,
-        &[[f64; 2]],
-        [f64; 3],
-    ),
+    F: FnMut(f64, &PointResponse, Option<&crate::fe::PointKinematics>, &[[f64; 2]], [f64; 3]),
 {
     let nn = nodes.len();
     let mut x = [[0.0; 2]; 4];
@@ -155,15 +167,13 @@ fn element_points<F>(
         ue[2 * a] = u[2 * n];
         ue[2 * a + 1] = u[2 * n + 1];
     }
-    let ns = store.n_state;
-    let mut scratch = [0.0; 16];
     if cx.kind == ElementKind::Bar2 {
         let g = e;
         let eps = element::bar_strain(&x[..2], &ue[..4]);
-        let eps_n = if cx.at_rest { eps } else { store.eps[3 * g] };
+        let eps_n = if cx.at_rest { eps } else { committed.eps(g)[0] };
         let de = eps - eps_n;
         let (_, l) = element::bar_axis(&x[..2]);
-        let resp = crate::material::PointResponse {
+        let resp = PointResponse {
             sigma: [cx.mat.e * eps, 0.0, 0.0],
             tangent: [[cx.mat.e, 0.0, 0.0], [0.0; 3], [0.0; 3]],
             psi: 0.5 * cx.mat.e * eps * eps,
@@ -171,15 +181,17 @@ fn element_points<F>(
                 numerical: 0.5 * cx.mat.e * de * de,
                 ..Default::default()
             },
+            status: PointStatus::Ok,
         };
         if let Some(t) = trial {
             // SAFETY: point g belongs to element e only.
-            write3(unsafe { t.slice(3 * g, 3) }, &[eps, 0.0, 0.0]);
-            write3(unsafe { t.slice(store.eps.len() + 3 * g, 3) }, &resp.sigma);
-            let slot = unsafe { t.slice(2 * store.eps.len() + g, 1) };
-            slot[0] = store.dissipated[g];
+            unsafe {
+                write3(t.base.slice(t.layout.eps() + 3 * g, 3), &[eps, 0.0, 0.0]);
+                write3(t.base.slice(t.layout.sigma() + 3 * g, 3), &resp.sigma);
+                t.base.slice(t.layout.dissipated() + g, 1)[0] = committed.dissipated(g);
+            }
         }
-        point(g, cx.section * l, &resp, None, &x[..2], resp.sigma);
+        point(cx.section * l, &resp, None, &x[..2], resp.sigma);
         return;
     }
     let rule = stiffness_rule(cx.kind);
@@ -192,6 +204,8 @@ fn element_points<F>(
             })
             .sum::<f64>();
     let length = area.abs().sqrt();
+    let ns = cx.mat.n_state();
+    let mut scratch = [0.0; MAX_STATE];
     for (q, &(xi, wq)) in rule.iter().enumerate() {
         let g = e * rule.len() + q;
         let k = kinematics(cx.kind, &x[..nn], xi);
@@ -200,10 +214,7 @@ fn element_points<F>(
             // A vanishing step: rates are zero and history does not evolve.
             (eps, f64::MIN_POSITIVE)
         } else {
-            (
-                [store.eps[3 * g], store.eps[3 * g + 1], store.eps[3 * g + 2]],
-                cx.dt,
-            )
+            (committed.eps(g), cx.dt)
         };
         let step = StrainStep {
             eps_n,
@@ -211,22 +222,20 @@ fn element_points<F>(
             dt,
             length,
         };
-        let committed = &store.committed[g * ns..(g + 1) * ns];
+        let history_n = committed.history(g);
         let mut pred = [0.0; 3];
         let resp = match trial {
             Some(t) => {
-                // SAFETY: point g belongs to element e only. The trial buffer holds
-                // strains, stresses, dissipation densities, then history (see
-                // `internal_force`).
-                let n3 = store.eps.len();
-                let np = n3 / 3;
-                write3(unsafe { t.slice(3 * g, 3) }, &eps);
-                let hist = unsafe { t.slice(2 * n3 + np + g * ns, ns) };
-                let r = cx.mat.update_with(&cx.c, cx.plane, &step, committed, hist);
-                write3(unsafe { t.slice(n3 + 3 * g, 3) }, &r.sigma);
-                let d = &r.dissipation;
-                let slot = unsafe { t.slice(2 * n3 + g, 1) };
-                slot[0] = store.dissipated[g] + d.viscous + d.damage + d.plastic;
+                // SAFETY: point g belongs to element e only; the slots are disjoint
+                // parts of the trial buffer (see `Layout`).
+                let hist = unsafe { t.base.slice(t.layout.history() + g * ns, ns) };
+                let r = cx.mat.update_with(&cx.c, cx.plane, &step, history_n, hist);
+                unsafe {
+                    write3(t.base.slice(t.layout.eps() + 3 * g, 3), &eps);
+                    write3(t.base.slice(t.layout.sigma() + 3 * g, 3), &r.sigma);
+                    t.base.slice(t.layout.dissipated() + g, 1)[0] =
+                        committed.dissipated(g) + r.dissipation.material();
+                }
                 if cx.predict {
                     pred = cx
                         .mat
@@ -236,16 +245,9 @@ fn element_points<F>(
             }
             None => cx
                 .mat
-                .update_with(&cx.c, cx.plane, &step, committed, &mut scratch[..ns]),
+                .update_with(&cx.c, cx.plane, &step, history_n, &mut scratch[..ns]),
         };
-        point(
-            g,
-            wq * k.det_j * cx.section,
-            &resp,
-            Some(&k),
-            &x[..nn],
-            pred,
-        );
+        point(wq * k.det_j * cx.section, &resp, Some(&k), &x[..nn], pred);
     }
 }
 
@@ -303,32 +305,42 @@ fn add_bt_sigma(
     }
 }
 
+/// What a pass of [`Assembler::internal_force`] evaluates.
+#[derive(Clone, Copy, Debug)]
+pub struct PointPass<'a> {
+    /// Displacements.
+    pub u: &'a [f64],
+    /// Step size.
+    pub dt: f64,
+    /// Evaluate the state at rest at `u` (the initial state: history not evolved).
+    pub at_rest: bool,
+}
+
 impl Assembler {
-    /// Internal forces at `u` into `f` (overwritten), trial states into the stores,
-    /// and the integrated stored energy and dissipation of the step `dt`. With
+    /// Internal forces at `pass.u` into `f` (overwritten), trial states into the
+    /// stores, and the integrated stored energy and dissipation of the step. With
     /// `f_pred`, also the internal force of the next step at unchanged `u` (see
-    /// `element_points`), in the same pass. With `at_rest`, the state at rest at `u`
-    /// is evaluated instead of a step (the initial state: history not evolved). With
-    /// `tangent`, the consistent tangent of the same updates is assembled into it in
-    /// the same pass (what [`Assembler::tangent`] would give at `u`).
+    /// `element_points`), in the same pass. With `tangent`, the consistent tangent of
+    /// the same updates is assembled into it in the same pass (what
+    /// [`Assembler::tangent`] would give at `u`). A failed point update is reported in
+    /// the totals, not hidden in the forces.
     #[allow(clippy::too_many_arguments)]
     pub fn internal_force(
         &self,
         mesh: &Mesh,
         materials: &[Material],
         plane: Plane,
-        u: &[f64],
-        dt: f64,
-        at_rest: bool,
+        pass: PointPass,
         stores: &mut [StateStore],
         f: &mut [f64],
         mut f_pred: Option<&mut [f64]>,
         mut tangent: Option<&mut [f64]>,
     ) -> PointTotals {
+        let u = pass.u;
         f.fill(0.0);
         let kp = tangent.as_mut().map(|k| {
             k.fill(0.0);
-            super::SharedValues(k.as_mut_ptr())
+            SharedValues(k.as_mut_ptr())
         });
         let fp = Shared(f.as_mut_ptr());
         let predict = f_pred.is_some();
@@ -338,25 +350,22 @@ impl Assembler {
         });
         let mut totals = PointTotals::default();
         for (bi, block) in mesh.blocks.iter().enumerate() {
-            let store = &mut stores[bi];
-            // Trial strains, stresses and history are written through one pointer
-            // base: keep them in one buffer for the duration of the loop.
-            let mut buf = std::mem::take(&mut store.eps_trial);
-            let n_eps = buf.len();
-            buf.append(&mut std::mem::take(&mut store.sigma_trial));
-            buf.append(&mut std::mem::take(&mut store.dissipated_trial));
-            buf.append(&mut std::mem::take(&mut store.trial));
-            let tp = Shared(buf.as_mut_ptr());
+            let (committed, trial_buf) = stores[bi].split();
+            let layout = committed.layout();
+            let trial = TrialOut {
+                base: Shared(trial_buf.as_mut_ptr()),
+                layout,
+            };
             let cx = Ctx::new(
                 mesh,
                 &materials[block.material],
                 plane,
                 block,
-                dt,
+                pass.dt,
                 predict,
-                at_rest,
+                pass.at_rest,
             );
-            let store_ref: &StateStore = store;
+            let ng = points_per_element(block.elements.kind);
             for colour in &self.colours[bi] {
                 let part = colour
                     .par_chunks(128)
@@ -367,15 +376,25 @@ impl Assembler {
                             let mut fe = [0.0; 8];
                             let mut fe_pred = [0.0; 8];
                             let mut ke = [0.0; 64];
+                            let mut q = 0;
                             element_points(
                                 &cx,
-                                store_ref,
+                                committed,
                                 nodes,
                                 u,
                                 e,
-                                Some(tp),
-                                |_, w, r, k, x, sp| {
-                                    acc.add_scaled(r.psi, &r.dissipation, w);
+                                Some(trial),
+                                |w, r, k, x, sp| {
+                                    acc.psi += w * r.psi;
+                                    acc.dissipation += r.dissipation.scaled(w);
+                                    if r.status != PointStatus::Ok && acc.failure.is_none() {
+                                        acc.failure = Some(PointFailure {
+                                            block: bi,
+                                            element: e,
+                                            point: e * ng + q,
+                                        });
+                                    }
+                                    q += 1;
                                     add_bt_sigma(k, x, nodes.len(), w, &r.sigma, &mut fe);
                                     if predict {
                                         add_bt_sigma(k, x, nodes.len(), w, &sp, &mut fe_pred);
@@ -410,16 +429,9 @@ impl Assembler {
                         }
                         acc
                     })
-                    .reduce(PointTotals::default, PointTotals::add);
-                totals = totals.add(part);
+                    .reduce(PointTotals::default, PointTotals::merge);
+                totals = totals.merge(part);
             }
-            let hist = buf.split_off(2 * n_eps + n_eps / 3);
-            let dissipated = buf.split_off(2 * n_eps);
-            let sigma = buf.split_off(n_eps);
-            store.eps_trial = buf;
-            store.sigma_trial = sigma;
-            store.dissipated_trial = dissipated;
-            store.trial = hist;
         }
         totals
     }
@@ -449,9 +461,15 @@ impl Assembler {
             let nodes = block.elements.element(e);
             let nd = 2 * nodes.len();
             ke[..nd * nd].fill(0.0);
-            element_points(&cx, &stores[bi], nodes, u, e, None, |_, w, r, k, x, _| {
-                add_point_tangent(k, x, nodes.len(), w, &r.tangent, ke)
-            });
+            element_points(
+                &cx,
+                stores[bi].committed(),
+                nodes,
+                u,
+                e,
+                None,
+                |w, r, k, x, _| add_point_tangent(k, x, nodes.len(), w, &r.tangent, ke),
+            );
         })
     }
 }

@@ -1,24 +1,36 @@
-//! The energy ledger: every term of the discrete energy identity of backward Euler,
+//! The energy ledger: every term of the discrete energy identity of a time scheme,
 //! accumulated step by step where it happens.
 //!
-//! Testing the step equation `M(v₁−v₀)/h + C v₁ + f_int¹ = f_ext¹` (reactions of
-//! supports included in `f_ext`) with `Δu = h v₁` and using
+//! Testing the backward-Euler step equation `M(v₁−v₀)/h + C v₁ + f_int¹ = f_ext¹`
+//! (reactions of supports included in `f_ext`) with `Δu = h v₁` and using
 //! `(a−b)·a = ½|a|² − ½|b|² + ½|a−b|²` gives, exactly,
 //!
 //! `ΔE_kin + ΔE_el + ΔD_viscous + ΔD_damage + ΔD_plastic + ΔD_contact + ΔD_mass + ΔD_num = ΔW_ext`
 //!
 //! with `ΔW_ext = ½Δu·(f_ext⁰+f_ext¹)` (trapezoidal), `ΔD_mass = Δu·C v₁` and the
-//! scheme's own loss `ΔD_num = ½|v₁−v₀|²_M + (material algorithmic loss) −
-//! ½Δu·(f_ext¹−f_ext⁰)`. The balance residual is the left side minus the right side;
+//! scheme's own loss `ΔD_num = (scheme's kinetic loss) + (material algorithmic loss)
+//! − ½Δu·(f_ext¹−f_ext⁰)`. The balance residual is the left side minus the right side;
 //! it is round-off for linear problems and the iteration tolerance otherwise.
 //! The trapezoidal work of the internal forces `E_int` is reported beside.
 //! Derivation: `theory/energy.md`.
+//!
+//! The work terms every scheme shares are formed by one function ([`work::step_work`]);
+//! a scheme adds only its kinetic energy and its own loss, a constraint its own line
+//! ([`StepIncrements`]).
+
+pub mod work;
+
+use std::ops::{Add, AddAssign};
 
 use serde::Serialize;
 
-/// Cumulative dissipation by mechanism.
+pub use work::{step_work, StepVectors, StepWork};
+
+/// Dissipation by mechanism: a step's increments at a material point (per unit
+/// volume), their integral over the mesh, or a run's cumulative totals. Added with
+/// `+=`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct Dissipated {
+pub struct Dissipation {
     /// Viscous (material dashpots).
     pub viscous: f64,
     /// Damage.
@@ -29,63 +41,100 @@ pub struct Dissipated {
     pub contact: f64,
     /// Mass and Rayleigh damping `∫ v·C v dt`.
     pub mass: f64,
-    /// The time scheme's own numerical loss.
+    /// The time scheme's own numerical loss. At a material point:
+    /// `σ_{n+1}:Δε − Δψ − (viscous + damage + plastic)`, in closed form for the
+    /// elastic, viscoelastic and damage models (a sum of squares for the linear ones)
+    /// and by that difference for plasticity.
     pub numerical: f64,
 }
 
-impl Dissipated {
+impl Dissipation {
     /// Sum over all mechanisms, numerical loss included.
     pub fn total(&self) -> f64 {
         self.viscous + self.damage + self.plastic + self.contact + self.mass + self.numerical
     }
+
+    /// Physical material dissipation: viscous + damage + plastic.
+    pub fn material(&self) -> f64 {
+        self.viscous + self.damage + self.plastic
+    }
+
+    /// Every line multiplied by `w` (a quadrature weight).
+    pub fn scaled(&self, w: f64) -> Dissipation {
+        Dissipation {
+            viscous: w * self.viscous,
+            damage: w * self.damage,
+            plastic: w * self.plastic,
+            contact: w * self.contact,
+            mass: w * self.mass,
+            numerical: w * self.numerical,
+        }
+    }
+
+    /// The lines as `(name, value)` pairs, in the order of `history.csv`.
+    pub fn lines(&self) -> [(&'static str, f64); 6] {
+        [
+            ("viscous", self.viscous),
+            ("damage", self.damage),
+            ("plastic", self.plastic),
+            ("contact", self.contact),
+            ("mass", self.mass),
+            ("numerical", self.numerical),
+        ]
+    }
 }
 
-/// The running ledger.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct Ledger {
-    /// Kinetic energy at the start.
-    pub kinetic_0: f64,
-    /// Stored elastic energy at the start.
-    pub elastic_0: f64,
-    /// Kinetic energy `½ vᵀ M v`.
-    pub kinetic: f64,
-    /// Work of internal forces (trapezoidal).
-    pub internal: f64,
-    /// Work of external forces and support reactions (trapezoidal).
-    pub external_work: f64,
-    /// Stored elastic energy.
-    pub elastic: f64,
-    /// Dissipation by mechanism.
-    pub dissipated: Dissipated,
-    /// Balance residual: `ΔE_kin + ΔE_el + D − W_ext`.
-    pub residual: f64,
-    /// Largest energy seen (for the relative residual).
-    pub scale: f64,
-    /// Largest `|residual|` seen.
-    pub max_abs_residual: f64,
+impl AddAssign for Dissipation {
+    fn add_assign(&mut self, o: Dissipation) {
+        self.viscous += o.viscous;
+        self.damage += o.damage;
+        self.plastic += o.plastic;
+        self.contact += o.contact;
+        self.mass += o.mass;
+        self.numerical += o.numerical;
+    }
 }
 
-/// One step's increments, computed by the time integrator.
+impl Add for Dissipation {
+    type Output = Dissipation;
+    fn add(mut self, o: Dissipation) -> Dissipation {
+        self += o;
+        self
+    }
+}
+
+/// One step's increments, as a scheme forms them.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StepIncrements {
-    /// `½ v₁ᵀ M v₁`.
+    /// Kinetic energy at the end of the step (the scheme's own).
     pub kinetic: f64,
-    /// `½ Δu·(f_int⁰ + f_int¹)`.
-    pub internal_work: f64,
-    /// `½ Δu·(f_ext⁰ + f_ext¹)`.
-    pub external_work: f64,
     /// Stored energy at the end of the step.
     pub elastic: f64,
-    /// Material dissipation increments (numerical: material algorithmic loss).
-    pub material: crate::material::Dissipation,
-    /// Contact dissipation increment.
+    /// The work terms every scheme shares ([`step_work`]).
+    pub work: StepWork,
+    /// Material dissipation increments (`numerical`: the material algorithmic loss).
+    pub material: Dissipation,
+    /// The scheme's own loss besides the material one (backward Euler:
+    /// `½ |v₁ − v₀|²_M`).
+    pub scheme_loss: f64,
+    /// Energy taken out by constraints (contact) in the step.
     pub contact: f64,
-    /// `Δu · C v₁`.
-    pub mass_damping: f64,
-    /// `½ |v₁ − v₀|²_M`.
-    pub kinetic_loss: f64,
-    /// `½ Δu·(f_ext¹ − f_ext⁰)`, subtracted from the numerical loss.
-    pub load_jump: f64,
+}
+
+/// The running ledger. Fields are read through accessors; only [`Ledger::record`]
+/// changes it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Ledger {
+    kinetic_0: f64,
+    elastic_0: f64,
+    kinetic: f64,
+    internal: f64,
+    external_work: f64,
+    elastic: f64,
+    dissipated: Dissipation,
+    residual: f64,
+    scale: f64,
+    max_abs_residual: f64,
 }
 
 impl Ledger {
@@ -96,7 +145,7 @@ impl Ledger {
             elastic_0,
             kinetic: kinetic_0,
             elastic: elastic_0,
-            scale: kinetic_0.max(elastic_0),
+            scale: kinetic_0.abs().max(elastic_0.abs()),
             ..Default::default()
         }
     }
@@ -104,27 +153,71 @@ impl Ledger {
     /// Books one step.
     pub fn record(&mut self, s: &StepIncrements) {
         self.kinetic = s.kinetic;
-        self.internal += s.internal_work;
-        self.external_work += s.external_work;
+        self.internal += s.work.internal;
+        self.external_work += s.work.external;
         self.elastic = s.elastic;
-        let d = &mut self.dissipated;
-        d.viscous += s.material.viscous;
-        d.damage += s.material.damage;
-        d.plastic += s.material.plastic;
-        d.contact += s.contact;
-        d.mass += s.mass_damping;
-        d.numerical += s.kinetic_loss + s.material.numerical - s.load_jump;
+        let mut step = s.material;
+        step.contact += s.contact;
+        step.mass += s.work.damping;
+        step.numerical += s.scheme_loss - s.work.load_jump;
+        self.dissipated += step;
         self.residual = (self.kinetic - self.kinetic_0)
             + (self.elastic - self.elastic_0)
             + self.dissipated.total()
             - self.external_work;
         self.scale = self
             .scale
-            .max(self.kinetic)
-            .max(self.elastic)
+            .max(self.kinetic.abs())
+            .max(self.elastic.abs())
             .max(self.external_work.abs())
             .max(self.internal.abs());
-        self.max_abs_residual = self.max_abs_residual.max(self.residual.abs());
+        // A NaN residual must not hide behind `max`.
+        self.max_abs_residual = if self.residual.is_nan() {
+            f64::NAN
+        } else {
+            self.max_abs_residual.max(self.residual.abs())
+        };
+    }
+
+    /// Kinetic energy at the start.
+    pub fn kinetic_0(&self) -> f64 {
+        self.kinetic_0
+    }
+    /// Stored energy at the start.
+    pub fn elastic_0(&self) -> f64 {
+        self.elastic_0
+    }
+    /// Kinetic energy `½ vᵀ M v`.
+    pub fn kinetic(&self) -> f64 {
+        self.kinetic
+    }
+    /// Work of internal forces (trapezoidal), `E_int` of the paper.
+    pub fn internal(&self) -> f64 {
+        self.internal
+    }
+    /// Work of external forces and support reactions (trapezoidal).
+    pub fn external_work(&self) -> f64 {
+        self.external_work
+    }
+    /// Stored elastic energy.
+    pub fn elastic(&self) -> f64 {
+        self.elastic
+    }
+    /// Cumulative dissipation by mechanism.
+    pub fn dissipated(&self) -> &Dissipation {
+        &self.dissipated
+    }
+    /// Balance residual: `ΔE_kin + ΔE_el + D − W_ext`.
+    pub fn residual(&self) -> f64 {
+        self.residual
+    }
+    /// Largest energy seen (the scale of the relative residual).
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+    /// Largest `|residual|` seen.
+    pub fn max_abs_residual(&self) -> f64 {
+        self.max_abs_residual
     }
 
     /// Largest `|residual|` relative to the largest energy seen.
@@ -132,7 +225,76 @@ impl Ledger {
         if self.scale > 0.0 {
             self.max_abs_residual / self.scale
         } else {
-            0.0
+            self.max_abs_residual
         }
+    }
+
+    /// The first ledger quantity that is not finite, by name.
+    pub fn first_non_finite(&self) -> Option<(&'static str, f64)> {
+        let scalars = [
+            ("E_kin", self.kinetic),
+            ("E_int", self.internal),
+            ("W_ext", self.external_work),
+            ("E_el", self.elastic),
+        ];
+        scalars
+            .into_iter()
+            .chain(self.dissipated.lines())
+            .find(|(_, v)| !v.is_finite())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dissipation_adds_by_line() {
+        let a = Dissipation {
+            viscous: 1.0,
+            damage: 2.0,
+            plastic: 3.0,
+            contact: 4.0,
+            mass: 5.0,
+            numerical: 6.0,
+        };
+        let mut b = a.scaled(0.5);
+        b += a;
+        assert_eq!(b.plastic, 4.5);
+        assert_eq!((a + a).total(), 42.0);
+        assert_eq!(a.material(), 6.0);
+    }
+
+    #[test]
+    fn ledger_books_scheme_and_constraint_lines() {
+        let mut l = Ledger::new(10.0, 0.0);
+        l.record(&StepIncrements {
+            kinetic: 4.0,
+            elastic: 3.0,
+            work: StepWork {
+                internal: 3.5,
+                external: 0.0,
+                load_jump: 0.0,
+                damping: 1.0,
+            },
+            material: Dissipation {
+                numerical: 0.5,
+                ..Default::default()
+            },
+            scheme_loss: 0.5,
+            contact: 1.0,
+        });
+        // ΔE_kin + ΔE_el + D − W = −6 + 3 + (1 + 1 + 1) − 0 = 0.
+        assert_eq!(l.residual(), 0.0);
+        assert_eq!(l.dissipated().numerical, 1.0);
+        assert_eq!(l.dissipated().contact, 1.0);
+        assert_eq!(l.dissipated().mass, 1.0);
+        assert!(l.first_non_finite().is_none());
+        l.record(&StepIncrements {
+            kinetic: f64::NAN,
+            ..Default::default()
+        });
+        assert_eq!(l.first_non_finite().map(|p| p.0), Some("E_kin"));
+        assert!(l.relative_residual().is_nan());
     }
 }

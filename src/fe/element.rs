@@ -2,8 +2,7 @@
 //! force, for continuum elements (Quad4, Tri3) and bars. All write into caller-owned
 //! slices (row-major `n_dof x n_dof`), so the assembly loop allocates nothing.
 
-use super::{kinematics, mass_rule, stiffness_rule, PointKinematics};
-use crate::mesh::ElementKind;
+use super::{kinematics, mass_rule, stiffness_rule, ElementKind, PointKinematics};
 
 /// Adds `w Bᵀ D B` at one point to the element matrix `ke` (row-major, `2nn x 2nn`).
 #[inline]

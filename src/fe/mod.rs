@@ -6,7 +6,28 @@
 
 pub mod element;
 
-use crate::mesh::ElementKind;
+/// The element types rothe knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ElementKind {
+    /// Bilinear quadrilateral, nodes counter-clockwise, 2x2 Gauss.
+    Quad4,
+    /// Linear (constant-strain) triangle, nodes counter-clockwise, 1 Gauss point.
+    Tri3,
+    /// Two-node bar (truss) carrying axial force only.
+    Bar2,
+}
+
+impl ElementKind {
+    /// Number of nodes of one element.
+    pub fn nodes(self) -> usize {
+        match self {
+            ElementKind::Quad4 => 4,
+            ElementKind::Tri3 => 3,
+            ElementKind::Bar2 => 2,
+        }
+    }
+}
 
 /// In-plane idealisation of the third direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]

@@ -9,9 +9,11 @@
 //! reuses afterwards, so a solve does not allocate.
 //!
 //! Ordering: CHOLMOD's default tries AMD and then METIS/NESDIS and keeps the best.
-//! Here `nmethods = 1` with `method[0].ordering = CHOLMOD_AMD`, so this backend and
-//! faer both use AMD and their timings compare the factorisation codes rather than
-//! the orderings. The factorisation is always supernodal (`CHOLMOD_SUPERNODAL`); its
+//! Here `nmethods = 1` with `method[0].ordering = CHOLMOD_AMD`, or, when an elimination
+//! order was proposed with `set_ordering` (the nested dissection the faer backend
+//! gets too), `CHOLMOD_GIVEN` through `cholmod_l_analyze_p`: both backends then
+//! factorise the same permuted matrix, and their timings compare the factorisation
+//! codes rather than the orderings. The factorisation is always supernodal (`CHOLMOD_SUPERNODAL`); its
 //! dense kernels run on the system BLAS (OpenBLAS if installed).
 //!
 //! Threads: faer runs sequentially here, and so do CHOLMOD's own OpenMP loops. Debian's
@@ -29,13 +31,13 @@ use std::ffi::c_void;
 use std::ptr;
 
 use suitesparse_sys::{
-    cholmod_common, cholmod_dense, cholmod_factor, cholmod_l_analyze, cholmod_l_factorize,
-    cholmod_l_finish, cholmod_l_free_dense, cholmod_l_free_factor, cholmod_l_solve2,
-    cholmod_l_start, cholmod_sparse, CHOLMOD_A, CHOLMOD_AMD, CHOLMOD_DOUBLE, CHOLMOD_LONG,
-    CHOLMOD_NOT_POSDEF, CHOLMOD_OK, CHOLMOD_REAL, CHOLMOD_SUPERNODAL,
+    cholmod_common, cholmod_dense, cholmod_factor, cholmod_l_analyze, cholmod_l_analyze_p,
+    cholmod_l_factorize, cholmod_l_finish, cholmod_l_free_dense, cholmod_l_free_factor,
+    cholmod_l_solve2, cholmod_l_start, cholmod_sparse, CHOLMOD_A, CHOLMOD_AMD, CHOLMOD_DOUBLE,
+    CHOLMOD_GIVEN, CHOLMOD_LONG, CHOLMOD_NOT_POSDEF, CHOLMOD_OK, CHOLMOD_REAL, CHOLMOD_SUPERNODAL,
 };
 
-use super::{not_analysed, LowerCsc, SymmetricSolver};
+use super::{check_block, not_analysed, LowerCsc, SymmetricSolver};
 use crate::error::{Error, Result};
 
 const NAME: &str = "cholmod";
@@ -133,6 +135,8 @@ pub struct CholmodCholesky {
     b: Vec<f64>,
     /// Whether the factor holds a successful numeric factorisation.
     factorized: bool,
+    /// Proposed elimination order for the next analysis, as CHOLMOD longs.
+    given: Option<Vec<i64>>,
 }
 
 // SAFETY: the raw pointers are owned exclusively by this struct (CHOLMOD objects
@@ -176,6 +180,7 @@ impl CholmodCholesky {
             values: Vec::new(),
             b: Vec::new(),
             factorized: false,
+            given: None,
         })
     }
 
@@ -323,10 +328,30 @@ impl SymmetricSolver for CholmodCholesky {
         self.values = vec![0.0; a.row_idx.len()];
         self.b = vec![0.0; a.n];
         let mut header = self.sparse_header();
+        let mut given = self.given.take().filter(|p| p.len() == a.n);
+        self.common.method[0].ordering = if given.is_some() {
+            CHOLMOD_GIVEN as i32
+        } else {
+            CHOLMOD_AMD as i32
+        };
         // SAFETY: `header` describes valid, checked arrays (n + 1 column pointers, nnz
         // in-range sorted row indices and nnz values) owned by `self` and alive for the
-        // call; `common` was started in `new`. The returned factor is owned by `self`.
-        self.factor = unsafe { cholmod_l_analyze(&mut header, &mut *self.common) };
+        // call; `common` was started in `new`; a given permutation holds n distinct
+        // indices in 0..n (checked by `set_ordering`). The returned factor is owned by
+        // `self`.
+        self.factor = unsafe {
+            match given.as_mut() {
+                Some(p) => cholmod_l_analyze_p(
+                    &mut header,
+                    p.as_mut_ptr(),
+                    ptr::null_mut(),
+                    0,
+                    &mut *self.common,
+                ),
+                None => cholmod_l_analyze(&mut header, &mut *self.common),
+            }
+        };
+        self.given = given;
         if self.factor.is_null() || self.common.status < CHOLMOD_OK as i32 {
             let status = self.common.status;
             self.free_all();
@@ -380,48 +405,50 @@ impl SymmetricSolver for CholmodCholesky {
         };
         if status == CHOLMOD_NOT_POSDEF as i32 || minor < n {
             let at = match col {
-                Some(c) => format!("at column {c} (pivot {minor} of {n} in AMD order)"),
+                Some(c) => format!("at column {c} (pivot {minor} of {n} in elimination order)"),
                 None => format!("at pivot {minor} of {n}"),
             };
-            return Err(err(format!(
-                "numeric factorisation failed {at}: the effective matrix is not positive \
-                 definite (a body without supports in a static run, or a bad material)"
-            )));
+            return Err(Error::NotPositiveDefinite {
+                backend: NAME,
+                column: col.map(|c| c as usize),
+                message: format!(
+                    "numeric factorisation failed {at}: the matrix is not positive definite"
+                ),
+            });
         }
         self.factorized = true;
         Ok(())
     }
 
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()> {
+    fn solve_block_in_place(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()> {
         if self.factor.is_null() || !self.factorized {
             return Err(not_analysed(NAME));
         }
         let n = self.n;
-        if rhs.len() != n {
-            return Err(err(format!(
-                "right-hand side has {} entries, the matrix {n} rows",
-                rhs.len()
-            )));
-        }
-        if n == 0 {
+        check_block(NAME, n, rhs, ncols)?;
+        if n == 0 || ncols == 0 {
             return Ok(());
         }
-        self.b.copy_from_slice(rhs);
+        if self.b.len() < n * ncols {
+            self.b.resize(n * ncols, 0.0);
+        }
+        self.b[..n * ncols].copy_from_slice(rhs);
         serialise_openmp();
         let mut b = cholmod_dense {
             nrow: n,
-            ncol: 1,
-            nzmax: n,
+            ncol: ncols,
+            nzmax: n * ncols,
             d: n,
             x: self.b.as_mut_ptr() as *mut c_void,
             z: ptr::null_mut(),
             xtype: CHOLMOD_REAL as i32,
             dtype: CHOLMOD_DOUBLE as i32,
         };
-        // SAFETY: the factor is numeric and valid (factorized), `b` describes the owned
-        // n-vector `self.b`, `x`/`y`/`e` are null or n-by-1 dense matrices CHOLMOD
-        // allocated with this `common` in a previous call (it reallocates them if
-        // their shape does not fit), and no sparse Bset/Xset is used.
+        // SAFETY: the factor is numeric and valid (factorized), `b` describes the
+        // owned n-by-ncols column-major block in `self.b` (leading dimension n),
+        // `x`/`y`/`e` are null or dense matrices CHOLMOD allocated with this `common`
+        // in a previous call (it reallocates them if their shape does not fit), and no
+        // sparse Bset/Xset is used.
         let ok = unsafe {
             cholmod_l_solve2(
                 CHOLMOD_A as i32,
@@ -442,18 +469,42 @@ impl SymmetricSolver for CholmodCholesky {
                 status_name(status)
             )));
         }
-        // SAFETY: `self.x` is the n-by-1 real double solution CHOLMOD just wrote; its
-        // `x` array holds at least `n` doubles and does not overlap `rhs`.
+        // SAFETY: `self.x` is the n-by-ncols real double solution CHOLMOD just wrote
+        // (checked below); its `x` array holds `d * ncols` doubles with leading
+        // dimension `d >= n`, and does not overlap `rhs`.
         unsafe {
             let x = &*self.x;
-            if x.nrow != n || x.ncol != 1 || x.x.is_null() {
+            if x.nrow != n || x.ncol != ncols || x.x.is_null() || x.d < n {
                 return Err(err(
                     "cholmod_l_solve2 returned a solution of the wrong shape",
                 ));
             }
-            rhs.copy_from_slice(std::slice::from_raw_parts(x.x as *const f64, n));
+            let data = std::slice::from_raw_parts(x.x as *const f64, x.d * ncols);
+            for c in 0..ncols {
+                rhs[c * n..(c + 1) * n].copy_from_slice(&data[c * x.d..c * x.d + n]);
+            }
         }
         Ok(())
+    }
+
+    fn set_ordering(&mut self, order: Vec<usize>) {
+        self.given =
+            super::inverse_order(&order).map(|_| order.iter().map(|&v| v as i64).collect());
+    }
+
+    fn ordering(&self) -> Option<Vec<usize>> {
+        if self.factor.is_null() {
+            return None;
+        }
+        // SAFETY: the factor is valid; `Perm` is null or holds n long entries.
+        unsafe {
+            let f = &*self.factor;
+            if f.Perm.is_null() {
+                return Some((0..f.n).collect());
+            }
+            let p = std::slice::from_raw_parts(f.Perm as *const i64, f.n);
+            Some(p.iter().map(|&v| v as usize).collect())
+        }
     }
 
     /// nnz(L) as the sum of `L->ColCount`: the exact column counts of the Cholesky

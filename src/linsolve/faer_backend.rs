@@ -6,7 +6,7 @@
 //! parallel factorisation measured slower.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
@@ -14,7 +14,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::{not_analysed, LowerCsc, SymmetricSolver};
+use super::{check_block, not_analysed, LowerCsc, SymmetricSolver};
 use crate::error::{Error, Result};
 
 const NAME: &str = "faer";
@@ -26,6 +26,8 @@ pub struct FaerCholesky {
     l_values: Vec<f64>,
     factor_scratch: Option<MemBuffer>,
     solve_scratch: Option<MemBuffer>,
+    /// Right-hand-side columns the solve scratch is sized for.
+    solve_cols: usize,
     factorized: bool,
     ordering: Option<(Vec<usize>, Vec<usize>)>,
 }
@@ -38,6 +40,37 @@ impl FaerCholesky {
 
     fn pattern(a: &LowerCsc) -> SymbolicSparseColMatRef<'_, usize> {
         SymbolicSparseColMatRef::new_checked(a.n, a.n, &a.col_ptr, None, &a.row_idx)
+    }
+
+    /// The symbolic factor (supernodes, row indices, permutation) of the last
+    /// analysis, and the numeric values of the last factorisation.
+    pub fn factor(&self) -> Option<(&SymbolicCholesky<usize>, &[f64])> {
+        match (&self.symbolic, self.factorized) {
+            (Some(s), true) => Some((s, &self.l_values)),
+            _ => None,
+        }
+    }
+
+    /// The original column eliminated `k`-th.
+    fn original_column(&self, k: usize) -> usize {
+        match self.symbolic.as_ref().and_then(|s| s.perm()) {
+            Some(p) => p.arrays().0[k],
+            None => k,
+        }
+    }
+
+    fn ensure_solve_scratch(&mut self, ncols: usize) -> Result<()> {
+        if ncols <= self.solve_cols && self.solve_scratch.is_some() {
+            return Ok(());
+        }
+        let sym = self.symbolic.as_ref().ok_or_else(|| not_analysed(NAME))?;
+        let req = StackReq::any_of(&[sym.solve_in_place_scratch::<f64>(ncols, Par::Seq)]);
+        self.solve_scratch = Some(MemBuffer::try_new(req).map_err(|_| Error::Solver {
+            backend: NAME,
+            message: format!("out of memory allocating the solve workspace for {ncols} columns"),
+        })?);
+        self.solve_cols = ncols;
+        Ok(())
     }
 }
 
@@ -69,19 +102,22 @@ impl SymmetricSolver for FaerCholesky {
         };
         self.l_values = crate::memory::zeroed(sym.len_val());
         let freq = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
-        let sreq = StackReq::any_of(&[sym.solve_in_place_scratch::<f64>(1, Par::Seq)]);
         self.factor_scratch = Some(MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?);
-        self.solve_scratch = Some(MemBuffer::try_new(sreq).map_err(|_| oom("solve workspace"))?);
         self.symbolic = Some(sym);
+        self.solve_scratch = None;
+        self.solve_cols = 0;
+        self.ensure_solve_scratch(1)?;
         self.factorized = false;
         Ok(())
     }
 
     fn factorize(&mut self, a: &LowerCsc) -> Result<()> {
         let sym = self.symbolic.as_ref().ok_or_else(|| not_analysed(NAME))?;
+        self.factorized = false;
         let mat = SparseColMatRef::new(Self::pattern(a), &a.values);
         let stack = MemStack::new(self.factor_scratch.as_mut().expect("set by analyze"));
-        sym.factorize_numeric_llt::<f64>(
+        let simplicial = matches!(sym.raw(), SymbolicCholeskyRaw::Simplicial(_));
+        let res = sym.factorize_numeric_llt::<f64>(
             &mut self.l_values,
             mat,
             Side::Lower,
@@ -89,29 +125,42 @@ impl SymmetricSolver for FaerCholesky {
             Par::Seq,
             stack,
             Default::default(),
-        )
-        .map_err(|e| Error::Solver {
-            backend: NAME,
-            message: format!(
-                "numeric factorisation failed ({e:?}): the effective matrix is not positive \
-                 definite (a body without supports in a static run, or a bad material)"
-            ),
-        })?;
+        );
+        if let Err(LltError::NonPositivePivot { index }) = res {
+            // faer's simplicial code counts pivots from 1, its supernodal (dense)
+            // code from 0 (checked by `pivot_column_is_named`).
+            let k = if simplicial { index - 1 } else { index };
+            let column = self.original_column(k);
+            return Err(Error::NotPositiveDefinite {
+                backend: NAME,
+                column: Some(column),
+                message: format!(
+                    "numeric factorisation failed at column {column} (pivot {k} of {} in \
+                     elimination order): the matrix is not positive definite",
+                    a.n
+                ),
+            });
+        }
         self.factorized = true;
         Ok(())
     }
 
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()> {
-        let sym = self.symbolic.as_ref().ok_or_else(|| not_analysed(NAME))?;
-        if !self.factorized {
+    fn solve_block_in_place(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()> {
+        if self.symbolic.is_none() || !self.factorized {
             return Err(not_analysed(NAME));
         }
-        let n = rhs.len();
+        let n = self.symbolic.as_ref().map_or(0, |s| s.nrows());
+        check_block(NAME, n, rhs, ncols)?;
+        if n == 0 || ncols == 0 {
+            return Ok(());
+        }
+        self.ensure_solve_scratch(ncols)?;
+        let sym = self.symbolic.as_ref().expect("checked");
         let llt = LltRef::<usize, f64>::new(sym, &self.l_values);
-        let stack = MemStack::new(self.solve_scratch.as_mut().expect("set by analyze"));
+        let stack = MemStack::new(self.solve_scratch.as_mut().expect("ensured"));
         llt.solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
+            MatMut::from_column_major_slice_mut(rhs, n, ncols),
             Par::Seq,
             stack,
         );
@@ -119,11 +168,18 @@ impl SymmetricSolver for FaerCholesky {
     }
 
     fn set_ordering(&mut self, order: Vec<usize>) {
-        let mut inv = vec![0usize; order.len()];
-        for (k, &v) in order.iter().enumerate() {
-            inv[v] = k;
+        match super::inverse_order(&order) {
+            Some(inv) => self.ordering = Some((order, inv)),
+            None => self.ordering = None,
         }
-        self.ordering = Some((order, inv));
+    }
+
+    fn ordering(&self) -> Option<Vec<usize>> {
+        let sym = self.symbolic.as_ref()?;
+        Some(match sym.perm() {
+            Some(p) => p.arrays().0.to_vec(),
+            None => (0..sym.nrows()).collect(),
+        })
     }
 
     fn factor_nnz(&self) -> Option<usize> {
@@ -132,5 +188,109 @@ impl SymmetricSolver for FaerCholesky {
             SymbolicCholeskyRaw::Simplicial(s) => s.len_val(),
             SymbolicCholeskyRaw::Supernodal(s) => s.len_val(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Tridiagonal `[-1, d_i, -1]` of size `n`, lower triangle.
+    fn tridiagonal(d: &[f64]) -> LowerCsc {
+        let n = d.len();
+        let mut col_ptr = vec![0];
+        let (mut row_idx, mut values) = (Vec::new(), Vec::new());
+        for j in 0..n {
+            row_idx.push(j);
+            values.push(d[j]);
+            if j + 1 < n {
+                row_idx.push(j + 1);
+                values.push(-1.0);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        LowerCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+
+    /// A dense SPD matrix of size `n` (forces faer's supernodal code) with one
+    /// diagonal entry made negative.
+    fn dense_with_bad_diagonal(n: usize, bad: usize) -> LowerCsc {
+        let mut col_ptr = vec![0];
+        let (mut row_idx, mut values) = (Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in j..n {
+                row_idx.push(i);
+                values.push(if i == j {
+                    if j == bad {
+                        -1.0
+                    } else {
+                        2.0 * n as f64
+                    }
+                } else {
+                    1.0
+                });
+            }
+            col_ptr.push(row_idx.len());
+        }
+        LowerCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+
+    #[test]
+    fn pivot_column_is_named() {
+        // Simplicial: a long tridiagonal matrix with a negative diagonal entry. The
+        // first bad pivot is at that column or one eliminated after it; for this
+        // matrix with diagonal 4 elsewhere the breakdown is at the entry itself.
+        let mut d = vec![4.0; 300];
+        d[137] = -4.0;
+        let a = tridiagonal(&d);
+        let mut s = FaerCholesky::new();
+        s.analyze(&a).unwrap();
+        match s.factorize(&a) {
+            Err(Error::NotPositiveDefinite { column, .. }) => assert_eq!(column, Some(137)),
+            other => panic!("expected a pivot error, got {other:?}"),
+        }
+        // Supernodal: a dense block.
+        let a = dense_with_bad_diagonal(120, 71);
+        let mut s = FaerCholesky::new();
+        s.analyze(&a).unwrap();
+        match s.factorize(&a) {
+            Err(Error::NotPositiveDefinite {
+                column, message, ..
+            }) => {
+                assert_eq!(column, Some(71), "{message}")
+            }
+            other => panic!("expected a pivot error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_block_solve_equals_the_single_solves() {
+        let d: Vec<f64> = (0..200).map(|i| 3.0 + (i % 5) as f64).collect();
+        let a = tridiagonal(&d);
+        let mut s = FaerCholesky::new();
+        s.analyze(&a).unwrap();
+        s.factorize(&a).unwrap();
+        let k = 5;
+        let block: Vec<f64> = (0..200 * k).map(|i| ((i * 7) % 13) as f64 - 6.0).collect();
+        let mut x = block.clone();
+        s.solve_block_in_place(&mut x, k).unwrap();
+        for c in 0..k {
+            let mut y = block[c * 200..(c + 1) * 200].to_vec();
+            s.solve_in_place(&mut y).unwrap();
+            for i in 0..200 {
+                assert!((y[i] - x[c * 200 + i]).abs() <= 1e-14 * y[i].abs().max(1.0));
+            }
+        }
+        assert!(s.solve_block_in_place(&mut x[..10], k).is_err());
     }
 }

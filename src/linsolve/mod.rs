@@ -2,10 +2,16 @@
 //!
 //! The contract is "symbolic once, numeric many": [`SymmetricSolver::analyze`] orders
 //! and analyses a sparsity pattern once, [`SymmetricSolver::factorize`] refactorises
-//! when the values change, [`SymmetricSolver::solve_in_place`] solves as often as
-//! needed. Matrices come as the lower triangle in CSC form ([`LowerCsc`]).
+//! when the values change, [`SymmetricSolver::solve_in_place`] solves one right-hand
+//! side and [`SymmetricSolver::solve_block_in_place`] a block of them (the factor is
+//! read once for the whole block), as often as needed. Matrices come as the lower
+//! triangle in CSC form ([`LowerCsc`]). A non-positive pivot is
+//! [`Error::NotPositiveDefinite`] with the column it happened at.
+//!
 //! Backends: [`faer_backend::FaerCholesky`] (default, pure Rust) and, with the
-//! `cholmod` feature, [`cholmod_backend::CholmodCholesky`] (SuiteSparse).
+//! `cholmod` feature, [`cholmod_backend::CholmodCholesky`] (SuiteSparse). An
+//! elimination order proposed with [`SymmetricSolver::set_ordering`] is used by both,
+//! so the two compare factorisation codes on the same factor.
 
 pub mod faer_backend;
 pub mod ordering;
@@ -44,6 +50,15 @@ impl LowerCsc {
                 }
             }
             y[j] += acc;
+        }
+    }
+
+    /// Diagonal entry of column `j` (zero if not stored).
+    pub fn diagonal(&self, j: usize) -> f64 {
+        let range = self.col_ptr[j]..self.col_ptr[j + 1];
+        match self.row_idx[range.clone()].binary_search(&j) {
+            Ok(k) => self.values[range.start + k],
+            Err(_) => 0.0,
         }
     }
 }
@@ -104,12 +119,20 @@ pub trait SymmetricSolver: Send {
     /// Numeric factorisation of `a`, whose pattern must be the analysed one.
     fn factorize(&mut self, a: &LowerCsc) -> Result<()>;
     /// Overwrites `rhs` with `A⁻¹ rhs`.
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()>;
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()> {
+        self.solve_block_in_place(rhs, 1)
+    }
+    /// Overwrites the `n x ncols` column-major block `rhs` with `A⁻¹ rhs`, reading
+    /// the factor once for all columns.
+    fn solve_block_in_place(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()>;
     /// Number of nonzeros of the factor `L`, once analysed.
     fn factor_nnz(&self) -> Option<usize>;
     /// Proposes an elimination order (`order[k]` eliminated `k`-th) for the next
-    /// [`SymmetricSolver::analyze`]; backends that order by themselves ignore it.
-    fn set_ordering(&mut self, _order: Vec<usize>) {}
+    /// [`SymmetricSolver::analyze`].
+    fn set_ordering(&mut self, order: Vec<usize>);
+    /// The elimination order the last analysis used (`order[k]` eliminated `k`-th),
+    /// when the backend exposes it.
+    fn ordering(&self) -> Option<Vec<usize>>;
 }
 
 pub(crate) fn not_analysed(backend: &'static str) -> Error {
@@ -117,4 +140,36 @@ pub(crate) fn not_analysed(backend: &'static str) -> Error {
         backend,
         message: "factorize/solve called before analyze".into(),
     }
+}
+
+/// Checks a right-hand-side block's shape.
+pub(crate) fn check_block(
+    backend: &'static str,
+    n: usize,
+    rhs: &[f64],
+    ncols: usize,
+) -> Result<()> {
+    if rhs.len() != n * ncols {
+        return Err(Error::Solver {
+            backend,
+            message: format!(
+                "right-hand side block has {} entries, the matrix {n} rows x {ncols} columns",
+                rhs.len()
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The inverse of an elimination order: `inv[order[k]] = k`; `None` unless `order`
+/// is a permutation of `0..n`.
+pub fn inverse_order(order: &[usize]) -> Option<Vec<usize>> {
+    let mut inv = vec![usize::MAX; order.len()];
+    for (k, &v) in order.iter().enumerate() {
+        if v >= order.len() || inv[v] != usize::MAX {
+            return None;
+        }
+        inv[v] = k;
+    }
+    Some(inv)
 }

@@ -4,7 +4,7 @@
 //! `½ Δε:C:Δε` per step (the `numerical` line): from
 //! `σ_{n+1}:Δε = ψ_{n+1} − ψ_n + ½ Δε:C:Δε` (see `theory/energy.md`).
 
-use super::{dot3, mul3, Dissipation, PointResponse, StrainStep};
+use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 
 /// Elastic update at one point.
 pub fn update(c: &[[f64; 3]; 3], step: &StrainStep) -> PointResponse {
@@ -22,5 +22,6 @@ pub fn update(c: &[[f64; 3]; 3], step: &StrainStep) -> PointResponse {
             numerical: 0.5 * dot3(&de, &mul3(c, &de)),
             ..Default::default()
         },
+        status: PointStatus::Ok,
     }
 }

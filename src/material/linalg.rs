@@ -1,12 +1,26 @@
-//! Tiny dense solves for material-point and driver systems.
+//! Tiny dense solves for material-point and driver systems, on fixed-size arrays so
+//! the Gauss-point loop allocates nothing: a system of dimension `n ≤ MAX_DIM` lives
+//! in the leading `n x n` block of a [`Small`] matrix.
 
-/// Solves `a x = b` by Gaussian elimination with partial pivoting; `None` if singular.
-pub fn solve_small(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
-    let n = b.len();
+/// Largest system these routines handle (the Rankine-Hill return: two principal
+/// stresses and up to three multipliers).
+pub const MAX_DIM: usize = 5;
+
+/// A dense matrix whose leading `n x n` block is used.
+pub type Small = [[f64; MAX_DIM]; MAX_DIM];
+
+/// Solves `a x = b` (leading `n x n` block) by Gaussian elimination with partial
+/// pivoting, overwriting `b` with `x`; `false` if the matrix is singular or not finite.
+pub fn solve_in_place(mut a: Small, b: &mut [f64; MAX_DIM], n: usize) -> bool {
     for c in 0..n {
-        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+        let mut p = c;
+        for i in c + 1..n {
+            if a[i][c].abs() > a[p][c].abs() {
+                p = i;
+            }
+        }
         if a[p][c] == 0.0 || !a[p][c].is_finite() {
-            return None;
+            return false;
         }
         a.swap(c, p);
         b.swap(c, p);
@@ -18,25 +32,61 @@ pub fn solve_small(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
             b[r] -= f * b[c];
         }
     }
-    let mut x = vec![0.0; n];
     for c in (0..n).rev() {
-        x[c] = (b[c] - (c + 1..n).map(|k| a[c][k] * x[k]).sum::<f64>()) / a[c][c];
+        let mut s = b[c];
+        for k in c + 1..n {
+            s -= a[c][k] * b[k];
+        }
+        b[c] = s / a[c][c];
     }
-    Some(x)
+    true
 }
 
-/// Inverse of a small matrix, `None` if singular.
-pub fn inverse_small(a: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
-    let n = a.len();
-    let mut cols = Vec::with_capacity(n);
+/// Inverse of the leading `n x n` block, `None` if singular.
+pub fn inverse(a: &Small, n: usize) -> Option<Small> {
+    let mut inv = [[0.0; MAX_DIM]; MAX_DIM];
     for j in 0..n {
-        let mut e = vec![0.0; n];
+        let mut e = [0.0; MAX_DIM];
         e[j] = 1.0;
-        cols.push(solve_small(a.to_vec(), e)?);
+        if !solve_in_place(*a, &mut e, n) {
+            return None;
+        }
+        for i in 0..n {
+            inv[i][j] = e[i];
+        }
     }
-    Some(
-        (0..n)
-            .map(|i| (0..n).map(|j| cols[j][i]).collect())
-            .collect(),
-    )
+    Some(inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solves_and_inverts_a_pivoting_system() {
+        // A system that needs a row swap (zero leading pivot).
+        let mut a = [[0.0; MAX_DIM]; MAX_DIM];
+        a[0] = [0.0, 2.0, 1.0, 0.0, 0.0];
+        a[1] = [1.0, 1.0, 0.0, 0.0, 0.0];
+        a[2] = [3.0, 0.0, 4.0, 0.0, 0.0];
+        let x_true = [1.0, -2.0, 0.5];
+        let mut b = [0.0; MAX_DIM];
+        for i in 0..3 {
+            b[i] = (0..3).map(|k| a[i][k] * x_true[k]).sum();
+        }
+        assert!(solve_in_place(a, &mut b, 3));
+        for i in 0..3 {
+            assert!((b[i] - x_true[i]).abs() < 1e-14);
+        }
+        let inv = inverse(&a, 3).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                let p: f64 = (0..3).map(|k| a[i][k] * inv[k][j]).sum();
+                assert!((p - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14);
+            }
+        }
+        let mut singular = a;
+        singular[2] = singular[0];
+        assert!(inverse(&singular, 3).is_none());
+    }
 }

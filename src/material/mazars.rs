@@ -16,7 +16,7 @@
 //! its tangent: the paper's fixed-point linearisation. Damage dissipation is
 //! `ΔW_d = ½(Yⁿ + Yⁿ⁺¹) ΔD`, `Y = ½ ε:C:ε`.
 
-use super::{dot3, mul3, Dissipation, PointResponse, StrainStep};
+use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 use crate::fe::Plane;
 
 /// Which Mazars law.
@@ -188,5 +188,6 @@ pub fn update(
             numerical: 0.5 * w * dot3(&de, &mul3(c, &de)) - 0.5 * dd * (y1 - y0),
             ..Default::default()
         },
+        status: PointStatus::Ok,
     }
 }

@@ -12,6 +12,7 @@ pub mod elastic;
 pub mod hardening;
 pub mod linalg;
 pub mod mazars;
+pub mod point_driver;
 pub mod principal;
 pub mod rankine_hill;
 pub mod store;
@@ -23,20 +24,20 @@ pub use rankine_hill::RankineHillParams;
 
 use crate::fe::{elasticity, Plane};
 
-/// Dissipation increments of one step at one point, per unit volume.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Dissipation {
-    /// Viscous (dashpot) dissipation.
-    pub viscous: f64,
-    /// Damage dissipation.
-    pub damage: f64,
-    /// Plastic dissipation.
-    pub plastic: f64,
-    /// The time scheme's own algorithmic loss at the point:
-    /// `σ_{n+1}:Δε − Δψ − (viscous + damage + plastic)`, in closed form for the
-    /// elastic, viscoelastic and damage models (a sum of squares for the linear ones)
-    /// and by that difference for plasticity.
-    pub numerical: f64,
+/// Dissipation increments of one step at one point, per unit volume (the `contact`
+/// and `mass` lines stay zero at a material point).
+pub use crate::energy::Dissipation;
+
+/// Whether a material update found its state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PointStatus {
+    /// The update is valid.
+    #[default]
+    Ok,
+    /// The return mapping found no admissible state (an exhausted strength, or a
+    /// softening too steep for the element): the response holds the trial stress and
+    /// must not be accepted; the equilibrium loop reports it and the step is cut.
+    ReturnFailed,
 }
 
 /// What one material update returns.
@@ -50,6 +51,8 @@ pub struct PointResponse {
     pub psi: f64,
     /// Dissipation increments of the step.
     pub dissipation: Dissipation,
+    /// Whether the update succeeded.
+    pub status: PointStatus,
 }
 
 /// The strain step a material point is asked to take.
@@ -99,6 +102,9 @@ pub enum Model {
     RankineHill(RankineHillParams),
 }
 
+/// The largest number of history values a model keeps per point.
+pub const MAX_STATE: usize = 5;
+
 /// A material: elastic constants, density and constitutive model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -137,7 +143,7 @@ impl Material {
         matches!(self.model, Model::Elastic)
     }
 
-    /// Number of history values stored per Gauss point.
+    /// Number of history values stored per Gauss point (at most [`MAX_STATE`]).
     pub fn n_state(&self) -> usize {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) => 0,
@@ -209,8 +215,9 @@ impl Material {
     ) -> [f64; 3] {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) | Model::Mazars(_) | Model::RankineHill(_) => {
-                let mut st = vec![0.0; self.n_state()];
-                self.update(
+                let mut st = [0.0; MAX_STATE];
+                self.update_with(
+                    c,
                     plane,
                     &StrainStep {
                         eps_n: *eps,
@@ -219,7 +226,7 @@ impl Material {
                         length: 1.0,
                     },
                     state,
-                    &mut st,
+                    &mut st[..self.n_state()],
                 )
                 .sigma
             }

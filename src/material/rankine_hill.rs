@@ -13,12 +13,12 @@
 //! paired with its own flow direction. See `theory/plasticity.md`.
 
 use super::hardening::Hardening;
-use super::linalg::{inverse_small, solve_small};
+use super::linalg::{inverse, solve_in_place, Small, MAX_DIM};
 use super::principal::{
     principal_stress, strain_from_principal, strain_to_frame, strain_transform,
     stress_from_principal,
 };
-use super::{dot3, mul3, Dissipation, PointResponse, StrainStep};
+use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 
 /// Rankine-Hill parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,8 +79,31 @@ fn vm_hessian(s: &[f64; 2]) -> [[f64; 2]; 2] {
     ]
 }
 
-/// Multipliers, principal stresses and the 2x2 algorithmic tangent of a projection.
-type Projection = (Vec<f64>, [f64; 2], Vec<Vec<f64>>);
+/// A set of active surfaces (at most three), kept on the stack.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Active {
+    items: [Surface; 3],
+    len: usize,
+}
+
+impl Active {
+    fn of(list: &[Surface]) -> Self {
+        let mut items = [Surface::R1; 3];
+        items[..list.len()].copy_from_slice(list);
+        Active {
+            items,
+            len: list.len(),
+        }
+    }
+
+    fn as_slice(&self) -> &[Surface] {
+        &self.items[..self.len]
+    }
+}
+
+/// Multipliers (first `m` used), principal stresses and the 2x2 algorithmic tangent
+/// of a projection.
+type Projection = ([f64; 3], [f64; 2], [[f64; 2]; 2]);
 
 struct Ctx<'a> {
     p: &'a RankineHillParams,
@@ -125,28 +148,29 @@ impl Ctx<'_> {
     /// Closest-point projection for a fixed active set; `None` if Newton fails.
     fn project(&self, s_tr: &[f64; 2], active: &[Surface]) -> Option<Projection> {
         let m = active.len();
+        let n = 2 + m;
         let mut s = *s_tr;
-        let mut dl = vec![0.0; m];
+        let mut dl = [0.0; 3];
         let scale = s_tr[0]
             .abs()
             .max(s_tr[1].abs())
             .max(self.p.tension.initial(self.e))
             .max(1.0);
         for _ in 0..60 {
-            let (kt, kc) = self.kappas(active, &dl);
+            let (kt, kc) = self.kappas(active, &dl[..m]);
             // Residuals.
-            let mut r = vec![0.0; 2 + m];
+            let mut r = [0.0; MAX_DIM];
             let ds = [s[0] - s_tr[0], s[1] - s_tr[1]];
             for i in 0..2 {
                 r[i] = self.dinv[i][0] * ds[0] + self.dinv[i][1] * ds[1];
             }
             let mut hs = [[0.0; 2]; 2];
-            let mut jac = vec![vec![0.0; 2 + m]; 2 + m];
-            let mut hard = vec![0.0; m];
+            let mut jac: Small = [[0.0; MAX_DIM]; MAX_DIM];
+            let mut hard = [0.0; 3];
             for (a, surf) in active.iter().enumerate() {
-                let n = normal(*surf, &s);
-                r[0] += dl[a] * n[0];
-                r[1] += dl[a] * n[1];
+                let nv = normal(*surf, &s);
+                r[0] += dl[a] * nv[0];
+                r[1] += dl[a] * nv[1];
                 let (f, hh) = self.f(*surf, &s, kt, kc);
                 r[2 + a] = f;
                 hard[a] = hh;
@@ -158,10 +182,10 @@ impl Ctx<'_> {
                         }
                     }
                 }
-                jac[0][2 + a] = n[0];
-                jac[1][2 + a] = n[1];
-                jac[2 + a][0] = n[0];
-                jac[2 + a][1] = n[1];
+                jac[0][2 + a] = nv[0];
+                jac[1][2 + a] = nv[1];
+                jac[2 + a][0] = nv[0];
+                jac[2 + a][1] = nv[1];
             }
             for i in 0..2 {
                 for j in 0..2 {
@@ -177,28 +201,27 @@ impl Ctx<'_> {
                 }
             }
             let norm = (r[0].abs() + r[1].abs()) * self.d[0][0]
-                + r[2..].iter().map(|x| x.abs()).sum::<f64>();
+                + r[2..n].iter().map(|x| x.abs()).sum::<f64>();
             if norm <= 1e-12 * scale {
                 // Algorithmic tangent: A = [D⁻¹ + Σ Δλ ∂n/∂σ]⁻¹, D_alg = A − A N (NᵀAN + H)⁻¹ NᵀA.
-                let a_inv = vec![vec![jac[0][0], jac[0][1]], vec![jac[1][0], jac[1][1]]];
-                let a = inverse_small(&a_inv)?;
-                let mut an = vec![[0.0; 2]; m]; // A n_b
+                let a = inverse(&jac, 2)?;
+                let mut an = [[0.0; 2]; 3]; // A n_b
                 for (b, surf) in active.iter().enumerate() {
-                    let n = normal(*surf, &s);
+                    let nv = normal(*surf, &s);
                     an[b] = [
-                        a[0][0] * n[0] + a[0][1] * n[1],
-                        a[1][0] * n[0] + a[1][1] * n[1],
+                        a[0][0] * nv[0] + a[0][1] * nv[1],
+                        a[1][0] * nv[0] + a[1][1] * nv[1],
                     ];
                 }
-                let mut g = vec![vec![0.0; m]; m];
+                let mut g: Small = [[0.0; MAX_DIM]; MAX_DIM];
                 for (x, sx) in active.iter().enumerate() {
                     let nx = normal(*sx, &s);
                     for y in 0..m {
                         g[x][y] = nx[0] * an[y][0] + nx[1] * an[y][1] - jac[2 + x][2 + y];
                     }
                 }
-                let gi = inverse_small(&g)?;
-                let mut d_alg = vec![vec![0.0; 2]; 2];
+                let gi = inverse(&g, m)?;
+                let mut d_alg = [[0.0; 2]; 2];
                 for i in 0..2 {
                     for j in 0..2 {
                         let mut v = a[i][j];
@@ -212,8 +235,13 @@ impl Ctx<'_> {
                 }
                 return Some((dl, s, d_alg));
             }
-            let neg: Vec<f64> = r.iter().map(|x| -x).collect();
-            let dx = solve_small(jac, neg)?;
+            let mut dx = [0.0; MAX_DIM];
+            for i in 0..n {
+                dx[i] = -r[i];
+            }
+            if !solve_in_place(jac, &mut dx, n) {
+                return None;
+            }
             s[0] += dx[0];
             s[1] += dx[1];
             for a in 0..m {
@@ -234,11 +262,13 @@ impl Ctx<'_> {
                 .max(self.p.tension.initial(self.e))
                 .max(1.0);
         let all = [Surface::R1, Surface::R2, Surface::Vm];
-        let mut active: Vec<Surface> = all
-            .iter()
-            .copied()
-            .filter(|s| self.f(*s, s_tr, self.kt_n, self.kc_n).0 > tol)
-            .collect();
+        let mut active = Active::of(&[]);
+        for s in all {
+            if self.f(s, s_tr, self.kt_n, self.kc_n).0 > tol {
+                active.items[active.len] = s;
+                active.len += 1;
+            }
+        }
         let candidates: [&[Surface]; 7] = [
             &[Surface::R1],
             &[Surface::Vm],
@@ -250,10 +280,11 @@ impl Ctx<'_> {
         ];
         let admissible = |set: &[Surface]| -> Option<Return> {
             let (dl, s, d_alg) = self.project(s_tr, set)?;
+            let dl = &dl[..set.len()];
             if dl.iter().any(|&l| l < -tol / self.d[0][0]) {
                 return None;
             }
-            let (kt, kc) = self.kappas(set, &dl);
+            let (kt, kc) = self.kappas(set, dl);
             if all
                 .iter()
                 .any(|x| !set.contains(x) && self.f(*x, &s, kt, kc).0 > tol)
@@ -267,11 +298,11 @@ impl Ctx<'_> {
             Some(Return {
                 sigma: s,
                 dlambda: lam,
-                d_alg: [[d_alg[0][0], d_alg[0][1]], [d_alg[1][0], d_alg[1][1]]],
+                d_alg,
             })
         };
-        active.sort_by_key(|s| all.iter().position(|x| x == s));
-        if let Some(r) = admissible(&active) {
+        // Surfaces were taken in the order of `all`, so the set is sorted already.
+        if let Some(r) = admissible(active.as_slice()) {
             return Some(r);
         }
         candidates.iter().find_map(|set| admissible(set))
@@ -314,35 +345,29 @@ pub fn update(
         kc_n,
     };
     state.copy_from_slice(state_n);
-    let elastic = |state: &mut [f64]| {
-        let _ = state;
-        PointResponse {
-            sigma: s_tr,
-            tangent: *c,
-            psi: 0.5 * dot3(&ee_tr, &s_tr),
-            dissipation: Dissipation {
-                numerical: numerical_elastic(c, &step.eps, &step.eps_n),
-                ..Default::default()
-            },
-        }
+    let elastic = PointResponse {
+        sigma: s_tr,
+        tangent: *c,
+        psi: 0.5 * dot3(&ee_tr, &s_tr),
+        dissipation: Dissipation {
+            numerical: numerical_elastic(c, &step.eps, &step.eps_n),
+            ..Default::default()
+        },
+        status: PointStatus::Ok,
     };
     let trial_ok = ctx.f(Surface::R1, &[s1, s2], kt_n, kc_n).0 <= 0.0
         && ctx.f(Surface::Vm, &[s1, s2], kt_n, kc_n).0 <= 0.0;
     if trial_ok {
-        return elastic(state);
+        return elastic;
     }
     let Some(ret) = ctx.ret(&[s1, s2]) else {
         // No admissible return (an exhausted strength, or a softening too steep for
-        // the element): poison the response so the equilibrium iteration fails, the
-        // step is cut, and a persisting failure stops the run with its location.
+        // the element): the trial response, flagged, so the equilibrium loop reports
+        // the point, the step is cut, and a persisting failure stops the run with
+        // its location. The history stays the committed one.
         return PointResponse {
-            sigma: [f64::NAN; 3],
-            tangent: *c,
-            psi: f64::NAN,
-            dissipation: Dissipation {
-                numerical: f64::NAN,
-                ..Default::default()
-            },
+            status: PointStatus::ReturnFailed,
+            ..elastic
         };
     };
     // Plastic strain increment in the principal frame: D⁻¹(σ_tr − σ).
@@ -415,6 +440,7 @@ pub fn update(
             numerical: work - (psi - psi_n) - plastic,
             ..Default::default()
         },
+        status: PointStatus::Ok,
     }
 }
 

@@ -1,55 +1,179 @@
-//! Gauss-point storage: committed and trial history, committed strain.
+//! Gauss-point storage of one element block: committed and trial states.
+//!
+//! Each state is one buffer laid out as `[ε (3 per point) | σ (3 per point) |
+//! cumulative dissipation density (1 per point) | history (n_state per point)]`. The
+//! Gauss-point loop writes a whole trial state through one base pointer (see
+//! `assembly::internal`); accepting a step swaps the two buffers, so a commit copies
+//! nothing and no pass allocates. Every evaluation rewrites all trial entries before
+//! they are read.
 
-/// Per-Gauss-point history, committed and trial, for one element block.
+/// Per-Gauss-point state, committed and trial, for one element block.
 #[derive(Clone, Debug, Default)]
 pub struct StateStore {
+    n_points: usize,
+    n_state: usize,
+    committed: Vec<f64>,
+    trial: Vec<f64>,
+}
+
+/// Offsets of the parts of a state buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// Points in the block.
+    pub n_points: usize,
     /// History values per point.
     pub n_state: usize,
-    /// Committed history (`n_points * n_state`).
-    pub committed: Vec<f64>,
-    /// Trial history of the step being solved.
-    pub trial: Vec<f64>,
-    /// Committed strain per point (`n_points * 3`).
-    pub eps: Vec<f64>,
-    /// Trial strain per point.
-    pub eps_trial: Vec<f64>,
-    /// Committed stress per point (`n_points * 3`).
-    pub sigma: Vec<f64>,
-    /// Trial stress per point.
-    pub sigma_trial: Vec<f64>,
-    /// Committed cumulative dissipation density (viscous + damage + plastic) per point.
-    pub dissipated: Vec<f64>,
-    /// Trial cumulative dissipation density.
-    pub dissipated_trial: Vec<f64>,
+}
+
+impl Layout {
+    /// Start of the strains.
+    pub fn eps(&self) -> usize {
+        0
+    }
+    /// Start of the stresses.
+    pub fn sigma(&self) -> usize {
+        3 * self.n_points
+    }
+    /// Start of the cumulative dissipation densities.
+    pub fn dissipated(&self) -> usize {
+        6 * self.n_points
+    }
+    /// Start of the history values.
+    pub fn history(&self) -> usize {
+        7 * self.n_points
+    }
+    /// Length of a state buffer.
+    pub fn len(&self) -> usize {
+        (7 + self.n_state) * self.n_points
+    }
+    /// True for a block without points.
+    pub fn is_empty(&self) -> bool {
+        self.n_points == 0
+    }
 }
 
 impl StateStore {
-    /// Storage for `n_points` points with `n_state` values each, all zero.
+    /// Storage for `n_points` points with `n_state` history values each, all zero.
     pub fn new(n_points: usize, n_state: usize) -> Self {
+        let len = Layout { n_points, n_state }.len();
         StateStore {
+            n_points,
             n_state,
-            committed: vec![0.0; n_points * n_state],
-            trial: vec![0.0; n_points * n_state],
-            eps: vec![0.0; n_points * 3],
-            eps_trial: vec![0.0; n_points * 3],
-            sigma: vec![0.0; n_points * 3],
-            sigma_trial: vec![0.0; n_points * 3],
-            dissipated: vec![0.0; n_points],
-            dissipated_trial: vec![0.0; n_points],
+            committed: crate::memory::zeroed(len),
+            trial: crate::memory::zeroed(len),
         }
     }
 
-    /// Accepts the step: trial becomes committed. The buffers are swapped, not
-    /// copied: every evaluation rewrites all trial entries before they are read.
-    pub fn commit(&mut self) {
-        std::mem::swap(&mut self.committed, &mut self.trial);
-        std::mem::swap(&mut self.eps, &mut self.eps_trial);
-        std::mem::swap(&mut self.sigma, &mut self.sigma_trial);
-        std::mem::swap(&mut self.dissipated, &mut self.dissipated_trial);
+    /// The buffer layout.
+    pub fn layout(&self) -> Layout {
+        Layout {
+            n_points: self.n_points,
+            n_state: self.n_state,
+        }
     }
 
     /// Number of points.
     pub fn n_points(&self) -> usize {
-        self.eps.len() / 3
+        self.n_points
+    }
+
+    /// History values per point.
+    pub fn n_state(&self) -> usize {
+        self.n_state
+    }
+
+    /// The committed state.
+    pub fn committed(&self) -> Committed<'_> {
+        Committed {
+            layout: self.layout(),
+            data: &self.committed,
+        }
+    }
+
+    /// The committed state of the last evaluation's trial buffer (for inspecting a
+    /// step before it is accepted).
+    pub fn trial(&self) -> Committed<'_> {
+        Committed {
+            layout: self.layout(),
+            data: &self.trial,
+        }
+    }
+
+    /// Committed history of point `g`, for setting an initial state.
+    pub fn history_mut(&mut self, g: usize) -> &mut [f64] {
+        let o = self.layout().history() + g * self.n_state;
+        &mut self.committed[o..o + self.n_state]
+    }
+
+    /// The committed state for reading and the trial buffer for writing, at once
+    /// (the Gauss-point loop reads one and writes the other).
+    pub fn split(&mut self) -> (Committed<'_>, &mut [f64]) {
+        (
+            Committed {
+                layout: Layout {
+                    n_points: self.n_points,
+                    n_state: self.n_state,
+                },
+                data: &self.committed,
+            },
+            &mut self.trial,
+        )
+    }
+
+    /// Makes the trial state the committed one.
+    pub fn commit(&mut self) {
+        std::mem::swap(&mut self.committed, &mut self.trial);
+    }
+
+    /// Copies the committed state into the trial buffer (after setting an initial
+    /// state by hand).
+    pub fn reset_trial(&mut self) {
+        self.trial.copy_from_slice(&self.committed);
+    }
+}
+
+/// Read access to one state buffer of a [`StateStore`].
+#[derive(Clone, Copy, Debug)]
+pub struct Committed<'a> {
+    layout: Layout,
+    data: &'a [f64],
+}
+
+impl Committed<'_> {
+    /// Strain of point `g`.
+    #[inline]
+    pub fn eps(&self, g: usize) -> [f64; 3] {
+        let o = 3 * g;
+        [self.data[o], self.data[o + 1], self.data[o + 2]]
+    }
+
+    /// Stress of point `g`.
+    #[inline]
+    pub fn sigma(&self, g: usize) -> [f64; 3] {
+        let o = self.layout.sigma() + 3 * g;
+        [self.data[o], self.data[o + 1], self.data[o + 2]]
+    }
+
+    /// Cumulative dissipation density (viscous + damage + plastic, J/m³) of point `g`.
+    #[inline]
+    pub fn dissipated(&self, g: usize) -> f64 {
+        self.data[self.layout.dissipated() + g]
+    }
+
+    /// History of point `g`.
+    #[inline]
+    pub fn history(&self, g: usize) -> &[f64] {
+        let o = self.layout.history() + g * self.layout.n_state;
+        &self.data[o..o + self.layout.n_state]
+    }
+
+    /// Number of points.
+    pub fn n_points(&self) -> usize {
+        self.layout.n_points
+    }
+
+    /// The buffer layout.
+    pub fn layout(&self) -> Layout {
+        self.layout
     }
 }

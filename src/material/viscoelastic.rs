@@ -2,7 +2,7 @@
 //! with the Maxwell and Kelvin limits. All updates are backward Euler, exact in the
 //! energy split `σ_{n+1}:Δε = Δψ + ΔD_viscous + ΔD_num` (see `theory/viscoelasticity.md`).
 
-use super::{dot3, mul3, Dissipation, PointResponse, StrainStep};
+use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 
 /// Voigt matrix of the identity viscosity `η = β I` acting on engineering strain
 /// rates: `σ = β ε̇` componentwise, so `σ_xy = β γ̇_xy / 2`.
@@ -46,6 +46,7 @@ pub fn kelvin_voigt(c: &[[f64; 3]; 3], eta: &[[f64; 3]; 3], step: &StrainStep) -
             numerical: 0.5 * dot3(&de, &mul3(c, &de)),
             ..Default::default()
         },
+        status: PointStatus::Ok,
     }
 }
 
@@ -99,6 +100,7 @@ pub fn standard_linear_solid(
             numerical: 0.5 * parallel * dot3(&de, &c_de) + 0.5 * alpha * dot3(&dee, &c_dee),
             ..Default::default()
         },
+        status: PointStatus::Ok,
     }
 }
 

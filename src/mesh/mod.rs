@@ -11,29 +11,7 @@ pub mod structured;
 use std::collections::BTreeMap;
 
 use crate::error::{Error, Result};
-
-/// The element types rothe knows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ElementKind {
-    /// Bilinear quadrilateral, nodes counter-clockwise, 2x2 Gauss.
-    Quad4,
-    /// Linear (constant-strain) triangle, nodes counter-clockwise, 1 Gauss point.
-    Tri3,
-    /// Two-node bar (truss) carrying axial force only.
-    Bar2,
-}
-
-impl ElementKind {
-    /// Number of nodes of one element.
-    pub fn nodes(self) -> usize {
-        match self {
-            ElementKind::Quad4 => 4,
-            ElementKind::Tri3 => 3,
-            ElementKind::Bar2 => 2,
-        }
-    }
-}
+pub use crate::fe::ElementKind;
 
 /// Elements of one kind with flattened connectivity (`nodes()` indices per element).
 #[derive(Clone, Debug, PartialEq)]

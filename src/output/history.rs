@@ -59,11 +59,11 @@ impl History {
         nl_residual: f64,
         probes: &[[f64; 2]],
     ) -> Result<()> {
-        let d = &l.dissipated;
+        let d = l.dissipated();
         let mut line = format!(
             "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
-            l.kinetic, l.internal, l.external_work, l.elastic, d.viscous, d.damage, d.plastic,
-            d.contact, d.mass, d.numerical, l.residual
+            l.kinetic(), l.internal(), l.external_work(), l.elastic(), d.viscous, d.damage, d.plastic,
+            d.contact, d.mass, d.numerical, l.residual()
         );
         for p in probes {
             line.push_str(&format!(",{:.12e},{:.12e}", p[0], p[1]));

@@ -5,5 +5,6 @@
 
 pub mod history;
 pub mod post;
+pub mod recorder;
 pub mod summary;
 pub mod vtk;

@@ -1,93 +1,121 @@
-//! Post-processing fields from a displacement vector.
+//! Post-processing fields for output: element stresses and the element averages of
+//! the point fields of materials with history.
+//!
+//! Stresses come from the committed Gauss-point state when the model has one; for
+//! models made only of linear elastic materials there is no point state (the state is
+//! `u`), and the stress is `C ε(u)` at the element's Gauss points. Averages over an
+//! element's points are weighted by their quadrature weights (`w det J`), so they are
+//! the element means of the fields.
 
 use crate::assembly::internal::points_per_element;
-use crate::fe::{element, kinematics, stiffness_rule, strain};
+use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind};
+use crate::material::mul3;
 use crate::material::store::StateStore;
-use crate::material::StrainStep;
-use crate::mesh::ElementKind;
+use crate::mesh::Mesh;
 use crate::model::Model;
 
-/// Element-averaged stress `[σ_xx, σ_yy, σ_xy]` of every element, blocks in order
-/// (bars: axial stress in the first slot): from the committed Gauss-point stresses
-/// when `points` holds them, else from `u` with the elastic law.
-pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64; 3]> {
-    let mut out = Vec::with_capacity(model.mesh.n_elements());
-    if !points.is_empty() {
-        for (block, store) in model.mesh.blocks.iter().zip(points) {
-            let ng = points_per_element(block.elements.kind);
-            for sig in store.sigma.chunks_exact(3 * ng) {
-                let mut avg = [0.0; 3];
-                for p in sig.chunks_exact(3) {
-                    for i in 0..3 {
-                        avg[i] += p[i] / ng as f64;
-                    }
-                }
-                out.push(avg);
-            }
-        }
-        return out;
+/// Quadrature weights `w det J` of the points of element `e` of `block` (bars: one
+/// point of weight 1).
+fn point_weights(mesh: &Mesh, block: usize, e: usize, out: &mut [f64; 4]) -> usize {
+    let b = &mesh.blocks[block];
+    let kind = b.elements.kind;
+    if kind == ElementKind::Bar2 {
+        out[0] = 1.0;
+        return 1;
     }
-    for block in &model.mesh.blocks {
-        let mat = &model.materials[block.material];
+    let mut x = [[0.0; 2]; 4];
+    let nodes = b.elements.element(e);
+    for (a, &n) in nodes.iter().enumerate() {
+        x[a] = mesh.coords[n];
+    }
+    let rule = stiffness_rule(kind);
+    for (q, &(xi, w)) in rule.iter().enumerate() {
+        out[q] = w * kinematics(kind, &x[..nodes.len()], xi).det_j;
+    }
+    rule.len()
+}
+
+/// Weighted mean of `f(point)` over the points of element `e`.
+fn element_mean(
+    mesh: &Mesh,
+    block: usize,
+    e: usize,
+    ng: usize,
+    mut f: impl FnMut(usize) -> [f64; 3],
+) -> [f64; 3] {
+    let mut w = [0.0; 4];
+    let n = point_weights(mesh, block, e, &mut w);
+    debug_assert_eq!(n, ng);
+    let total: f64 = w[..n].iter().sum();
+    let mut avg = [0.0; 3];
+    for q in 0..n {
+        let v = f(e * ng + q);
+        for i in 0..3 {
+            avg[i] += w[q] / total * v[i];
+        }
+    }
+    avg
+}
+
+/// Element-mean stress `[σ_xx, σ_yy, σ_xy]` of every element, blocks in order (bars:
+/// axial stress in the first slot): from the committed Gauss-point stresses when
+/// `points` holds them, else `C ε(u)`.
+pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64; 3]> {
+    let mesh = &model.mesh;
+    let mut out = Vec::with_capacity(mesh.n_elements());
+    for (bi, block) in mesh.blocks.iter().enumerate() {
         let kind = block.elements.kind;
+        let ng = points_per_element(kind);
+        if let Some(store) = points.get(bi) {
+            let c = store.committed();
+            for e in 0..block.elements.len() {
+                out.push(element_mean(mesh, bi, e, ng, |g| c.sigma(g)));
+            }
+            continue;
+        }
+        let mat = &model.materials[block.material];
+        let d = mat.c(model.plane);
         let nn = kind.nodes();
         for e in 0..block.elements.len() {
             let nodes = block.elements.element(e);
-            let x: Vec<[f64; 2]> = nodes.iter().map(|&n| model.mesh.coords[n]).collect();
-            let ue: Vec<f64> = nodes
-                .iter()
-                .flat_map(|&n| [u[2 * n], u[2 * n + 1]])
-                .collect();
+            let mut x = [[0.0; 2]; 4];
+            let mut ue = [0.0; 8];
+            for (a, &n) in nodes.iter().enumerate() {
+                x[a] = mesh.coords[n];
+                ue[2 * a] = u[2 * n];
+                ue[2 * a + 1] = u[2 * n + 1];
+            }
             if kind == ElementKind::Bar2 {
-                out.push([mat.e * element::bar_strain(&x, &ue), 0.0, 0.0]);
+                out.push([mat.e * element::bar_strain(&x[..2], &ue[..4]), 0.0, 0.0]);
                 continue;
             }
             let rule = stiffness_rule(kind);
-            let mut avg = [0.0; 3];
-            let mut st = [0.0; 0];
-            for &(xi, _) in rule {
-                let k = kinematics(kind, &x, xi);
-                let eps = strain(&k, nn, &ue);
-                let r = mat.update(
-                    model.plane,
-                    &StrainStep {
-                        eps_n: eps,
-                        eps,
-                        dt: 1.0,
-                        length: 1.0,
-                    },
-                    &[],
-                    &mut st,
-                );
-                for i in 0..3 {
-                    avg[i] += r.sigma[i] / rule.len() as f64;
-                }
-            }
-            out.push(avg);
+            out.push(element_mean(mesh, bi, e, ng, |g| {
+                let k = kinematics(kind, &x[..nn], rule[g - e * ng].0);
+                mul3(&d, &strain(&k, nn, &ue))
+            }));
         }
     }
     out
 }
 
-/// Element averages of the point fields of materials with history: damage,
-/// equivalent plastic strain `κ_t + κ_c`, and cumulative dissipation density (J/m³).
+/// Element means of the point fields of materials with history: damage, equivalent
+/// plastic strain `κ_t + κ_c`, and cumulative dissipation density (J/m³).
 pub fn cell_history_fields(model: &Model, points: &[StateStore]) -> Vec<(&'static str, Vec<f64>)> {
+    let mesh = &model.mesh;
     let (mut damage, mut eqp, mut diss) = (Vec::new(), Vec::new(), Vec::new());
-    for (block, store) in model.mesh.blocks.iter().zip(points) {
+    for (bi, (block, store)) in mesh.blocks.iter().zip(points).enumerate() {
         let mat = &model.materials[block.material];
         let ng = points_per_element(block.elements.kind);
-        let ns = store.n_state;
+        let c = store.committed();
         for e in 0..block.elements.len() {
-            let (mut d, mut p, mut w) = (0.0, 0.0, 0.0);
-            for g in e * ng..(e + 1) * ng {
-                let (dd, pp) = mat.output_fields(&store.committed[g * ns..(g + 1) * ns]);
-                d += dd / ng as f64;
-                p += pp / ng as f64;
-                w += store.dissipated[g] / ng as f64;
-            }
-            damage.push(d);
-            eqp.push(p);
-            diss.push(w);
+            let m = element_mean(mesh, bi, e, ng, |g| {
+                let (d, p) = mat.output_fields(c.history(g));
+                [d, p, c.dissipated(g)]
+            });
+            damage.push(m[0]);
+            eqp.push(m[1]);
+            diss.push(m[2]);
         }
     }
     vec![

@@ -7,7 +7,6 @@ use serde::Serialize;
 
 use crate::energy::Ledger;
 use crate::error::{Error, Result};
-use crate::time::Timing;
 
 /// Extremes of one probe's vertical displacement.
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -53,7 +52,7 @@ pub struct EnergySummary {
     /// Stored elastic energy.
     pub elastic: f64,
     /// Dissipation by mechanism.
-    pub dissipated: crate::energy::Dissipated,
+    pub dissipated: crate::energy::Dissipation,
     /// Final balance residual.
     pub balance_residual: f64,
     /// Largest `|residual|` over the run relative to the largest energy.
@@ -63,13 +62,13 @@ pub struct EnergySummary {
 impl From<&Ledger> for EnergySummary {
     fn from(l: &Ledger) -> Self {
         EnergySummary {
-            kinetic_0: l.kinetic_0,
-            kinetic: l.kinetic,
-            internal: l.internal,
-            external_work: l.external_work,
-            elastic: l.elastic,
-            dissipated: l.dissipated,
-            balance_residual: l.residual,
+            kinetic_0: l.kinetic_0(),
+            kinetic: l.kinetic(),
+            internal: l.internal(),
+            external_work: l.external_work(),
+            elastic: l.elastic(),
+            dissipated: *l.dissipated(),
+            balance_residual: l.residual(),
             balance_residual_rel: l.relative_residual(),
         }
     }
@@ -89,13 +88,13 @@ pub struct TimingSummary {
 }
 
 impl TimingSummary {
-    /// From the integrator's timing and the total.
-    pub fn new(t: &Timing, total_s: f64) -> Self {
+    /// All zero.
+    pub fn zero() -> Self {
         TimingSummary {
-            assembly_s: t.assembly_s,
-            factorization_s: t.factorization_s,
-            solve_s: t.solve_s,
-            total_s,
+            assembly_s: 0.0,
+            factorization_s: 0.0,
+            solve_s: 0.0,
+            total_s: 0.0,
         }
     }
 }

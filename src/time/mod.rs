@@ -1,16 +1,83 @@
-//! Time integration: backward Euler (Rothe) dynamics and static equilibrium, the
-//! free-dof system they solve, and the explicit critical step estimate.
+//! Time integration: the integrator interface, the state it advances, backward Euler
+//! (Rothe) dynamics, static equilibrium, adaptive step control and the explicit
+//! critical step estimate.
 //!
-//! Start with [`backward_euler::BackwardEuler`]: it owns the matrices, the solver and
-//! scratch; the state ([`backward_euler::DynState`]) lives outside it, so a step can
-//! be repeated or cut back by copying the state.
+//! An [`Integrator`] owns its matrices, solver and scratch; the [`State`] lives
+//! outside it, so a step can be repeated or cut back by copying the state, and
+//! [`march::march`] drives any integrator to the end time with step cuts. Start with
+//! [`backward_euler::BackwardEuler`]; its step equation goes through the one
+//! equilibrium loop of [`crate::nonlinear`].
 
 pub mod backward_euler;
 pub mod cfl;
+pub mod forces;
+mod implicit;
+pub mod march;
 pub mod statics;
-pub mod system;
 
+use crate::energy::Ledger;
+use crate::error::{Error, Result};
+use crate::material::store::StateStore;
 use crate::model::Model;
+use crate::nonlinear::Outcome;
+
+/// The state of a run after a step: what a step reads and writes, and what the
+/// output records.
+#[derive(Clone, Debug)]
+pub struct State {
+    /// Time.
+    pub t: f64,
+    /// Steps taken.
+    pub step: usize,
+    /// Displacements `u_n`.
+    pub u: Vec<f64>,
+    /// Velocities (backward Euler: `(u_n − u_{n−1})/h`; statics: zero).
+    pub v: Vec<f64>,
+    /// `M v`.
+    pub mv: Vec<f64>,
+    /// Internal forces `f_int(u_n)`.
+    pub f_int: Vec<f64>,
+    /// External forces including support reactions.
+    pub f_ext: Vec<f64>,
+    /// Energy ledger.
+    pub ledger: Ledger,
+    /// Gauss-point states per element block (empty when every material is linear
+    /// elastic and the step runs on global matrices only).
+    pub points: Vec<StateStore>,
+    /// Internal force of the next step at unchanged displacement (constant-tangent
+    /// materials with history; empty otherwise): `f_int(u) = f_pred + K_t (u − u_n)`.
+    pub f_pred: Vec<f64>,
+    /// The step size `f_pred` was predicted for.
+    pub f_pred_h: f64,
+}
+
+/// What an accepted step reports besides the new state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepReport {
+    /// Corrections (linear or constrained solves) taken.
+    pub iterations: usize,
+    /// Relative residual `sqrt(Σ r² / Σ (f_ext² + f_int² + (M a)²))` over the free
+    /// dofs at the end of the step.
+    pub nl_residual: f64,
+}
+
+/// A step that did not converge: the loop's outcome and a message locating it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rejection {
+    /// How the equilibrium loop ended.
+    pub outcome: Outcome,
+    /// What failed and where (node, coordinates, body, element).
+    pub message: String,
+}
+
+/// What a step gave.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepOutcome {
+    /// The state was advanced.
+    Accepted(StepReport),
+    /// The state is unchanged; step control may cut the step.
+    Rejected(Rejection),
+}
 
 /// Wall-clock time spent per phase, in seconds.
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -21,36 +88,50 @@ pub struct Timing {
     pub factorization_s: f64,
     /// Triangular solves.
     pub solve_s: f64,
-    /// Everything else inside steps (matrix-vector products, ledger).
+    /// Everything else inside steps (material passes, matrix-vector products, ledger).
     pub step_other_s: f64,
 }
 
-/// External forces at time `t` (loads and gravity; reactions not included).
-pub fn external_force(model: &Model, gravity: Option<&[f64]>, t: f64, f: &mut [f64]) {
-    match gravity {
-        Some(g) => f.copy_from_slice(g),
-        None => f.fill(0.0),
-    }
-    for load in &model.loads {
-        let s = load.function.at(t);
-        if s != 0.0 {
-            for &(d, v) in &load.entries {
-                f[d] += s * v;
-            }
+/// Facts about an integrator's linear solver.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolverFacts {
+    /// Backend name.
+    pub backend: &'static str,
+    /// Numeric factorisations so far.
+    pub factorizations: usize,
+    /// Nonzeros of the factor.
+    pub factor_nnz: Option<usize>,
+}
+
+/// A time scheme: advances a [`State`] it does not own by steps of a size it can
+/// change.
+pub trait Integrator {
+    /// The model being integrated.
+    fn model(&self) -> &Model;
+    /// The current step size.
+    fn h(&self) -> f64;
+    /// Changes the step size (refactorising what depends on it).
+    fn set_step(&mut self, h: f64) -> Result<()>;
+    /// The state at `t = 0`.
+    fn initial_state(&mut self) -> Result<State>;
+    /// Advances `s` by one step `h`; on [`StepOutcome::Rejected`] `s` is unchanged.
+    fn step(&mut self, s: &mut State) -> Result<StepOutcome>;
+    /// Time per phase so far.
+    fn timing(&self) -> Timing;
+    /// The linear solver's facts.
+    fn solver(&self) -> SolverFacts;
+
+    /// [`Integrator::step`] for callers that treat a rejected step as an error
+    /// (tests, benches, fixed-step studies).
+    fn step_accepted(&mut self, s: &mut State) -> Result<StepReport> {
+        match self.step(s)? {
+            StepOutcome::Accepted(r) => Ok(r),
+            StepOutcome::Rejected(r) => Err(Error::Stepping(r.message)),
         }
     }
 }
 
-/// Gravity force `M g` (exact for a constant acceleration field), if any.
-pub fn gravity_force(
-    model: &Model,
-    mass: &crate::assembly::Mass,
-    pattern: &crate::assembly::Pattern,
-) -> Option<Vec<f64>> {
-    model.gravity.map(|g| {
-        let field: Vec<f64> = (0..model.mesh.n_dofs()).map(|d| g[d % 2]).collect();
-        let mut f = vec![0.0; field.len()];
-        mass.matvec(pattern, &field, &mut f);
-        f
-    })
+/// Dot product.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

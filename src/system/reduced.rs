@@ -1,41 +1,11 @@
-//! Free and constrained dofs, and the effective matrix restricted to the free dofs.
+//! The effective matrix restricted to the free dofs, with the map from its entries
+//! to the shared full pattern, so refills cost one pass.
 
 use rayon::prelude::*;
 
+use super::DofMap;
 use crate::assembly::{Mass, Pattern};
 use crate::linsolve::LowerCsc;
-
-/// Numbering of the free dofs; constrained dofs get `usize::MAX`.
-#[derive(Clone, Debug)]
-pub struct DofMap {
-    /// Equation number of each dof.
-    pub eq: Vec<usize>,
-    /// Free dofs in equation order.
-    pub free: Vec<usize>,
-}
-
-impl DofMap {
-    /// Numbers the dofs not in `constrained`, keeping their natural order.
-    pub fn new(n_dofs: usize, constrained: impl IntoIterator<Item = usize>) -> Self {
-        let mut eq = vec![0usize; n_dofs];
-        for d in constrained {
-            eq[d] = usize::MAX;
-        }
-        let mut free = Vec::with_capacity(n_dofs);
-        for (d, e) in eq.iter_mut().enumerate() {
-            if *e != usize::MAX {
-                *e = free.len();
-                free.push(d);
-            }
-        }
-        DofMap { eq, free }
-    }
-
-    /// Number of free dofs.
-    pub fn n_free(&self) -> usize {
-        self.free.len()
-    }
-}
 
 /// The lower triangle of `Σ c_i A_i` on the free dofs, with the map from its entries to
 /// the shared full pattern, so refills cost one pass.
@@ -62,14 +32,14 @@ impl ReducedMatrix {
             let nbrs = &pattern.adj[pattern.adj_ptr[n]..pattern.adj_ptr[n + 1]];
             for j in 0..2 {
                 let ec = dofs.eq[2 * n + j];
-                if ec == usize::MAX {
+                if ec == super::CONSTRAINED {
                     continue;
                 }
                 let c0 = pattern.col_start(n, j);
                 for (k, &m) in nbrs.iter().enumerate() {
                     for i in 0..2 {
                         let er = dofs.eq[2 * m as usize + i];
-                        if er != usize::MAX && er >= ec {
+                        if er != super::CONSTRAINED && er >= ec {
                             if er == ec {
                                 diag_pos.push(row_idx.len());
                             }

@@ -15,6 +15,7 @@ use serde::Deserialize;
 use crate::config::MaterialSpec;
 use crate::error::{Error, Result};
 use crate::fe::Plane;
+use crate::material::linalg::{solve_in_place, MAX_DIM};
 use crate::material::{Material, PointResponse, StrainStep};
 use crate::model::TimeFunction;
 
@@ -225,15 +226,19 @@ pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
             }
             // Newton on the stress-controlled components.
             let m = free.len();
-            let mut a = vec![vec![0.0; m]; m];
+            let mut a = [[0.0; MAX_DIM]; MAX_DIM];
+            let mut d = [0.0; MAX_DIM];
             for (ii, &i) in free.iter().enumerate() {
                 for (jj, &j) in free.iter().enumerate() {
                     a[ii][jj] = resp.tangent[i][j];
                 }
+                d[ii] = r[ii];
             }
-            let d = crate::material::linalg::solve_small(a, r).ok_or_else(|| {
-                Error::Stepping(format!("material point: singular tangent at t = {t:e}"))
-            })?;
+            if !solve_in_place(a, &mut d, m) {
+                return Err(Error::Stepping(format!(
+                    "material point: singular tangent at t = {t:e}"
+                )));
+            }
             for (ii, &i) in free.iter().enumerate() {
                 eps[i] -= d[ii];
             }

@@ -1,0 +1,53 @@
+//! The convergence test of the equilibrium loop.
+
+/// What constraints (contact) report about an iterate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ConstraintStatus {
+    /// Largest penetration (negative gap magnitude) at the iterate (m).
+    pub penetration: f64,
+    /// Largest `|λ_i g_i|` at the iterate (J).
+    pub complementarity: f64,
+    /// Whether the active set differs from the previous iterate's.
+    pub active_set_changed: bool,
+}
+
+impl ConstraintStatus {
+    /// No constraints, or all satisfied.
+    pub const SATISFIED: ConstraintStatus = ConstraintStatus {
+        penetration: 0.0,
+        complementarity: 0.0,
+        active_set_changed: false,
+    };
+}
+
+impl Default for ConstraintStatus {
+    fn default() -> Self {
+        ConstraintStatus::SATISFIED
+    }
+}
+
+/// Tolerances of the equilibrium loop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Convergence {
+    /// Relative residual `|r| / |(f_ext, f_int, inertia)|` over the free dofs.
+    pub tolerance: f64,
+    /// Last correction relative to the step's displacement increment (for problems
+    /// that are not affine).
+    pub displacement_tolerance: f64,
+    /// Corrections allowed per step.
+    pub max_iterations: usize,
+    /// Largest penetration accepted (m).
+    pub penetration_tolerance: f64,
+    /// Largest `|λ g|` accepted (J).
+    pub complementarity_tolerance: f64,
+}
+
+impl Convergence {
+    /// Whether the constraints of an iterate are met: no penetration beyond the
+    /// tolerance, complementarity, and an active set that did not change.
+    pub fn constraints_hold(&self, c: &ConstraintStatus) -> bool {
+        c.penetration <= self.penetration_tolerance
+            && c.complementarity <= self.complementarity_tolerance
+            && !c.active_set_changed
+    }
+}

@@ -1,0 +1,245 @@
+//! The one equilibrium loop every implicit step goes through.
+//!
+//! A step asks for `u_{n+1}` with `r(u_{n+1}) = 0`, where `r` is the step's residual
+//! (for backward Euler `M(v − v_n)/h + C v + f_int(u) − f_ext`, for statics
+//! `f_int(u) − f_ext`). Three parts meet here:
+//! - a [`StepProblem`] gives the residual at a trial displacement from the committed
+//!   state, and the tangent from the same Gauss-point pass when asked;
+//! - a [`Correction`] turns the residual into a displacement change: one solve on the
+//!   factor ([`LinearCorrection`]), or a constrained correction (contact) that also
+//!   adds its constraint forces to the residual;
+//! - a [`Convergence`] test on the residual, the last correction and the
+//!   constraints' complementarity and active set.
+//!
+//! The loop's result is an [`Outcome`], not an error: converged, not converged (with
+//! the residual history and the worst dof), the effective matrix not positive
+//! definite (with the dof), a failed material update (with the point), or a failed
+//! constraint solve. Step control (`time::march`) acts on it; `Error` is kept for
+//! bad input and broken invariants.
+//!
+//! An affine problem (linear elasticity; linear viscoelasticity with its predicted
+//! force) predicts its residual at the start without an evaluation, so the step costs
+//! one solve and one evaluation that confirms it.
+
+mod convergence;
+mod correction;
+
+pub use convergence::{ConstraintStatus, Convergence};
+pub use correction::{Corrected, Correction, LinearCorrection};
+
+use crate::assembly::internal::PointFailure;
+use crate::error::Result;
+use crate::system::{EffectiveSystem, Factored};
+
+/// What an evaluation of the residual reports besides the residual itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Evaluation {
+    /// `Σ (f_ext² + f_int² + inertia²)` over the free dofs: the scale of the relative
+    /// residual.
+    pub force_scale2: f64,
+    /// `Σ (|f_ext| + |f_int| + |M v/h| + |M v_n/h| + |C v|)²` over all dofs (the
+    /// reactions included): the size of the forces the residual is summed from, whose
+    /// round-off bounds how small it can get ([`ROUNDOFF`]).
+    pub magnitude2: f64,
+    /// `|u − u_n|²` over the free dofs: the scale of the relative correction.
+    pub increment2: f64,
+    /// A tangent was assembled in the same pass ([`StepProblem::update_matrix`] can
+    /// use it).
+    pub tangent: bool,
+    /// A material point whose update failed.
+    pub failure: Option<PointFailure>,
+}
+
+/// Relative round-off of a residual: an iterate whose residual is below `ROUNDOFF`
+/// times the size of the terms it is summed from ([`Evaluation::magnitude2`]) is as
+/// converged as double precision allows (a free flight at uniform velocity, a patch
+/// test with no load on the free dofs), whatever its relative residual. Sums of a few
+/// tens of products lose about `1e-14` of their terms' size; `1e-12` leaves a margin.
+pub const ROUNDOFF: f64 = 1e-12;
+
+/// The nonlinear problem of one step.
+pub trait StepProblem {
+    /// Whether one correction from the predicted residual is exact (affine problem
+    /// with a constant, already factorised effective matrix).
+    fn is_affine(&self) -> bool;
+    /// For an affine problem: writes the residual at `u` into [`StepProblem::residual`]
+    /// (free dofs) without evaluating the materials, and returns true; false when no
+    /// exact prediction is at hand.
+    fn predict(&mut self, u: &[f64]) -> bool;
+    /// Whether the evaluation of iteration `iteration` should assemble the tangent.
+    fn wants_tangent(&self, iteration: usize) -> bool;
+    /// Evaluates the residual at `u` (all dofs: on constrained dofs it is the reaction
+    /// the supports must supply), with the tangent when `tangent`.
+    fn evaluate(&mut self, u: &[f64], tangent: bool) -> Evaluation;
+    /// The residual of the last evaluation or prediction.
+    fn residual(&self) -> &[f64];
+    /// The residual, for constraints to add their forces.
+    fn residual_mut(&mut self) -> &mut [f64];
+    /// Refills and refactorises the effective matrix with the last evaluation's
+    /// tangent.
+    fn update_matrix(&mut self, sys: &mut EffectiveSystem) -> Result<Factored>;
+}
+
+/// How the equilibrium loop ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    /// The residual, the last correction and the constraints met the test.
+    Converged {
+        /// Corrections taken (linear solves or constrained solves).
+        iterations: usize,
+        /// Final relative residual.
+        residual: f64,
+    },
+    /// The iteration limit was reached or the residual stopped being finite.
+    NotConverged {
+        /// Corrections taken.
+        iterations: usize,
+        /// Relative residual at each evaluation.
+        history: Vec<f64>,
+        /// The free dof with the largest residual and that residual (N).
+        worst: Option<(usize, f64)>,
+    },
+    /// The effective matrix lost positive definiteness.
+    NotPositiveDefinite {
+        /// The dof whose column broke down, when known.
+        dof: Option<usize>,
+        /// The solver's message.
+        message: String,
+    },
+    /// A material update found no admissible state.
+    MaterialFailure(PointFailure),
+    /// A constrained correction failed (e.g. the contact QP).
+    ConstraintFailure(String),
+}
+
+impl Outcome {
+    /// Whether the step converged.
+    pub fn converged(&self) -> bool {
+        matches!(self, Outcome::Converged { .. })
+    }
+}
+
+/// Buffers the loop reuses from step to step (nothing is allocated per iteration).
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    /// Right-hand side `−r` and then the correction, on the free dofs.
+    rhs: Vec<f64>,
+    /// Relative residual of each evaluation.
+    history: Vec<f64>,
+}
+
+impl Scratch {
+    /// Buffers for `n_free` equations and up to `max_iterations` iterations.
+    pub fn new(n_free: usize, max_iterations: usize) -> Self {
+        Scratch {
+            rhs: Vec::with_capacity(n_free),
+            history: Vec::with_capacity(max_iterations + 1),
+        }
+    }
+
+    /// Relative residuals of the last solve, one per evaluation.
+    pub fn history(&self) -> &[f64] {
+        &self.history
+    }
+}
+
+fn relative(r2: f64, scale2: f64) -> f64 {
+    if scale2 > 0.0 {
+        (r2 / scale2).sqrt()
+    } else {
+        r2.sqrt()
+    }
+}
+
+/// Gathers `−r` on the free dofs into `rhs`; returns `Σ r²` and the free dof with
+/// the largest `|r|`.
+fn gather(r: &[f64], free: &[usize], rhs: &mut Vec<f64>) -> (f64, Option<(usize, f64)>) {
+    rhs.clear();
+    let mut r2 = 0.0;
+    let mut worst: Option<(usize, f64)> = None;
+    for &d in free {
+        let x = r[d];
+        r2 += x * x;
+        if worst.is_none_or(|w| x.abs() > w.1.abs() || x.is_nan()) {
+            worst = Some((d, x));
+        }
+        rhs.push(-x);
+    }
+    (r2, worst)
+}
+
+/// Iterates `u` to equilibrium: see the module docs. On any outcome but
+/// [`Outcome::Converged`] `u` holds the last iterate, which the caller discards.
+pub fn solve<P, C>(
+    problem: &mut P,
+    correction: &mut C,
+    sys: &mut EffectiveSystem,
+    test: &Convergence,
+    u: &mut [f64],
+    scratch: &mut Scratch,
+) -> Result<Outcome>
+where
+    P: StepProblem + ?Sized,
+    C: Correction + ?Sized,
+{
+    scratch.history.clear();
+    let affine = problem.is_affine();
+    let mut iterations = 0;
+    let mut last_correction: Option<f64> = None;
+    let mut predicted = affine && problem.predict(u);
+    loop {
+        if predicted {
+            gather(problem.residual(), &sys.dofs().free, &mut scratch.rhs);
+        } else {
+            let ev = problem.evaluate(u, problem.wants_tangent(iterations));
+            if let Some(f) = ev.failure {
+                return Ok(Outcome::MaterialFailure(f));
+            }
+            let constraints = correction.constrain(u, problem.residual_mut());
+            let (r2, worst) = gather(problem.residual(), &sys.dofs().free, &mut scratch.rhs);
+            let nl = relative(r2, ev.force_scale2);
+            if scratch.history.len() < scratch.history.capacity() {
+                scratch.history.push(nl);
+            }
+            let small_correction = affine
+                || last_correction
+                    .is_none_or(|c| c <= test.displacement_tolerance * ev.increment2.sqrt());
+            let at_roundoff = r2 <= ROUNDOFF * ROUNDOFF * ev.magnitude2;
+            if nl.is_finite()
+                && ((nl <= test.tolerance && small_correction) || at_roundoff)
+                && test.constraints_hold(&constraints)
+            {
+                return Ok(Outcome::Converged {
+                    iterations,
+                    residual: nl,
+                });
+            }
+            if iterations >= test.max_iterations || !nl.is_finite() {
+                return Ok(Outcome::NotConverged {
+                    iterations,
+                    history: scratch.history.clone(),
+                    worst,
+                });
+            }
+            if ev.tangent {
+                if let Factored::NotPositiveDefinite { dof, message } =
+                    problem.update_matrix(sys)?
+                {
+                    return Ok(Outcome::NotPositiveDefinite { dof, message });
+                }
+            }
+        }
+        predicted = false;
+        if let Corrected::Failed(why) = correction.correct(sys, u, &mut scratch.rhs)? {
+            return Ok(Outcome::ConstraintFailure(why));
+        }
+        let mut c2 = 0.0;
+        for (eq, &d) in sys.dofs().free.iter().enumerate() {
+            let delta = scratch.rhs[eq];
+            u[d] += delta;
+            c2 += delta * delta;
+        }
+        last_correction = Some(c2.sqrt());
+        iterations += 1;
+    }
+}

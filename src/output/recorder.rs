@@ -1,0 +1,109 @@
+//! The recorder of a run: `history.csv` (ledger, solver and probe columns, one
+//! flushed row per step), VTK files at the chosen cadence, and the probes' extremes.
+//! It reads what a step left behind: displacements, velocities, the ledger and the
+//! committed Gauss-point states.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::history::History;
+use super::post::{cell_history_fields, cell_stress};
+use super::summary::ProbeSummary;
+use super::vtk::VtkSeries;
+use crate::energy::Ledger;
+use crate::error::{Error, Result};
+use crate::material::store::StateStore;
+use crate::model::Model;
+
+/// What the recorder reads of a state.
+#[derive(Clone, Copy, Debug)]
+pub struct Snapshot<'a> {
+    /// Step number.
+    pub step: usize,
+    /// Time.
+    pub t: f64,
+    /// Displacements.
+    pub u: &'a [f64],
+    /// Velocities.
+    pub v: &'a [f64],
+    /// Ledger.
+    pub ledger: &'a Ledger,
+    /// Committed Gauss-point states (empty for elastic-only models).
+    pub points: &'a [StateStore],
+    /// Corrections of the step.
+    pub iterations: usize,
+    /// Final relative residual of the step.
+    pub nl_residual: f64,
+}
+
+/// Writes a run's history, VTK series and probe extremes as it goes.
+pub struct Recorder {
+    history: History,
+    vtk: Option<VtkSeries>,
+    vtk_every: usize,
+    probes: BTreeMap<String, ProbeSummary>,
+    samples: Vec<[f64; 2]>,
+}
+
+impl Recorder {
+    /// Creates `out/history.csv` (and `out/vtk/` when VTK is on).
+    pub fn new(model: &Model, out: &Path) -> Result<Self> {
+        std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+        let names: Vec<String> = model.probes.iter().map(|p| p.name.clone()).collect();
+        let history = History::create(&out.join("history.csv"), &names)?;
+        let vtk = if model.analysis.vtk_every > 0 {
+            Some(VtkSeries::new(out, &model.mesh)?)
+        } else {
+            None
+        };
+        let probes = names
+            .iter()
+            .map(|n| (n.clone(), ProbeSummary::default()))
+            .collect();
+        Ok(Recorder {
+            history,
+            vtk,
+            vtk_every: model.analysis.vtk_every,
+            probes,
+            samples: Vec::with_capacity(model.probes.len()),
+        })
+    }
+
+    /// Records one state: a history row, and a VTK file when the step is on the
+    /// cadence.
+    pub fn record(&mut self, model: &Model, s: &Snapshot) -> Result<()> {
+        self.samples.clear();
+        for p in &model.probes {
+            let x = [s.u[2 * p.node], s.u[2 * p.node + 1]];
+            if let Some(summary) = self.probes.get_mut(&p.name) {
+                summary.sample(x[1]);
+            }
+            self.samples.push(x);
+        }
+        self.history
+            .row(s.t, s.ledger, s.iterations, s.nl_residual, &self.samples)?;
+        if let Some(vtk) = &mut self.vtk {
+            if s.step % self.vtk_every == 0 {
+                let extra = if s.points.is_empty() {
+                    Vec::new()
+                } else {
+                    cell_history_fields(model, s.points)
+                };
+                vtk.write(
+                    s.step,
+                    s.t,
+                    s.u,
+                    s.v,
+                    &cell_stress(model, s.u, s.points),
+                    &extra,
+                )?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The probes' extremes so far.
+    pub fn probes(&self) -> &BTreeMap<String, ProbeSummary> {
+        &self.probes
+    }
+}

@@ -1,0 +1,840 @@
+//! What backward Euler and statics share: the operators (stiffness, mass, the
+//! constant tangent), the step problem they hand to the equilibrium loop, the step's
+//! scratch vectors, and the bookkeeping that turns a converged iterate into the new
+//! state and its ledger line.
+//!
+//! The step residual, with `Δu = u − u_n`, `v = Δu/h`:
+//! - backward Euler: `r(u) = M(v − v_n)/h + (zeta + a_m) M v + a_k K v + f_int(u) − f_ext`,
+//! - statics: `r(u) = f_int(u) − f_ext`,
+//!
+//! with `f_int(u) = f_int,n + K Δu` for linear elasticity and the Gauss-point loop
+//! otherwise. Its derivative is the effective matrix
+//! `K_eff = c_m M + c_k K + K_t` (`c_m = 1/h² + (zeta+a_m)/h` or 0, see
+//! [`Operators::coefficients`]). See `theory/scheme.md`.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::forces::{external_force, gravity_force};
+use super::{Rejection, State, StepOutcome, StepReport};
+use crate::assembly::internal::{new_stores, PointPass, PointTotals};
+use crate::assembly::{Assembler, Mass};
+use crate::energy::{step_work, Dissipation, Ledger, StepIncrements, StepVectors};
+use crate::error::{Error, Result};
+use crate::linsolve::Backend;
+use crate::model::{IterationMethod, Model};
+use crate::nonlinear::{
+    self, Convergence, Correction, Evaluation, LinearCorrection, Outcome, StepProblem,
+};
+use crate::system::{DofMap, EffectiveSystem, Factored};
+
+/// How the materials respond, which decides how the effective matrix is kept.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Response {
+    /// Every material is linear elastic: `f_int = K u`, no Gauss-point state.
+    Elastic,
+    /// Materials with history whose tangent is constant for a fixed step (linear
+    /// viscoelasticity): factorised once per step size, affine step.
+    Constant,
+    /// A state-dependent tangent (damage, plasticity), followed as `iteration` says.
+    StateDependent(IterationMethod),
+}
+
+/// The time discretisation of the step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Scheme {
+    /// Backward Euler with step `h` and damping `C = damp_m M + damp_k K`.
+    BackwardEuler {
+        /// Step size.
+        h: f64,
+        /// Mass-proportional damping `zeta + a_m` (1/s).
+        damp_m: f64,
+        /// Stiffness-proportional damping `a_k` (s).
+        damp_k: f64,
+    },
+    /// Static equilibrium at load steps of size `dt` (the material rates use it).
+    Static {
+        /// Load step size.
+        dt: f64,
+    },
+}
+
+/// Matrices and settings of an implicit scheme: built once, read by every step.
+pub(crate) struct Operators {
+    pub asm: Assembler,
+    /// Elastic stiffness on the shared pattern.
+    pub k: Vec<f64>,
+    pub mass: Mass,
+    pub gravity: Option<Vec<f64>>,
+    pub response: Response,
+    /// The constant tangent of `Response::Constant` for the current step size.
+    pub kt: Vec<f64>,
+    pub scheme: Scheme,
+    /// Constrained dofs, for sums over the free dofs.
+    pub constrained: Vec<bool>,
+    pub test: Convergence,
+}
+
+impl Operators {
+    /// Assembles `K`, `M` (statics: only for gravity), gravity, the constant tangent,
+    /// and decides the response of the model's materials.
+    pub fn new(model: &Model, scheme: Scheme) -> Self {
+        let a = &model.analysis;
+        let asm = Assembler::new(&model.mesh);
+        let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+        let mass = asm.mass(&model.mesh, &model.materials, a.lumped_mass);
+        let gravity = gravity_force(model, &mass, &asm.pattern);
+        let response = if model.materials.iter().all(|m| m.is_linear_elastic()) {
+            Response::Elastic
+        } else if model.materials.iter().all(|m| m.has_constant_tangent()) {
+            Response::Constant
+        } else {
+            Response::StateDependent(a.iteration)
+        };
+        let mut constrained = vec![false; model.mesh.n_dofs()];
+        for c in &model.constraints {
+            constrained[c.dof] = true;
+        }
+        let mut ops = Operators {
+            asm,
+            k,
+            mass,
+            gravity,
+            response,
+            kt: Vec::new(),
+            scheme,
+            constrained,
+            test: Convergence {
+                tolerance: a.tolerance,
+                displacement_tolerance: a.displacement_tolerance,
+                max_iterations: a.max_iterations,
+                penetration_tolerance: f64::INFINITY,
+                complementarity_tolerance: f64::INFINITY,
+            },
+        };
+        ops.update_constant_tangent(model);
+        ops
+    }
+
+    /// The step size (statics: the load step).
+    pub fn h(&self) -> f64 {
+        match self.scheme {
+            Scheme::BackwardEuler { h, .. } => h,
+            Scheme::Static { dt } => dt,
+        }
+    }
+
+    /// Sets the step size.
+    pub fn set_h(&mut self, model: &Model, h_new: f64) {
+        match &mut self.scheme {
+            Scheme::BackwardEuler { h, .. } => *h = h_new,
+            Scheme::Static { dt } => *dt = h_new,
+        }
+        self.update_constant_tangent(model);
+    }
+
+    /// The tangent of constant-tangent materials at the current step size (it does
+    /// not depend on the state: evaluated at rest from fresh stores).
+    fn update_constant_tangent(&mut self, model: &Model) {
+        if self.response == Response::Constant {
+            let stores = new_stores(&model.mesh, &model.materials);
+            let u0 = vec![0.0; model.mesh.n_dofs()];
+            self.kt = self.asm.tangent(
+                &model.mesh,
+                &model.materials,
+                model.plane,
+                &u0,
+                self.h(),
+                &stores,
+            );
+        }
+    }
+
+    /// `(c_m, c_k, c_t)` of `K_eff = c_m M + c_k K + c_t K_t`.
+    pub fn coefficients(&self) -> (f64, f64, f64) {
+        let c_t = if self.response == Response::Elastic {
+            0.0
+        } else {
+            1.0
+        };
+        match self.scheme {
+            Scheme::BackwardEuler { h, damp_m, damp_k } => {
+                let c_m = 1.0 / (h * h) + damp_m / h;
+                let c_k = if c_t == 0.0 {
+                    1.0 + damp_k / h
+                } else {
+                    damp_k / h
+                };
+                (c_m, c_k, c_t)
+            }
+            Scheme::Static { .. } => (0.0, 1.0 - c_t, c_t),
+        }
+    }
+
+    /// Refills the effective matrix with the tangent `kt` (ignored for elastic
+    /// models) and refactorises it.
+    pub fn refactor(&self, sys: &mut EffectiveSystem, kt: &[f64]) -> Result<Factored> {
+        let (c_m, c_k, c_t) = self.coefficients();
+        if c_t == 0.0 {
+            sys.refill(c_m, &self.mass, &[(c_k, &self.k)]);
+        } else if c_k == 0.0 {
+            sys.refill(c_m, &self.mass, &[(c_t, kt)]);
+        } else {
+            sys.refill(c_m, &self.mass, &[(c_k, &self.k), (c_t, kt)]);
+        }
+        sys.factorize()
+    }
+
+    /// The initial effective matrix: the elastic or constant one, or for
+    /// state-dependent materials the tangent at rest.
+    pub fn initial_system(
+        &self,
+        model: &Model,
+        backend: Backend,
+    ) -> Result<(EffectiveSystem, Factored)> {
+        let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+        let mut sys = EffectiveSystem::new(
+            &self.asm.pattern,
+            dofs,
+            backend,
+            model.analysis.ordering,
+            &model.mesh.coords,
+        )?;
+        let factored = match self.response {
+            Response::StateDependent(_) => {
+                let stores = new_stores(&model.mesh, &model.materials);
+                let u0 = vec![0.0; model.mesh.n_dofs()];
+                let kt = self.asm.tangent(
+                    &model.mesh,
+                    &model.materials,
+                    model.plane,
+                    &u0,
+                    self.h(),
+                    &stores,
+                );
+                self.refactor(&mut sys, &kt)?
+            }
+            _ => self.refactor(&mut sys, &self.kt)?,
+        };
+        Ok((sys, factored))
+    }
+
+    /// Whether the scheme has inertia (backward Euler) or not (statics).
+    fn dynamic(&self) -> Option<(f64, f64, f64)> {
+        match self.scheme {
+            Scheme::BackwardEuler { h, damp_m, damp_k } => Some((h, damp_m, damp_k)),
+            Scheme::Static { .. } => None,
+        }
+    }
+
+    fn damped(&self) -> bool {
+        matches!(self.scheme, Scheme::BackwardEuler { damp_m, damp_k, .. } if damp_m != 0.0 || damp_k != 0.0)
+    }
+
+    fn internal(
+        &self,
+        model: &Model,
+        pass: PointPass,
+        points: &mut [crate::material::store::StateStore],
+        f: &mut [f64],
+        f_pred: Option<&mut [f64]>,
+        tangent: Option<&mut [f64]>,
+    ) -> PointTotals {
+        self.asm.internal_force(
+            &model.mesh,
+            &model.materials,
+            model.plane,
+            pass,
+            points,
+            f,
+            f_pred,
+            tangent,
+        )
+    }
+
+    /// The state at `t = 0`: prescribed displacements, the bodies' initial velocities
+    /// (statics: at rest), history materials at rest.
+    pub fn initial_state(&self, model: &Model) -> State {
+        let n = model.mesh.n_dofs();
+        let mut u = vec![0.0; n];
+        for c in &model.constraints {
+            u[c.dof] = c.at(0.0);
+        }
+        let v = match self.scheme {
+            Scheme::BackwardEuler { .. } => model.initial_velocity(),
+            Scheme::Static { .. } => vec![0.0; n],
+        };
+        let mut mv = vec![0.0; n];
+        self.mass.matvec(&self.asm.pattern, &v, &mut mv);
+        let mut f_ext = vec![0.0; n];
+        external_force(model, self.gravity.as_deref(), 0.0, &mut f_ext);
+        let mut f_int = vec![0.0; n];
+        let mut f_pred = if self.response == Response::Constant {
+            vec![0.0; n]
+        } else {
+            Vec::new()
+        };
+        let (e_el0, points) = if self.response == Response::Elastic {
+            self.asm.pattern.matvec(&self.k, &u, &mut f_int);
+            (0.5 * super::dot(&u, &f_int), Vec::new())
+        } else {
+            let mut points = new_stores(&model.mesh, &model.materials);
+            let pred = (!f_pred.is_empty()).then_some(&mut f_pred[..]);
+            let pass = PointPass {
+                u: &u,
+                dt: self.h(),
+                at_rest: true,
+            };
+            let totals = self.internal(model, pass, &mut points, &mut f_int, pred, None);
+            points.iter_mut().for_each(|p| p.commit());
+            (totals.psi, points)
+        };
+        let e_kin0 = 0.5 * super::dot(&v, &mv);
+        State {
+            t: 0.0,
+            step: 0,
+            u,
+            v,
+            mv,
+            f_int,
+            f_ext,
+            ledger: Ledger::new(e_kin0, e_el0),
+            points,
+            f_pred,
+            f_pred_h: self.h(),
+        }
+    }
+}
+
+/// The vectors of the step being solved (reused from step to step).
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// The iterate `u_{n+1}`.
+    u: Vec<f64>,
+    /// `u − u_n`.
+    du: Vec<f64>,
+    /// `v_{n+1} = Δu/h`.
+    v: Vec<f64>,
+    /// `M v_{n+1}`.
+    mv: Vec<f64>,
+    /// `f_int(u)`.
+    f_int: Vec<f64>,
+    /// Applied external forces at `t_{n+1}`; the reactions are added once converged.
+    f_ext: Vec<f64>,
+    /// Predicted internal force of the following step.
+    f_pred: Vec<f64>,
+    /// `K Δu` (elastic) or `K v` (stiffness damping of history materials).
+    kdu: Vec<f64>,
+    /// `M Δu_c` in a prediction.
+    m_du: Vec<f64>,
+    /// `K_t Δu_c` in a prediction.
+    kt_du: Vec<f64>,
+    /// The residual (all dofs).
+    r: Vec<f64>,
+    /// Damping force `C v_{n+1}` for the ledger.
+    f_damp: Vec<f64>,
+    /// Tangent of the last evaluation (state-dependent materials).
+    kt: Vec<f64>,
+    /// Material totals of the last evaluation.
+    totals: PointTotals,
+    nl: nonlinear::Scratch,
+}
+
+impl Scratch {
+    pub fn new(n: usize, ops: &Operators, n_free: usize) -> Self {
+        let z = || vec![0.0; n];
+        Scratch {
+            u: z(),
+            du: z(),
+            v: z(),
+            mv: z(),
+            f_int: z(),
+            f_ext: z(),
+            f_pred: if ops.response == Response::Constant {
+                z()
+            } else {
+                Vec::new()
+            },
+            kdu: z(),
+            m_du: z(),
+            kt_du: z(),
+            r: z(),
+            f_damp: if ops.damped() { z() } else { Vec::new() },
+            kt: if matches!(ops.response, Response::StateDependent(_)) {
+                vec![0.0; ops.asm.pattern.nnz()]
+            } else {
+                Vec::new()
+            },
+            totals: PointTotals::default(),
+            nl: nonlinear::Scratch::new(n_free, ops.test.max_iterations),
+        }
+    }
+}
+
+/// The step problem handed to the equilibrium loop.
+struct ImplicitStep<'a> {
+    model: &'a Model,
+    ops: &'a Operators,
+    /// The committed state (its Gauss-point stores take the trial states).
+    s: &'a mut State,
+    w: &'a mut Scratch,
+    /// Prescribed displacements move in this step (`Δu_c ≠ 0`).
+    moving: bool,
+}
+
+impl StepProblem for ImplicitStep<'_> {
+    fn is_affine(&self) -> bool {
+        !matches!(self.ops.response, Response::StateDependent(_))
+    }
+
+    fn predict(&mut self, u: &[f64]) -> bool {
+        let (ops, s, w) = (self.ops, &*self.s, &mut *self.w);
+        let base: &[f64] = match ops.response {
+            Response::Elastic => &s.f_int,
+            Response::Constant if s.f_pred_h == ops.h() && !s.f_pred.is_empty() => &s.f_pred,
+            _ => return false,
+        };
+        let (c_m, c_k, c_t) = ops.coefficients();
+        if self.moving {
+            // Δu_c = u − u_n is nonzero on prescribed dofs only.
+            for (d, (a, b)) in w.du.iter_mut().zip(u.iter().zip(&s.u)) {
+                *d = a - b;
+            }
+            let p = &ops.asm.pattern;
+            ops.mass.matvec(p, &w.du, &mut w.m_du);
+            p.matvec(&ops.k, &w.du, &mut w.kdu);
+            if c_t != 0.0 {
+                p.matvec(&ops.kt, &w.du, &mut w.kt_du);
+            }
+        }
+        let inertia = ops.dynamic().map(|(h, _, _)| h);
+        let moving = self.moving;
+        let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext, &w.m_du, &w.kdu, &w.kt_du);
+        w.r.par_iter_mut().enumerate().for_each(|(i, r)| {
+            let mut x = base[i] - f_ext[i];
+            if let Some(h) = inertia {
+                x -= mv_n[i] / h;
+            }
+            if moving {
+                x += c_m * m_du[i] + c_k * kdu[i];
+                if c_t != 0.0 {
+                    x += c_t * kt_du[i];
+                }
+            }
+            *r = x;
+        });
+        true
+    }
+
+    fn wants_tangent(&self, iteration: usize) -> bool {
+        match self.ops.response {
+            Response::StateDependent(IterationMethod::Newton) => true,
+            Response::StateDependent(IterationMethod::Fixed) => iteration == 0,
+            _ => false,
+        }
+    }
+
+    fn evaluate(&mut self, u: &[f64], tangent: bool) -> Evaluation {
+        let (ops, model) = (self.ops, self.model);
+        let (s, w) = (&mut *self.s, &mut *self.w);
+        let h = ops.h();
+        let dynamic = ops.dynamic();
+        w.du.par_iter_mut()
+            .zip(w.v.par_iter_mut())
+            .zip(u.par_iter().zip(s.u.par_iter()))
+            .for_each(|((du, v), (a, b))| {
+                *du = a - b;
+                *v = *du / h;
+            });
+        let p = &ops.asm.pattern;
+        let mut failure = None;
+        match ops.response {
+            Response::Elastic => {
+                // K Δu (and M v with a consistent mass) in one pass over the pattern.
+                match (&ops.mass, dynamic.is_some()) {
+                    (Mass::Consistent(m), true) => {
+                        p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.v, &mut w.mv)
+                    }
+                    (_, true) => {
+                        p.matvec(&ops.k, &w.du, &mut w.kdu);
+                        ops.mass.matvec(p, &w.v, &mut w.mv);
+                    }
+                    (_, false) => p.matvec(&ops.k, &w.du, &mut w.kdu),
+                }
+                w.f_int
+                    .par_iter_mut()
+                    .zip(s.f_int.par_iter().zip(w.kdu.par_iter()))
+                    .for_each(|(f, (f0, kd))| *f = f0 + kd);
+            }
+            _ => {
+                let pred = (!w.f_pred.is_empty()).then_some(&mut w.f_pred[..]);
+                let kt = tangent.then_some(&mut w.kt[..]);
+                let pass = PointPass {
+                    u,
+                    dt: h,
+                    at_rest: false,
+                };
+                w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int, pred, kt);
+                failure = w.totals.failure;
+                if let Some((_, _, damp_k)) = dynamic {
+                    ops.mass.matvec(p, &w.v, &mut w.mv);
+                    if damp_k != 0.0 {
+                        p.matvec(&ops.k, &w.v, &mut w.kdu);
+                    }
+                }
+            }
+        }
+        // The residual and its scales, in one pass.
+        let elastic = ops.response == Response::Elastic;
+        let (mv, mv_n, kdu, f_int, f_ext, du) = (&w.mv, &s.mv, &w.kdu, &w.f_int, &w.f_ext, &w.du);
+        let fixed = &ops.constrained;
+        let sums =
+            w.r.par_iter_mut()
+                .enumerate()
+                .with_min_len(4096)
+                .fold(
+                    || [0.0f64; 3],
+                    |mut acc, (i, r)| {
+                        let (inertia, damping, momenta) = match dynamic {
+                            Some((h, damp_m, damp_k)) => {
+                                let kv = if damp_k == 0.0 {
+                                    0.0
+                                } else if elastic {
+                                    kdu[i] / h
+                                } else {
+                                    kdu[i]
+                                };
+                                (
+                                    (mv[i] - mv_n[i]) / h,
+                                    damp_m * mv[i] + damp_k * kv,
+                                    (mv[i].abs() + mv_n[i].abs()) / h,
+                                )
+                            }
+                            None => (0.0, 0.0, 0.0),
+                        };
+                        *r = inertia + damping + f_int[i] - f_ext[i];
+                        if !fixed[i] {
+                            acc[0] += f_ext[i] * f_ext[i] + f_int[i] * f_int[i] + inertia * inertia;
+                            acc[1] += du[i] * du[i];
+                        }
+                        // Over every dof: the reactions size the forces of a model whose
+                        // free dofs carry no load.
+                        let m = f_ext[i].abs() + f_int[i].abs() + momenta + damping.abs();
+                        acc[2] += m * m;
+                        acc
+                    },
+                )
+                .reduce(|| [0.0; 3], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2]]);
+        Evaluation {
+            force_scale2: sums[0],
+            magnitude2: sums[2],
+            increment2: sums[1],
+            tangent,
+            failure,
+        }
+    }
+
+    fn residual(&self) -> &[f64] {
+        &self.w.r
+    }
+
+    fn residual_mut(&mut self) -> &mut [f64] {
+        &mut self.w.r
+    }
+
+    fn update_matrix(&mut self, sys: &mut EffectiveSystem) -> Result<Factored> {
+        self.ops.refactor(sys, &self.w.kt)
+    }
+}
+
+/// Runs one implicit step from `s` to `t + h` with `correction`; on acceptance `s`
+/// holds the new state and its ledger line, on rejection `s` is unchanged.
+pub(crate) fn step(
+    model: &Model,
+    ops: &Operators,
+    sys: &mut EffectiveSystem,
+    w: &mut Scratch,
+    correction: &mut dyn Correction,
+    s: &mut State,
+) -> Result<StepOutcome> {
+    let h = ops.h();
+    let t1 = s.t + h;
+    external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext);
+    // The start of the iteration: u_n with the prescribed values of t_{n+1}.
+    w.u.copy_from_slice(&s.u);
+    let mut moving = false;
+    for c in &model.constraints {
+        let target = c.at(t1);
+        if target != s.u[c.dof] {
+            w.u[c.dof] = target;
+            moving = true;
+        }
+    }
+    let mut u = std::mem::take(&mut w.u);
+    let mut nl = std::mem::take(&mut w.nl);
+    let outcome = {
+        let mut problem = ImplicitStep {
+            model,
+            ops,
+            s,
+            w,
+            moving,
+        };
+        nonlinear::solve(&mut problem, correction, sys, &ops.test, &mut u, &mut nl)
+    };
+    w.u = u;
+    w.nl = nl;
+    let report = match outcome? {
+        Outcome::Converged {
+            iterations,
+            residual,
+        } => StepReport {
+            iterations,
+            nl_residual: residual,
+        },
+        other => {
+            let message = describe(model, &other, t1, h);
+            return Ok(StepOutcome::Rejected(Rejection {
+                outcome: other,
+                message,
+            }));
+        }
+    };
+    finish(ops, sys.dofs(), w, s, t1);
+    Ok(StepOutcome::Accepted(report))
+}
+
+/// Books the converged step and makes it the state.
+fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f64) {
+    // Support reactions: on constrained dofs the residual is what the supports give.
+    for &d in &dofs.constrained {
+        w.f_ext[d] += w.r[d];
+    }
+    let dynamic = ops.dynamic();
+    let elastic = ops.response == Response::Elastic;
+    if let Some((h, damp_m, damp_k)) = dynamic {
+        if ops.damped() {
+            let (mv, kdu) = (&w.mv, &w.kdu);
+            w.f_damp.par_iter_mut().enumerate().for_each(|(i, f)| {
+                let kv = if elastic { kdu[i] / h } else { kdu[i] };
+                *f = damp_m * mv[i] + damp_k * kv;
+            });
+        }
+    }
+    // The scheme's lines (kinetic energy and its loss) and, for elastic models, the
+    // stored energy and the material's algorithmic loss, in one pass.
+    let (v, mv, v_n, mv_n) = (&w.v, &w.mv, &s.v, &s.mv);
+    let (u1, f_int, du, kdu) = (&w.u, &w.f_int, &w.du, &w.kdu);
+    let sums = (0..v.len())
+        .into_par_iter()
+        .with_min_len(4096)
+        .fold(
+            || [0.0f64; 4],
+            |mut acc, i| {
+                if dynamic.is_some() {
+                    acc[0] += 0.5 * v[i] * mv[i];
+                    acc[1] += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);
+                }
+                if elastic {
+                    acc[2] += 0.5 * u1[i] * f_int[i];
+                    acc[3] += 0.5 * du[i] * kdu[i];
+                }
+                acc
+            },
+        )
+        .reduce(|| [0.0; 4], |a, b| std::array::from_fn(|k| a[k] + b[k]));
+    let work = step_work(&StepVectors {
+        du: &w.du,
+        f_int_n: &s.f_int,
+        f_int_np1: &w.f_int,
+        f_ext_n: &s.f_ext,
+        f_ext_np1: &w.f_ext,
+        f_damp_np1: ops.damped().then_some(&w.f_damp[..]),
+    });
+    let (elastic_energy, material) = if elastic {
+        (
+            sums[2],
+            Dissipation {
+                numerical: sums[3],
+                ..Default::default()
+            },
+        )
+    } else {
+        (w.totals.psi, w.totals.dissipation)
+    };
+    s.ledger.record(&StepIncrements {
+        kinetic: sums[0],
+        elastic: elastic_energy,
+        work,
+        material,
+        scheme_loss: sums[1],
+        contact: 0.0,
+    });
+    std::mem::swap(&mut s.u, &mut w.u);
+    std::mem::swap(&mut s.f_int, &mut w.f_int);
+    std::mem::swap(&mut s.f_ext, &mut w.f_ext);
+    if dynamic.is_some() {
+        std::mem::swap(&mut s.v, &mut w.v);
+        std::mem::swap(&mut s.mv, &mut w.mv);
+    }
+    if !w.f_pred.is_empty() {
+        std::mem::swap(&mut s.f_pred, &mut w.f_pred);
+        s.f_pred_h = ops.h();
+    }
+    s.points.iter_mut().for_each(|p| p.commit());
+    s.t = t1;
+    s.step += 1;
+}
+
+/// A message for a rejected step: what failed, when, and where.
+fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> String {
+    let when = format!("at t = {t1:.6e} (h = {h:.3e})");
+    match outcome {
+        Outcome::Converged { .. } => format!("converged {when}"),
+        Outcome::NotConverged {
+            iterations,
+            history,
+            worst,
+        } => {
+            let worst = worst
+                .map(|(d, r)| {
+                    format!(
+                        "; largest residual {:.3e} N at {}",
+                        r.abs(),
+                        model.describe_dof(d)
+                    )
+                })
+                .unwrap_or_default();
+            format!(
+                "no convergence {when} after {iterations} iterations; relative residuals [{}]{worst}",
+                history
+                    .iter()
+                    .map(|r| format!("{r:.2e}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        }
+        Outcome::NotPositiveDefinite { dof, message } => format!(
+            "the effective matrix lost positive definiteness {when}{} ({message})",
+            dof.map(|d| format!(" at {}", model.describe_dof(d)))
+                .unwrap_or_default()
+        ),
+        Outcome::MaterialFailure(f) => format!(
+            "the material update found no admissible state {when} at {}",
+            model.describe_point(f.block, f.element)
+        ),
+        Outcome::ConstraintFailure(why) => format!("the constraint solve failed {when}: {why}"),
+    }
+}
+
+/// The integrator parts every implicit scheme holds.
+pub(crate) struct Core<'m> {
+    pub model: &'m Model,
+    pub ops: Operators,
+    pub sys: EffectiveSystem,
+    pub scratch: Scratch,
+    pub correction: Box<dyn Correction + Send>,
+    pub assembly_s: f64,
+    /// Time inside steps besides solves and refactorisations.
+    pub step_other_s: f64,
+}
+
+impl<'m> Core<'m> {
+    /// Assembles, analyses and factorises; a matrix that is not positive definite
+    /// from the start is an error traced to its likely cause.
+    pub fn new(model: &'m Model, backend: Backend, scheme: Scheme) -> Result<Self> {
+        let t0 = Instant::now();
+        let ops = Operators::new(model, scheme);
+        let assembly_s = t0.elapsed().as_secs_f64();
+        let (sys, factored) = ops.initial_system(model, backend)?;
+        if let Factored::NotPositiveDefinite { dof, message } = factored {
+            return Err(Error::Solver {
+                backend: sys.backend(),
+                message: format!(
+                    "the initial effective matrix is not positive definite{} ({message}); \
+                     {}",
+                    dof.map(|d| format!(" at {}", model.describe_dof(d)))
+                        .unwrap_or_default(),
+                    match scheme {
+                        Scheme::Static { .. } =>
+                            "in a static analysis every body needs supports that stop its rigid motion",
+                        Scheme::BackwardEuler { .. } =>
+                            "check the material constants and the step size",
+                    }
+                ),
+            });
+        }
+        let scratch = Scratch::new(model.mesh.n_dofs(), &ops, sys.dofs().n_free());
+        Ok(Core {
+            model,
+            ops,
+            sys,
+            scratch,
+            correction: Box::new(LinearCorrection),
+            assembly_s,
+            step_other_s: 0.0,
+        })
+    }
+
+    /// One step (see [`step`]), timed.
+    pub fn step(&mut self, s: &mut State) -> Result<StepOutcome> {
+        let t = Instant::now();
+        let before = self.sys.timing();
+        let r = step(
+            self.model,
+            &self.ops,
+            &mut self.sys,
+            &mut self.scratch,
+            self.correction.as_mut(),
+            s,
+        );
+        let after = self.sys.timing();
+        self.step_other_s += t.elapsed().as_secs_f64()
+            - (after.solve_s - before.solve_s)
+            - (after.factorization_s - before.factorization_s);
+        r
+    }
+
+    /// Changes the step size; refactorises what depends on it.
+    pub fn set_step(&mut self, h: f64) -> Result<()> {
+        if h == self.ops.h() {
+            return Ok(());
+        }
+        self.ops.set_h(self.model, h);
+        let static_elastic = matches!(self.ops.scheme, Scheme::Static { .. })
+            && self.ops.response == Response::Elastic;
+        if static_elastic || matches!(self.ops.response, Response::StateDependent(_)) {
+            // The static stiffness does not depend on the load step; a state-dependent
+            // matrix is rebuilt at the next step anyway.
+            // The matrix follows the state: it is rebuilt at the next step anyway.
+            return Ok(());
+        }
+        match self.ops.refactor(&mut self.sys, &self.ops.kt)? {
+            Factored::Ok => Ok(()),
+            Factored::NotPositiveDefinite { message, .. } => Err(Error::Stepping(format!(
+                "the effective matrix for h = {h:e} is not positive definite ({message})"
+            ))),
+        }
+    }
+
+    /// Time per phase.
+    pub fn timing(&self) -> super::Timing {
+        let t = self.sys.timing();
+        super::Timing {
+            assembly_s: self.assembly_s,
+            factorization_s: t.analysis_s + t.factorization_s,
+            solve_s: t.solve_s,
+            step_other_s: self.step_other_s,
+        }
+    }
+
+    /// Solver facts.
+    pub fn solver(&self) -> super::SolverFacts {
+        super::SolverFacts {
+            backend: self.sys.backend(),
+            factorizations: self.sys.factorizations(),
+            factor_nnz: self.sys.factor_nnz(),
+        }
+    }
+}

@@ -1,0 +1,121 @@
+//! Adaptive step control for any [`Integrator`]: a step the equilibrium loop rejects
+//! is halved and retried from the same state; after four accepted steps at a reduced
+//! size the step doubles back, never beyond the requested one.
+
+use super::{Integrator, State, StepOutcome, StepReport};
+use crate::error::{Error, Result};
+
+/// What [`march`] reports to its observer.
+pub enum Marched<'a> {
+    /// A step was accepted.
+    Step(&'a StepReport),
+    /// A step was rejected and `h` was halved.
+    Cut {
+        /// The new step size.
+        h: f64,
+        /// Why the step failed.
+        reason: &'a str,
+    },
+}
+
+/// How [`march`] may change the step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepControl {
+    /// The requested step (never exceeded).
+    pub h: f64,
+    /// End time.
+    pub t_end: f64,
+    /// Halvings allowed in a row before the run stops.
+    pub max_cuts: usize,
+}
+
+impl StepControl {
+    /// The model's requested step, end time and cut limit.
+    pub fn of(model: &crate::model::Model) -> Self {
+        let a = &model.analysis;
+        StepControl {
+            h: a.dt,
+            t_end: a.t_end,
+            max_cuts: a.max_cuts,
+        }
+    }
+}
+
+/// Accepted steps at a reduced size before the step doubles back.
+const EASY_STEPS_TO_GROW: usize = 4;
+
+/// Integrates `s` to `control.t_end` (see the module docs). `observe` sees every
+/// accepted step and every cut; an error from it stops the march. On failure the
+/// error names the step and time, and `s` holds the last accepted state.
+pub fn march<I, F>(
+    integrator: &mut I,
+    s: &mut State,
+    control: StepControl,
+    mut observe: F,
+) -> Result<()>
+where
+    I: Integrator + ?Sized,
+    F: FnMut(&State, Marched) -> Result<()>,
+{
+    let StepControl {
+        h: h0,
+        t_end,
+        max_cuts,
+    } = control;
+    let mut h = h0;
+    let (mut cuts_in_row, mut easy) = (0usize, 0usize);
+    while s.t < t_end - 1e-9 * h0 {
+        let h_try = h.min(t_end - s.t);
+        if (h_try - integrator.h()).abs() > 1e-12 * h0 {
+            integrator.set_step(h_try)?;
+        }
+        match integrator.step(s)? {
+            StepOutcome::Accepted(report) => {
+                observe(s, Marched::Step(&report))?;
+                cuts_in_row = 0;
+                if h < h0 {
+                    easy += 1;
+                    if easy >= EASY_STEPS_TO_GROW {
+                        h = (2.0 * h).min(h0);
+                        easy = 0;
+                    }
+                }
+            }
+            StepOutcome::Rejected(r) if cuts_in_row < max_cuts => {
+                cuts_in_row += 1;
+                easy = 0;
+                h *= 0.5;
+                observe(
+                    s,
+                    Marched::Cut {
+                        h,
+                        reason: &r.message,
+                    },
+                )?;
+            }
+            StepOutcome::Rejected(r) => {
+                return Err(Error::Stepping(format!(
+                    "step {} (t = {:.6e}) failed after {cuts_in_row} step cuts: {}",
+                    s.step + 1,
+                    s.t + integrator.h(),
+                    r.message
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Takes `n` steps of the current `h` (no cuts; a rejected step is an error): for
+/// benches and studies. Returns the number of corrections.
+pub fn march_steps<I: Integrator + ?Sized>(
+    integrator: &mut I,
+    s: &mut State,
+    n: usize,
+) -> Result<usize> {
+    let mut solves = 0;
+    for _ in 0..n {
+        solves += integrator.step_accepted(s)?.iterations;
+    }
+    Ok(solves)
+}
