@@ -1,21 +1,36 @@
-//! CHOLMOD against faer: same solutions on SPD matrices, refactorisation on a fixed
-//! pattern, errors (not panics) on bad input, and identical static and dynamic runs.
-#![cfg(feature = "cholmod")]
+//! The linear solver backends: each solves SPD matrices to round-off, refactorises on
+//! a fixed pattern, solves blocks of right-hand sides as the single solves, names the
+//! column of a non-positive pivot, refuses bad input with an error (not a panic), and
+//! uses a given elimination order as it is. With the `cholmod` feature, CHOLMOD and
+//! faer also agree with each other on matrices, static and dynamic runs and their
+//! ledgers. A plain `cargo test` runs the faer half.
 
 use std::path::Path;
+#[cfg(feature = "cholmod")]
 use std::time::Instant;
 
 use rothe::assembly::{Assembler, Mass};
+#[cfg(feature = "cholmod")]
 use rothe::linsolve::cholmod_backend::CholmodCholesky;
 use rothe::linsolve::faer_backend::FaerCholesky;
 use rothe::linsolve::{Backend, LowerCsc, SymmetricSolver};
 use rothe::model::Model;
 use rothe::system::{DofMap, ReducedMatrix};
+#[cfg(feature = "cholmod")]
 use rothe::time::backward_euler::BackwardEuler;
 use rothe::time::statics;
+#[cfg(feature = "cholmod")]
 use rothe::time::Integrator;
 
 const TOL: f64 = 1e-10;
+
+/// A fresh solver of every backend this build has.
+fn backends() -> Vec<Box<dyn SymmetricSolver>> {
+    let mut v: Vec<Box<dyn SymmetricSolver>> = vec![Box::new(FaerCholesky::new())];
+    #[cfg(feature = "cholmod")]
+    v.push(Box::new(CholmodCholesky::new().expect("cholmod starts")));
+    v
+}
 
 /// `max|a − b| / max|b|`.
 fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
@@ -135,141 +150,235 @@ fn test_matrices() -> Vec<(&'static str, LowerCsc)> {
 }
 
 #[test]
-fn both_backends_agree_on_spd_matrices() {
+fn every_backend_solves_spd_matrices() {
     for (name, a) in test_matrices() {
         let b = rhs(a.n);
-        let mut faer = FaerCholesky::new();
-        let mut chol = CholmodCholesky::new().expect("cholmod starts");
-        let xf = solve_with(&mut faer, &a, &b);
-        let xc = solve_with(&mut chol, &a, &b);
-        let d = rel_diff(&xc, &xf);
-        assert!(d < TOL, "{name}: backends differ by {d:e}");
-        let r = residual(&a, &xc, &b);
-        assert!(r < 1e-8, "{name}: cholmod residual {r:e}");
-        let (nf, nc) = (faer.factor_nnz().unwrap(), chol.factor_nnz().unwrap());
-        assert!(nc >= a.row_idx.len(), "{name}: nnz(L) {nc} below nnz(A)");
-        eprintln!(
-            "{name}: n = {}, nnz(L) faer {nf} (len_val), cholmod {nc}",
-            a.n
+        let mut reference: Option<Vec<f64>> = None;
+        for mut solver in backends() {
+            let x = solve_with(solver.as_mut(), &a, &b);
+            let r = residual(&a, &x, &b);
+            assert!(r < 1e-8, "{name}: {} residual {r:e}", solver.name());
+            let nnz = solver.factor_nnz().unwrap();
+            assert!(nnz >= a.row_idx.len(), "{name}: nnz(L) {nnz} below nnz(A)");
+            match &reference {
+                None => reference = Some(x),
+                Some(x0) => {
+                    let d = rel_diff(&x, x0);
+                    assert!(
+                        d < TOL,
+                        "{name}: {} differs from faer by {d:e}",
+                        solver.name()
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn block_solves_equal_the_single_solves() {
+    // Eight right-hand sides solved as one block (the factor is read once) give the
+    // eight single solves.
+    let model = cantilever("dynamic", [20, 6], 1e-4);
+    let h: f64 = 1e-5;
+    let a = effective_matrix(&model, 1.0 / (h * h), 1.0);
+    let k = 8;
+    let block: Vec<f64> = (0..a.n * k)
+        .map(|i| ((i as f64) * 0.13).cos() + (i % 11) as f64 * 0.01)
+        .collect();
+    for mut solver in backends() {
+        solver.analyze(&a).unwrap();
+        solver.factorize(&a).unwrap();
+        let mut x = block.clone();
+        solver.solve_block_in_place(&mut x, k).unwrap();
+        for c in 0..k {
+            let mut y = block[c * a.n..(c + 1) * a.n].to_vec();
+            solver.solve_in_place(&mut y).unwrap();
+            let d = rel_diff(&x[c * a.n..(c + 1) * a.n], &y);
+            assert!(d < 1e-13, "{}: column {c} differs by {d:e}", solver.name());
+        }
+        assert!(solver.solve_block_in_place(&mut x[1..], k).is_err());
+    }
+}
+
+#[test]
+fn a_given_ordering_is_used_as_it_is() {
+    // The nested dissection handed to the solver is the order it factorises in, on
+    // both backends: a comparison of the two compares factorisation codes.
+    let model = cantilever("dynamic", [40, 10], 1e-4);
+    let asm = Assembler::new(&model.mesh);
+    let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+    let reduced = ReducedMatrix::new(&asm.pattern, &dofs);
+    let order = reduced.nested_dissection(&dofs, &model.mesh.coords);
+    let h: f64 = 1e-5;
+    let a = effective_matrix(&model, 1.0 / (h * h), 1.0);
+    let b = rhs(a.n);
+    for mut solver in backends() {
+        solver.set_ordering(order.clone());
+        let x = solve_with(solver.as_mut(), &a, &b);
+        assert_eq!(
+            solver.ordering().as_deref(),
+            Some(&order[..]),
+            "{}",
+            solver.name()
         );
+        assert!(residual(&a, &x, &b) < 1e-8);
     }
 }
 
 #[test]
 fn refactorisation_on_the_same_pattern() {
     let model = cantilever("dynamic", [20, 6], 1e-4);
-    let mut a = effective_matrix(&model, 1e10, 1.0);
-    let b = rhs(a.n);
-    let mut faer = FaerCholesky::new();
-    let mut chol = CholmodCholesky::new().unwrap();
-    faer.analyze(&a).unwrap();
-    chol.analyze(&a).unwrap();
-    let nnz0 = chol.factor_nnz();
-    // Several value sets on one analysis: the step size changes as in `set_step`.
-    for h in [1e-5, 3e-5, 1e-4, 2e-6] {
-        a = effective_matrix(&model, 1.0 / (h * h), 1.0);
-        faer.factorize(&a).unwrap();
-        chol.factorize(&a).unwrap();
-        for scale in [1.0, -2.5] {
-            let mut xf: Vec<f64> = b.iter().map(|v| v * scale).collect();
-            let mut xc = xf.clone();
-            faer.solve_in_place(&mut xf).unwrap();
-            chol.solve_in_place(&mut xc).unwrap();
-            let d = rel_diff(&xc, &xf);
-            assert!(
-                d < TOL,
-                "h = {h:e}, scale {scale}: backends differ by {d:e}"
-            );
-        }
-    }
-    assert_eq!(
-        chol.factor_nnz(),
-        nnz0,
-        "refactorisation changed the pattern"
-    );
-
-    // Refactorising the Laplacian with new values too.
-    let mut l = laplacian(30, 0.5);
-    chol.analyze(&l).unwrap();
-    faer.analyze(&l).unwrap();
-    for shift in [0.5, 1e-4, 10.0] {
-        for (p, v) in l.values.iter_mut().enumerate() {
-            if *v > 0.0 {
-                *v = 4.0 + shift + 1e-3 * (p % 5) as f64;
+    let a0 = effective_matrix(&model, 1e10, 1.0);
+    let b = rhs(a0.n);
+    for mut solver in backends() {
+        let name = solver.name();
+        solver.analyze(&a0).unwrap();
+        let nnz0 = solver.factor_nnz();
+        // Several value sets on one analysis: the step size changes as in `set_step`.
+        for h in [1e-5, 3e-5, 1e-4, 2e-6] {
+            let a = effective_matrix(&model, 1.0 / (h * h), 1.0);
+            solver.factorize(&a).unwrap();
+            let mut fresh = FaerCholesky::new();
+            for scale in [1.0, -2.5] {
+                let bs: Vec<f64> = b.iter().map(|v| v * scale).collect();
+                let mut x = bs.clone();
+                solver.solve_in_place(&mut x).unwrap();
+                let x_ref = solve_with(&mut fresh, &a, &bs);
+                let d = rel_diff(&x, &x_ref);
+                assert!(
+                    d < TOL,
+                    "{name}: h = {h:e}, scale {scale}: differs by {d:e}"
+                );
             }
         }
-        chol.factorize(&l).unwrap();
-        faer.factorize(&l).unwrap();
-        let mut xc = rhs(l.n);
-        let mut xf = xc.clone();
-        chol.solve_in_place(&mut xc).unwrap();
-        faer.solve_in_place(&mut xf).unwrap();
-        assert!(rel_diff(&xc, &xf) < TOL, "shift {shift}");
+        assert_eq!(
+            solver.factor_nnz(),
+            nnz0,
+            "{name}: refactorisation changed the pattern"
+        );
+
+        // Refactorising the Laplacian with new values too.
+        let mut l = laplacian(30, 0.5);
+        solver.analyze(&l).unwrap();
+        for shift in [0.5, 1e-4, 10.0] {
+            for (p, v) in l.values.iter_mut().enumerate() {
+                if *v > 0.0 {
+                    *v = 4.0 + shift + 1e-3 * (p % 5) as f64;
+                }
+            }
+            solver.factorize(&l).unwrap();
+            let mut x = rhs(l.n);
+            solver.solve_in_place(&mut x).unwrap();
+            let x_ref = solve_with(&mut FaerCholesky::new(), &l, &rhs(l.n));
+            assert!(rel_diff(&x, &x_ref) < TOL, "{name}: shift {shift}");
+        }
     }
 }
 
 #[test]
 fn not_positive_definite_is_an_error() {
-    // Indefinite: the Laplacian shifted below its smallest eigenvalue.
-    let mut a = laplacian(10, -1.0);
-    let mut chol = CholmodCholesky::new().unwrap();
-    chol.analyze(&a).unwrap();
-    let e = chol.factorize(&a).expect_err("indefinite matrix must fail");
-    let msg = e.to_string();
-    assert!(msg.contains("cholmod"), "{msg}");
-    assert!(msg.contains("not positive definite"), "{msg}");
-    assert!(msg.contains("column"), "{msg}");
-    eprintln!("indefinite: {msg}");
-    // No solve with a failed factor.
-    let mut x = rhs(a.n);
-    assert!(chol.solve_in_place(&mut x).is_err());
+    for mut solver in backends() {
+        let name = solver.name();
+        // Indefinite: the Laplacian shifted below its smallest eigenvalue.
+        let mut a = laplacian(10, -1.0);
+        solver.analyze(&a).unwrap();
+        let e = solver
+            .factorize(&a)
+            .expect_err("indefinite matrix must fail");
+        let msg = e.to_string();
+        assert!(msg.contains(name), "{msg}");
+        assert!(msg.contains("not positive definite"), "{msg}");
+        assert!(msg.contains("column"), "{msg}");
+        assert!(
+            matches!(e, rothe::Error::NotPositiveDefinite { .. }),
+            "{e:?}"
+        );
+        // No solve with a failed factor.
+        let mut x = rhs(a.n);
+        assert!(solver.solve_in_place(&mut x).is_err());
 
-    // The same analysis still works once the values are fixed.
-    for v in a.values.iter_mut().filter(|v| **v > 0.0) {
-        *v = 5.0;
+        // The same analysis still works once the values are fixed.
+        for v in a.values.iter_mut().filter(|v| **v > 0.0) {
+            *v = 5.0;
+        }
+        solver.factorize(&a).unwrap();
+        let b = rhs(a.n);
+        let mut x = b.clone();
+        solver.solve_in_place(&mut x).unwrap();
+        assert!(residual(&a, &x, &b) < 1e-12);
+
+        // A single negative pivot, named by its column: whatever the elimination
+        // order, the first pivot to fail is that column's (the pivots eliminated
+        // before it do not see its value).
+        let mut d = laplacian(4, 1.0);
+        let p = d.col_ptr[9];
+        d.values[p] = -1.0;
+        let mut fresh = backends().into_iter().find(|s| s.name() == name).unwrap();
+        fresh.analyze(&d).unwrap();
+        match fresh.factorize(&d) {
+            Err(rothe::Error::NotPositiveDefinite {
+                column, message, ..
+            }) => {
+                assert_eq!(column, Some(9), "{name}: {message}");
+                assert!(message.contains("column 9"), "{message}");
+            }
+            other => panic!("{name}: expected a pivot error, got {other:?}"),
+        }
+
+        // The cantilever without its supports: singular stiffness.
+        let mut free_model = cantilever("static", [8, 2], 1e-4);
+        free_model.constraints.clear();
+        let k = stiffness_matrix(&free_model);
+        let mut fresh = backends().into_iter().find(|s| s.name() == name).unwrap();
+        fresh.analyze(&k).unwrap();
+        assert!(
+            fresh.factorize(&k).is_err(),
+            "{name}: singular stiffness must fail"
+        );
+        // The static driver reports it as an error too, naming the likely cause.
+        let backend: Backend = name.parse().unwrap();
+        let e = statics::solve(&free_model, backend, &[0.0]).unwrap_err();
+        assert!(e.to_string().contains("supports"), "{e}");
     }
-    chol.factorize(&a).unwrap();
-    let b = rhs(a.n);
-    let mut x = b.clone();
-    chol.solve_in_place(&mut x).unwrap();
-    assert!(residual(&a, &x, &b) < 1e-12);
-
-    // A single negative pivot, named by its column.
-    let mut d = laplacian(4, 1.0);
-    let p = d.col_ptr[9];
-    d.values[p] = -1.0;
-    let mut chol = CholmodCholesky::new().unwrap();
-    chol.analyze(&d).unwrap();
-    let msg = chol.factorize(&d).unwrap_err().to_string();
-    eprintln!("negative diagonal: {msg}");
-
-    // The cantilever without its supports: singular stiffness.
-    let mut free_model = cantilever("static", [8, 2], 1e-4);
-    free_model.constraints.clear();
-    let k = stiffness_matrix(&free_model);
-    let mut chol = CholmodCholesky::new().unwrap();
-    chol.analyze(&k).unwrap();
-    let r = chol.factorize(&k);
-    assert!(r.is_err(), "singular stiffness must fail");
-    eprintln!("singular K: {}", r.unwrap_err());
-    // The static driver reports it as an error too.
-    assert!(statics::solve(&free_model, Backend::Cholmod, &[0.0]).is_err());
 }
 
 #[test]
 fn bad_input_is_an_error() {
+    for mut solver in backends() {
+        let name = solver.name();
+        let a = laplacian(5, 1.0);
+        let mut x = rhs(a.n);
+        assert!(
+            solver.factorize(&a).is_err(),
+            "{name}: factorize before analyze"
+        );
+        assert!(
+            solver.solve_in_place(&mut x).is_err(),
+            "{name}: solve before analyze"
+        );
+        assert!(solver.factor_nnz().is_none());
+        solver.analyze(&a).unwrap();
+        assert!(
+            solver.solve_in_place(&mut x).is_err(),
+            "{name}: solve before factorize"
+        );
+        solver.factorize(&a).unwrap();
+        let mut short = vec![1.0; a.n - 1];
+        assert!(
+            solver.solve_in_place(&mut short).is_err(),
+            "{name}: rhs length"
+        );
+        let mut x = rhs(a.n);
+        solver.solve_in_place(&mut x).unwrap();
+    }
+}
+
+#[cfg(feature = "cholmod")]
+#[test]
+fn cholmod_checks_the_pattern_it_is_given() {
     let a = laplacian(5, 1.0);
     let mut chol = CholmodCholesky::new().unwrap();
-    let mut x = rhs(a.n);
-    assert!(chol.factorize(&a).is_err(), "factorize before analyze");
-    assert!(chol.solve_in_place(&mut x).is_err(), "solve before analyze");
-    assert!(chol.factor_nnz().is_none());
-    chol.analyze(&a).unwrap();
-    assert!(
-        chol.solve_in_place(&mut x).is_err(),
-        "solve before factorize"
-    );
-
     let mut bad = a.clone();
     bad.row_idx[1] = 99;
     assert!(chol.analyze(&bad).is_err(), "row index out of range");
@@ -291,8 +400,6 @@ fn bad_input_is_an_error() {
     nan.values[3] = f64::NAN;
     assert!(chol.factorize(&nan).is_err(), "NaN value");
     chol.factorize(&a).unwrap();
-    let mut short = vec![1.0; a.n - 1];
-    assert!(chol.solve_in_place(&mut short).is_err(), "rhs length");
     let mut x = rhs(a.n);
     chol.solve_in_place(&mut x).unwrap();
 
@@ -308,6 +415,7 @@ fn bad_input_is_an_error() {
     chol.solve_in_place(&mut []).unwrap();
 }
 
+#[cfg(feature = "cholmod")]
 #[test]
 fn static_cantilever_agrees() {
     let model = cantilever("static", [40, 10], 1e-3);
@@ -322,6 +430,7 @@ fn static_cantilever_agrees() {
     assert!(sf[1].u.iter().any(|&v| v != 0.0));
 }
 
+#[cfg(feature = "cholmod")]
 #[test]
 fn dynamic_cantilever_histories_agree() {
     let model = cantilever("dynamic", [40, 10], 2e-4);
@@ -344,6 +453,27 @@ fn dynamic_cantilever_histories_agree() {
             rel_diff(&sc.v, &sf.v) < TOL,
             "step {step}: velocities differ"
         );
+        // The ledgers agree line by line, relative to the largest energy.
+        let (lf, lc) = (&sf.ledger, &sc.ledger);
+        let scale = lf.scale();
+        let lines = |l: &rothe::energy::Ledger| {
+            let d = l.dissipated();
+            [
+                l.kinetic(),
+                l.elastic(),
+                l.internal(),
+                l.external_work(),
+                d.numerical,
+                d.mass,
+                l.residual(),
+            ]
+        };
+        for (k, (a, b)) in lines(lf).iter().zip(lines(lc)).enumerate() {
+            assert!(
+                (a - b).abs() <= TOL * scale,
+                "step {step}: ledger line {k} differs: {a} vs {b}"
+            );
+        }
     }
     // A step-size change refactorises both on the same pattern.
     bf.set_step(5e-6).unwrap();
@@ -358,6 +488,7 @@ fn dynamic_cantilever_histories_agree() {
 }
 
 /// Probe displacement columns (`*_ux`, `*_uy`) of a `history.csv`.
+#[cfg(feature = "cholmod")]
 fn probe_columns(path: &Path) -> Vec<(String, Vec<f64>)> {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
@@ -378,6 +509,7 @@ fn probe_columns(path: &Path) -> Vec<(String, Vec<f64>)> {
     cols
 }
 
+#[cfg(feature = "cholmod")]
 #[test]
 fn full_run_histories_agree() {
     let model = cantilever("dynamic", [20, 5], 2e-4);
@@ -408,6 +540,7 @@ fn full_run_histories_agree() {
 
 /// Factorisation and solve times of both backends on the same matrices; run with
 /// `cargo test --release --features cholmod --test backends -- --ignored --nocapture`.
+#[cfg(feature = "cholmod")]
 #[test]
 #[ignore]
 fn timing_report() {

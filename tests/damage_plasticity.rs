@@ -7,9 +7,7 @@
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
 use rothe::fe::Plane;
-use rothe::material::mazars::damage_law;
 use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
-use rothe::material::rankine_hill::yield_values;
 use rothe::material::{Material, Model, StrainStep};
 use rothe::model::TimeFunction;
 
@@ -17,6 +15,98 @@ const E: f64 = 33e9;
 const NU: f64 = 0.2;
 const MAZARS: &str = "eps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
 const RH_BILINEAR: &str = "tension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }";
+
+/// Eq. (13) written out: `D(κ) = 1 − (1−A) κ₀/κ − A exp(−B(κ − κ₀))` above the
+/// threshold `κ₀`, zero below.
+fn eq13(kappa: f64, kappa0: f64, a: f64, b: f64) -> f64 {
+    if kappa <= kappa0 {
+        0.0
+    } else {
+        1.0 - (1.0 - a) * kappa0 / kappa - a * (-b * (kappa - kappa0)).exp()
+    }
+}
+
+/// The strength laws of the Rankine-Hill tests, written out from their diagrams.
+#[derive(Clone, Copy)]
+enum Law {
+    /// `σ̄ = f_y + H κ`, `H = E E_t / (E − E_t)` (the uniaxial diagram has slope
+    /// `E_t` after yield: `dσ = E_t dε = E (dε − dκ)`).
+    Bilinear { fy: f64, et: f64 },
+    /// `σ̄ = f_t (1 − κ/κ_u)` down to zero, `κ_u = 2 G_f / (f_t h)`.
+    Softening { ft: f64, gf: f64 },
+    /// Eurocode 2: `σ(ε) = f_cm (kη − η²)/(1 + (k−2)η)`, `η = ε/ε_c1`,
+    /// `k = 1.05 E ε_c1/f_cm`, elastic up to where the secant `σ/ε` meets `E`,
+    /// `κ = ε − σ(ε)/E`, constant past `ε_cu1`.
+    Ec2 { fcm: f64, ec1: f64, ecu1: f64 },
+}
+
+/// `σ̄(κ)` for element size `h`.
+fn strength(law: Law, kappa: f64, h: f64) -> f64 {
+    match law {
+        Law::Bilinear { fy, et } => (fy + E * et / (E - et) * kappa).max(0.0),
+        Law::Softening { ft, gf } => (ft * (1.0 - kappa * ft * h / (2.0 * gf))).max(0.0),
+        Law::Ec2 { fcm, ec1, ecu1 } => {
+            let k = 1.05 * E * ec1 / fcm;
+            let sigma = |eps: f64| {
+                let eta = eps / ec1;
+                fcm * (k * eta - eta * eta) / (1.0 + (k - 2.0) * eta)
+            };
+            // Secant meets E: (k − η) = (k/1.05)(1 + (k−2)η).
+            let eta_y = (k - k / 1.05) / (1.0 + k / 1.05 * (k - 2.0));
+            let kap = |eps: f64| eps - sigma(eps) / E;
+            if kappa >= kap(ecu1) {
+                return sigma(ecu1);
+            }
+            // Bisection on ε ∈ [ε_y, ε_cu1], where κ(ε) increases.
+            let (mut lo, mut hi) = (eta_y * ec1, ecu1);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if kap(mid) < kappa {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            sigma(0.5 * (lo + hi))
+        }
+    }
+}
+
+/// The Rankine and von Mises yield functions at a plane stress: `σ₁ − σ̄_t(κ_t)` and
+/// `√(σ₁² − σ₁σ₂ + σ₂²) − σ̄_c(κ_c)`, principal stresses from Mohr's circle.
+fn yield_functions(
+    tension: Law,
+    compression: Law,
+    sigma: &[f64; 3],
+    kt: f64,
+    kc: f64,
+) -> (f64, f64) {
+    let c = 0.5 * (sigma[0] + sigma[1]);
+    let r = (0.25 * (sigma[0] - sigma[1]).powi(2) + sigma[2] * sigma[2]).sqrt();
+    let (s1, s2) = (c + r, c - r);
+    (
+        s1 - strength(tension, kt, 0.1),
+        (s1 * s1 - s1 * s2 + s2 * s2).sqrt() - strength(compression, kc, 0.1),
+    )
+}
+
+const BILINEAR_T: Law = Law::Bilinear {
+    fy: 2.9e6,
+    et: 1.65e9,
+};
+const BILINEAR_C: Law = Law::Bilinear {
+    fy: 30e6,
+    et: 1.65e9,
+};
+const SOFTENING_T: Law = Law::Softening {
+    ft: 2.9e6,
+    gf: 140.0,
+};
+const EC2_C: Law = Law::Ec2 {
+    fcm: 38e6,
+    ec1: 0.0022,
+    ecu1: 0.0035,
+};
 
 fn mat(text: &str) -> Material {
     let spec: MaterialSpec =
@@ -59,7 +149,7 @@ fn mazars_paper_uniaxial_curves_match_closed_form() {
     let mut peak: f64 = 0.0;
     for r in &recs[1..] {
         let e = r.eps[0];
-        let want = (1.0 - damage_law(e, 1e-4, 1.0, 1e4).min(0.99999)) * E * e;
+        let want = (1.0 - eq13(e, 1e-4, 1.0, 1e4).min(0.99999)) * E * e;
         assert!(
             (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
             "tension at ε = {e}"
@@ -71,7 +161,7 @@ fn mazars_paper_uniaxial_curves_match_closed_form() {
     for r in &recs[1..] {
         let e = r.eps[0];
         // With A_c > 1 the law dips below zero just past the threshold: D ≥ 0 holds.
-        let want = (1.0 - damage_law(-e, 1e-4, 1.2, 1.5e3).clamp(0.0, 0.99999)) * E * e;
+        let want = (1.0 - eq13(-e, 1e-4, 1.2, 1.5e3).clamp(0.0, 0.99999)) * E * e;
         assert!(
             (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
             "compression at ε = {e}"
@@ -89,7 +179,7 @@ fn mazars_classic_uniaxial_curves_match_closed_form() {
     ));
     for r in &uniaxial(&m, vec![[0.0, 0.0], [1.0, 1e-3]], 500)[1..] {
         let e = r.eps[0];
-        let want = (1.0 - damage_law(e, 1e-4, 1.0, 1e4).min(0.99999)) * E * e;
+        let want = (1.0 - eq13(e, 1e-4, 1.0, 1e4).min(0.99999)) * E * e;
         assert!(
             (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
             "tension at ε = {e}"
@@ -98,7 +188,7 @@ fn mazars_classic_uniaxial_curves_match_closed_form() {
     for r in &uniaxial(&m, vec![[0.0, 0.0], [1.0, -8e-3]], 500)[1..] {
         let e = r.eps[0];
         let k = 2f64.sqrt() * NU * e.abs();
-        let want = (1.0 - damage_law(k, 1e-4, 1.2, 1.5e3).clamp(0.0, 0.99999)) * E * e;
+        let want = (1.0 - eq13(k, 1e-4, 1.2, 1.5e3).clamp(0.0, 0.99999)) * E * e;
         assert!(
             (r.response.sigma[0] - want).abs() <= 1e-9 * E * 1e-4,
             "compression at ε = {e}"
@@ -225,16 +315,13 @@ fn rankine_hill_corner_return_satisfies_kkt() {
     // the plastic strain increment lies in the normal cone, coaxial with the stress:
     // Δεᵖ = Δλ_t (1, 0) + Δλ_c ∂q/∂σ in the principal frame.
     let m = mat(&format!("model = \"rankine_hill\"\n{RH_BILINEAR}"));
-    let Model::RankineHill(p) = m.model else {
-        unreachable!()
-    };
     for (ex, ey, g) in [
         (1.5e-3, -1.6e-3, 0.0),
         (1.2e-3, -1.4e-3, 3e-4),
         (2e-3, -2e-3, -5e-4),
     ] {
         let (r, st) = rh_point(&m, [0.0; 3], [ex, ey, g], &[0.0; 5]);
-        let (ft, fc) = yield_values(&p, E, 0.1, &r.sigma, st[3], st[4]);
+        let (ft, fc) = yield_functions(BILINEAR_T, BILINEAR_C, &r.sigma, st[3], st[4]);
         let tol = 1e-6 * 30e6;
         assert!(
             ft.abs() < tol && fc.abs() < tol,
@@ -344,8 +431,9 @@ proptest! {
             prop_assert!(d.damage >= 0.0 && d.plastic >= 0.0, "dissipation {:?}", d);
             match m.model {
                 Model::Mazars(_) => prop_assert!(st[2] >= st_n[2] && st[2] < 1.0),
-                Model::RankineHill(p) => {
-                    let (ft, fc) = yield_values(&p, E, 0.1, &r.sigma, st[3], st[4]);
+                Model::RankineHill(_) => {
+                    let (t, c) = if variant == 2 { (BILINEAR_T, BILINEAR_C) } else { (SOFTENING_T, EC2_C) };
+                    let (ft, fc) = yield_functions(t, c, &r.sigma, st[3], st[4]);
                     prop_assert!(ft <= 1e-6 * 2.9e6 && fc <= 1e-6 * 30e6, "f_t = {}, f_c = {}", ft, fc);
                     prop_assert!(st[3] >= st_n[3] && st[4] >= st_n[4]);
                 }

@@ -203,8 +203,8 @@ pub enum MaterialSpec {
         /// Density (kg/m³).
         rho: f64,
         /// `paper` (default) or `classic`.
-        #[serde(default = "default_variant")]
-        variant: String,
+        #[serde(default)]
+        variant: crate::material::MazarsVariant,
         /// Tensile threshold `ε_t^0` (classic: `κ_0`).
         eps_t0: f64,
         /// Compressive threshold `ε_c^0` (paper variant; default `eps_t0`).
@@ -256,10 +256,6 @@ pub enum MaterialSpec {
         /// Dashpot time (s).
         beta: f64,
     },
-}
-
-fn default_variant() -> String {
-    "paper".into()
 }
 
 fn default_mazars_beta() -> f64 {

@@ -270,7 +270,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             e,
             nu,
             rho,
-            ref variant,
+            variant,
             eps_t0,
             eps_c0,
             a_t,
@@ -280,17 +280,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             beta,
             d_max,
         } => {
-            use crate::material::{MazarsParams, MazarsVariant};
-            let variant = match variant.as_str() {
-                "paper" => MazarsVariant::Paper,
-                "classic" => MazarsVariant::Classic,
-                v => {
-                    return Err(Error::config(
-                        format!("{field}.variant"),
-                        format!("unknown variant `{v}` (expected paper or classic)"),
-                    ))
-                }
-            };
+            use crate::material::MazarsParams;
             positive(&format!("{field}.eps_t0"), eps_t0)?;
             let eps_c0 = eps_c0.unwrap_or(eps_t0);
             positive(&format!("{field}.eps_c0"), eps_c0)?;

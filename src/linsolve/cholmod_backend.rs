@@ -334,6 +334,10 @@ impl SymmetricSolver for CholmodCholesky {
         } else {
             CHOLMOD_AMD as i32
         };
+        // A given order is used as it is (the nested dissection of `super::ordering`
+        // is postordered already), so both backends factorise the same permuted
+        // matrix; CHOLMOD's own AMD order is postordered.
+        self.common.postorder = i32::from(given.is_none());
         // SAFETY: `header` describes valid, checked arrays (n + 1 column pointers, nnz
         // in-range sorted row indices and nnz values) owned by `self` and alive for the
         // call; `common` was started in `new`; a given permutation holds n distinct

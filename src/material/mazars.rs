@@ -19,10 +19,12 @@
 use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 use crate::fe::Plane;
 
-/// Which Mazars law.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which Mazars law (`variant = "paper" | "classic"` in a scenario).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum MazarsVariant {
     /// Eqs. (11)-(13) of the paper.
+    #[default]
     Paper,
     /// Mazars (1984), as other FE codes ship it.
     Classic,

@@ -448,18 +448,3 @@ fn numerical_elastic(c: &[[f64; 3]; 3], eps: &[f64; 3], eps_n: &[f64; 3]) -> f64
     let de = [eps[0] - eps_n[0], eps[1] - eps_n[1], eps[2] - eps_n[2]];
     0.5 * dot3(&de, &mul3(c, &de))
 }
-
-/// Values of the yield functions `(f_t, f_c)` at a stress for given `κ_t, κ_c`.
-pub fn yield_values(
-    p: &RankineHillParams,
-    e: f64,
-    h: f64,
-    sigma: &[f64; 3],
-    kt: f64,
-    kc: f64,
-) -> (f64, f64) {
-    let (s1, s2, _) = principal_stress(sigma);
-    let (yt, _) = p.tension.strength(kt, e, h);
-    let (yc, _) = p.compression.strength(kc, e, h);
-    (s1 - yt, q_and_n(&[s1, s2]).0 - yc)
-}

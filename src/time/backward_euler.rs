@@ -81,6 +81,12 @@ impl<'m> BackwardEuler<'m> {
         self.core.sys.dofs()
     }
 
+    /// Relative residuals of the last step's equilibrium iterations, one per
+    /// evaluation of the residual.
+    pub fn residual_history(&self) -> &[f64] {
+        self.core.scratch.history()
+    }
+
     /// The effective system (matrix, factor, solves).
     pub fn system(&mut self) -> &mut EffectiveSystem {
         &mut self.core.sys

@@ -311,19 +311,19 @@ impl Operators {
 #[derive(Default)]
 pub(crate) struct Scratch {
     /// The iterate `u_{n+1}`.
-    u: Vec<f64>,
+    u_np1: Vec<f64>,
     /// `u − u_n`.
     du: Vec<f64>,
     /// `v_{n+1} = Δu/h`.
-    v: Vec<f64>,
+    v_np1: Vec<f64>,
     /// `M v_{n+1}`.
-    mv: Vec<f64>,
+    mv_np1: Vec<f64>,
     /// `f_int(u)`.
-    f_int: Vec<f64>,
+    f_int_np1: Vec<f64>,
     /// Applied external forces at `t_{n+1}`; the reactions are added once converged.
-    f_ext: Vec<f64>,
+    f_ext_np1: Vec<f64>,
     /// Predicted internal force of the following step.
-    f_pred: Vec<f64>,
+    f_pred_np1: Vec<f64>,
     /// `K Δu` (elastic) or `K v` (stiffness damping of history materials).
     kdu: Vec<f64>,
     /// `M Δu_c` in a prediction.
@@ -342,16 +342,21 @@ pub(crate) struct Scratch {
 }
 
 impl Scratch {
+    /// Relative residuals of the last step, one per evaluation.
+    pub fn history(&self) -> &[f64] {
+        self.nl.history()
+    }
+
     pub fn new(n: usize, ops: &Operators, n_free: usize) -> Self {
         let z = || vec![0.0; n];
         Scratch {
-            u: z(),
+            u_np1: z(),
             du: z(),
-            v: z(),
-            mv: z(),
-            f_int: z(),
-            f_ext: z(),
-            f_pred: if ops.response == Response::Constant {
+            v_np1: z(),
+            mv_np1: z(),
+            f_int_np1: z(),
+            f_ext_np1: z(),
+            f_pred_np1: if ops.response == Response::Constant {
                 z()
             } else {
                 Vec::new()
@@ -410,7 +415,7 @@ impl StepProblem for ImplicitStep<'_> {
         }
         let inertia = ops.dynamic().map(|(h, _, _)| h);
         let moving = self.moving;
-        let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext, &w.m_du, &w.kdu, &w.kt_du);
+        let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext_np1, &w.m_du, &w.kdu, &w.kt_du);
         w.r.par_iter_mut().enumerate().for_each(|(i, r)| {
             let mut x = base[i] - f_ext[i];
             if let Some(h) = inertia {
@@ -441,7 +446,7 @@ impl StepProblem for ImplicitStep<'_> {
         let h = ops.h();
         let dynamic = ops.dynamic();
         w.du.par_iter_mut()
-            .zip(w.v.par_iter_mut())
+            .zip(w.v_np1.par_iter_mut())
             .zip(u.par_iter().zip(s.u.par_iter()))
             .for_each(|((du, v), (a, b))| {
                 *du = a - b;
@@ -454,40 +459,41 @@ impl StepProblem for ImplicitStep<'_> {
                 // K Δu (and M v with a consistent mass) in one pass over the pattern.
                 match (&ops.mass, dynamic.is_some()) {
                     (Mass::Consistent(m), true) => {
-                        p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.v, &mut w.mv)
+                        p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.v_np1, &mut w.mv_np1)
                     }
                     (_, true) => {
                         p.matvec(&ops.k, &w.du, &mut w.kdu);
-                        ops.mass.matvec(p, &w.v, &mut w.mv);
+                        ops.mass.matvec(p, &w.v_np1, &mut w.mv_np1);
                     }
                     (_, false) => p.matvec(&ops.k, &w.du, &mut w.kdu),
                 }
-                w.f_int
+                w.f_int_np1
                     .par_iter_mut()
                     .zip(s.f_int.par_iter().zip(w.kdu.par_iter()))
                     .for_each(|(f, (f0, kd))| *f = f0 + kd);
             }
             _ => {
-                let pred = (!w.f_pred.is_empty()).then_some(&mut w.f_pred[..]);
+                let pred = (!w.f_pred_np1.is_empty()).then_some(&mut w.f_pred_np1[..]);
                 let kt = tangent.then_some(&mut w.kt[..]);
                 let pass = PointPass {
                     u,
                     dt: h,
                     at_rest: false,
                 };
-                w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int, pred, kt);
+                w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int_np1, pred, kt);
                 failure = w.totals.failure;
                 if let Some((_, _, damp_k)) = dynamic {
-                    ops.mass.matvec(p, &w.v, &mut w.mv);
+                    ops.mass.matvec(p, &w.v_np1, &mut w.mv_np1);
                     if damp_k != 0.0 {
-                        p.matvec(&ops.k, &w.v, &mut w.kdu);
+                        p.matvec(&ops.k, &w.v_np1, &mut w.kdu);
                     }
                 }
             }
         }
         // The residual and its scales, in one pass.
         let elastic = ops.response == Response::Elastic;
-        let (mv, mv_n, kdu, f_int, f_ext, du) = (&w.mv, &s.mv, &w.kdu, &w.f_int, &w.f_ext, &w.du);
+        let (mv, mv_n, kdu, f_int, f_ext, du) =
+            (&w.mv_np1, &s.mv, &w.kdu, &w.f_int_np1, &w.f_ext_np1, &w.du);
         let fixed = &ops.constrained;
         let sums =
             w.r.par_iter_mut()
@@ -560,18 +566,18 @@ pub(crate) fn step(
 ) -> Result<StepOutcome> {
     let h = ops.h();
     let t1 = s.t + h;
-    external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext);
+    external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
     // The start of the iteration: u_n with the prescribed values of t_{n+1}.
-    w.u.copy_from_slice(&s.u);
+    w.u_np1.copy_from_slice(&s.u);
     let mut moving = false;
     for c in &model.constraints {
         let target = c.at(t1);
         if target != s.u[c.dof] {
-            w.u[c.dof] = target;
+            w.u_np1[c.dof] = target;
             moving = true;
         }
     }
-    let mut u = std::mem::take(&mut w.u);
+    let mut u = std::mem::take(&mut w.u_np1);
     let mut nl = std::mem::take(&mut w.nl);
     let outcome = {
         let mut problem = ImplicitStep {
@@ -583,7 +589,7 @@ pub(crate) fn step(
         };
         nonlinear::solve(&mut problem, correction, sys, &ops.test, &mut u, &mut nl)
     };
-    w.u = u;
+    w.u_np1 = u;
     w.nl = nl;
     let report = match outcome? {
         Outcome::Converged {
@@ -609,13 +615,13 @@ pub(crate) fn step(
 fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f64) {
     // Support reactions: on constrained dofs the residual is what the supports give.
     for &d in &dofs.constrained {
-        w.f_ext[d] += w.r[d];
+        w.f_ext_np1[d] += w.r[d];
     }
     let dynamic = ops.dynamic();
     let elastic = ops.response == Response::Elastic;
     if let Some((h, damp_m, damp_k)) = dynamic {
         if ops.damped() {
-            let (mv, kdu) = (&w.mv, &w.kdu);
+            let (mv, kdu) = (&w.mv_np1, &w.kdu);
             w.f_damp.par_iter_mut().enumerate().for_each(|(i, f)| {
                 let kv = if elastic { kdu[i] / h } else { kdu[i] };
                 *f = damp_m * mv[i] + damp_k * kv;
@@ -624,8 +630,8 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
     }
     // The scheme's lines (kinetic energy and its loss) and, for elastic models, the
     // stored energy and the material's algorithmic loss, in one pass.
-    let (v, mv, v_n, mv_n) = (&w.v, &w.mv, &s.v, &s.mv);
-    let (u1, f_int, du, kdu) = (&w.u, &w.f_int, &w.du, &w.kdu);
+    let (v, mv, v_n, mv_n) = (&w.v_np1, &w.mv_np1, &s.v, &s.mv);
+    let (u1, f_int, du, kdu) = (&w.u_np1, &w.f_int_np1, &w.du, &w.kdu);
     let sums = (0..v.len())
         .into_par_iter()
         .with_min_len(4096)
@@ -647,9 +653,9 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
     let work = step_work(&StepVectors {
         du: &w.du,
         f_int_n: &s.f_int,
-        f_int_np1: &w.f_int,
+        f_int_np1: &w.f_int_np1,
         f_ext_n: &s.f_ext,
-        f_ext_np1: &w.f_ext,
+        f_ext_np1: &w.f_ext_np1,
         f_damp_np1: ops.damped().then_some(&w.f_damp[..]),
     });
     let (elastic_energy, material) = if elastic {
@@ -671,15 +677,15 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
         scheme_loss: sums[1],
         contact: 0.0,
     });
-    std::mem::swap(&mut s.u, &mut w.u);
-    std::mem::swap(&mut s.f_int, &mut w.f_int);
-    std::mem::swap(&mut s.f_ext, &mut w.f_ext);
+    std::mem::swap(&mut s.u, &mut w.u_np1);
+    std::mem::swap(&mut s.f_int, &mut w.f_int_np1);
+    std::mem::swap(&mut s.f_ext, &mut w.f_ext_np1);
     if dynamic.is_some() {
-        std::mem::swap(&mut s.v, &mut w.v);
-        std::mem::swap(&mut s.mv, &mut w.mv);
+        std::mem::swap(&mut s.v, &mut w.v_np1);
+        std::mem::swap(&mut s.mv, &mut w.mv_np1);
     }
-    if !w.f_pred.is_empty() {
-        std::mem::swap(&mut s.f_pred, &mut w.f_pred);
+    if !w.f_pred_np1.is_empty() {
+        std::mem::swap(&mut s.f_pred, &mut w.f_pred_np1);
         s.f_pred_h = ops.h();
     }
     s.points.iter_mut().for_each(|p| p.commit());

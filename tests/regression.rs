@@ -1,0 +1,148 @@
+//! Regression: small runs whose histories are kept as reference data
+//! (`tests/regression/NAME.csv` beside `NAME.toml`), so any change of results shows.
+//! Each reference row is matched by its time to a row of the run's `history.csv`;
+//! every kept column (ledger lines and probe displacements) must agree to the
+//! tolerance of its scenario, relative to the column's largest value.
+//!
+//! The references were written by the code before the equilibrium loop was
+//! reshaped (commit 932f280), so the reshaped code is checked against it. To
+//! rewrite them after a change of results that is understood and right:
+//! `ROTHE_BLESS=1 cargo test --release --test regression`, and say in the commit
+//! which results moved, by how much and why.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use rothe::linsolve::Backend;
+use rothe::run::{run, RunOptions};
+
+/// The scenarios and their tolerances: linear runs agree to round-off, runs that
+/// iterate agree far below their equilibrium tolerance (1e-8 on the residual):
+/// the iterations themselves must not change.
+const CASES: [(&str, f64); 6] = [
+    ("elastic_cantilever", 1e-10),
+    ("damped_lumped_gravity", 1e-10),
+    ("sls_wave_bar", 1e-10),
+    ("static_ramp", 1e-10),
+    ("mazars_cantilever", 1e-9),
+    ("rankine_hill_cantilever", 1e-9),
+];
+
+/// Columns kept in the references.
+fn kept(name: &str) -> bool {
+    matches!(
+        name,
+        "t" | "E_kin"
+            | "E_int"
+            | "W_ext"
+            | "E_el"
+            | "D_viscous"
+            | "D_damage"
+            | "D_plastic"
+            | "D_contact"
+            | "D_mass"
+            | "D_num"
+    ) || name.ends_with("_ux")
+        || name.ends_with("_uy")
+}
+
+/// Columns by name of a CSV file (kept columns only).
+fn read_csv(path: &Path) -> BTreeMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let mut cols: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for line in lines {
+        for (name, v) in header.iter().zip(line.split(',')) {
+            if kept(name) {
+                cols.entry(name.to_string())
+                    .or_default()
+                    .push(v.trim().parse().unwrap());
+            }
+        }
+    }
+    cols
+}
+
+fn write_csv(path: &Path, cols: &BTreeMap<String, Vec<f64>>) {
+    let names: Vec<&String> = std::iter::once(cols.keys().find(|k| *k == "t").unwrap())
+        .chain(cols.keys().filter(|k| *k != "t"))
+        .collect();
+    let mut out = names
+        .iter()
+        .map(|s| s.as_str())
+        .collect::<Vec<_>>()
+        .join(",")
+        + "\n";
+    for i in 0..cols["t"].len() {
+        let row: Vec<String> = names
+            .iter()
+            .map(|n| format!("{:.12e}", cols[*n][i]))
+            .collect();
+        out += &row.join(",");
+        out += "\n";
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+fn dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/regression")
+}
+
+#[test]
+fn histories_match_their_references() {
+    let bless = std::env::var_os("ROTHE_BLESS").is_some();
+    let tmp = tempfile::tempdir().unwrap();
+    for (name, tol) in CASES {
+        let model = rothe::config::load(&dir().join(format!("{name}.toml"))).unwrap();
+        let out = tmp.path().join(name);
+        run(
+            &model,
+            &RunOptions {
+                out: out.clone(),
+                backend: Backend::Faer,
+                progress: false,
+            },
+        )
+        .unwrap();
+        let got = read_csv(&out.join("history.csv"));
+        let reference = dir().join(format!("{name}.csv"));
+        if bless {
+            write_csv(&reference, &got);
+            continue;
+        }
+        let want = read_csv(&reference);
+        let t_got = &got["t"];
+        // Energy lines share one scale (the largest energy), so a line that is
+        // round-off in one version and exactly zero in the other compares.
+        let max_of = |v: &Vec<f64>| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let energy = |c: &str| c.starts_with('E') || c.starts_with('W') || c.starts_with('D');
+        let energy_scale = want
+            .iter()
+            .filter(|(c, _)| energy(c))
+            .map(|(_, v)| max_of(v))
+            .fold(0.0, f64::max);
+        for (col, values) in &want {
+            let scale = if energy(col) {
+                energy_scale
+            } else {
+                max_of(values)
+            };
+            let have = got
+                .get(col)
+                .unwrap_or_else(|| panic!("{name}: column {col} is gone"));
+            for (i, (&t, &v)) in want["t"].iter().zip(values).enumerate() {
+                let j = t_got
+                    .iter()
+                    .position(|&x| (x - t).abs() <= 1e-9 * t.abs().max(1e-12))
+                    .unwrap_or_else(|| panic!("{name}: no row at t = {t}"));
+                assert!(
+                    (have[j] - v).abs() <= tol * scale + 1e-300,
+                    "{name}: {col} at row {i} (t = {t:e}) is {} against {v} (scale {scale:e}, tolerance {tol:e})",
+                    have[j]
+                );
+            }
+        }
+        assert!(want["t"].len() >= 10, "{name}: reference too short");
+    }
+}
