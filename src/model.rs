@@ -175,8 +175,8 @@ pub struct Analysis {
     pub ordering: Ordering,
 }
 
-/// Fill-reducing ordering of the effective matrix for the faer backend (CHOLMOD
-/// always orders with its own AMD).
+/// Fill-reducing ordering of the effective matrix. Nested dissection is handed to
+/// both backends; `Amd` lets each backend run its own AMD.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum Ordering {

@@ -64,6 +64,7 @@ fn read_csv(path: &Path) -> BTreeMap<String, Vec<f64>> {
     cols
 }
 
+#[allow(clippy::needless_range_loop)] // rows across several columns
 fn write_csv(path: &Path, cols: &BTreeMap<String, Vec<f64>>) {
     let names: Vec<&String> = std::iter::once(cols.keys().find(|k| *k == "t").unwrap())
         .chain(cols.keys().filter(|k| *k != "t"))
