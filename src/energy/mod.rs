@@ -14,9 +14,10 @@
 //! The trapezoidal work of the internal forces `E_int` is reported beside.
 //! Derivation: `theory/energy.md`.
 //!
-//! The work terms every scheme shares are formed by one function ([`work::step_work`]);
-//! a scheme adds only its kinetic energy and its own loss, a constraint its own line
-//! ([`StepIncrements`]).
+//! The work terms every scheme shares are defined once ([`work::work_integrands`],
+//! summed by [`work::step_work`] or inside a scheme's own pass over the step's
+//! vectors); a scheme adds only its kinetic energy and its own loss, a constraint its
+//! own line ([`StepIncrements`]).
 
 pub mod work;
 
@@ -24,7 +25,7 @@ use std::ops::{Add, AddAssign};
 
 use serde::Serialize;
 
-pub use work::{step_work, StepVectors, StepWork};
+pub use work::{step_work, work_integrands, StepVectors, StepWork};
 
 /// Dissipation by mechanism: a step's increments at a material point (per unit
 /// volume), their integral over the mesh, or a run's cumulative totals. Added with

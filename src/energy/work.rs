@@ -41,6 +41,40 @@ pub struct StepWork {
     pub damping: f64,
 }
 
+/// The work terms' integrands at one dof, `[Δu(f_int,n + f_int,n+1),
+/// Δu(f_ext,n + f_ext,n+1), Δu(f_ext,n+1 − f_ext,n), Δu f_damp,n+1]`: summed over the
+/// dofs by [`step_work`], or inside a scheme's own pass over the step's vectors
+/// (which then forms the terms with [`StepWork::from_sums`]), so there is one
+/// definition of the work terms whichever pass sums them.
+#[inline(always)]
+pub fn work_integrands(
+    du: f64,
+    f_int_n: f64,
+    f_int_np1: f64,
+    f_ext_n: f64,
+    f_ext_np1: f64,
+    f_damp_np1: f64,
+) -> [f64; 4] {
+    [
+        du * (f_int_n + f_int_np1),
+        du * (f_ext_n + f_ext_np1),
+        du * (f_ext_np1 - f_ext_n),
+        du * f_damp_np1,
+    ]
+}
+
+impl StepWork {
+    /// The terms from the sums of [`work_integrands`] over the dofs.
+    pub fn from_sums(sums: [f64; 4]) -> StepWork {
+        StepWork {
+            internal: 0.5 * sums[0],
+            external: 0.5 * sums[1],
+            load_jump: 0.5 * sums[2],
+            damping: sums[3],
+        }
+    }
+}
+
 /// Forms the work terms of a step (one parallel pass over the dofs).
 pub fn step_work(v: &StepVectors) -> StepWork {
     let n = v.du.len();
@@ -52,24 +86,20 @@ pub fn step_work(v: &StepVectors) -> StepWork {
         .with_min_len(4096)
         .fold(
             || [0.0f64; 4],
-            |mut acc, i| {
-                let d = v.du[i];
-                acc[0] += d * (v.f_int_n[i] + v.f_int_np1[i]);
-                acc[1] += d * (v.f_ext_n[i] + v.f_ext_np1[i]);
-                acc[2] += d * (v.f_ext_np1[i] - v.f_ext_n[i]);
-                if let Some(c) = v.f_damp_np1 {
-                    acc[3] += d * c[i];
-                }
-                acc
+            |acc, i| {
+                let w = work_integrands(
+                    v.du[i],
+                    v.f_int_n[i],
+                    v.f_int_np1[i],
+                    v.f_ext_n[i],
+                    v.f_ext_np1[i],
+                    v.f_damp_np1.map_or(0.0, |c| c[i]),
+                );
+                std::array::from_fn(|k| acc[k] + w[k])
             },
         )
         .reduce(|| [0.0; 4], |a, b| std::array::from_fn(|k| a[k] + b[k]));
-    StepWork {
-        internal: 0.5 * sums[0],
-        external: 0.5 * sums[1],
-        load_jump: 0.5 * sums[2],
-        damping: sums[3],
-    }
+    StepWork::from_sums(sums)
 }
 
 #[cfg(test)]

@@ -62,10 +62,10 @@ pub trait StepProblem {
     /// Whether one correction from the predicted residual is exact (affine problem
     /// with a constant, already factorised effective matrix).
     fn is_affine(&self) -> bool;
-    /// For an affine problem: writes the residual at `u` into [`StepProblem::residual`]
-    /// (free dofs) without evaluating the materials, and returns true; false when no
-    /// exact prediction is at hand.
-    fn predict(&mut self, u: &[f64]) -> bool;
+    /// For an affine problem: writes `−r(u)` on the free dofs (`free[eq]` the dof of
+    /// equation `eq`) into `rhs` without evaluating the materials, and returns true;
+    /// false when no exact prediction is at hand.
+    fn predict(&mut self, u: &[f64], free: &[usize], rhs: &mut Vec<f64>) -> bool;
     /// Whether the evaluation of iteration `iteration` should assemble the tangent.
     fn wants_tangent(&self, iteration: usize) -> bool;
     /// Evaluates the residual at `u` (all dofs: on constrained dofs it is the reaction
@@ -78,6 +78,18 @@ pub trait StepProblem {
     /// Refills and refactorises the effective matrix with the last evaluation's
     /// tangent.
     fn update_matrix(&mut self, sys: &mut EffectiveSystem) -> Result<Factored>;
+
+    /// Adds the correction `delta` (one entry per free dof, `free[eq]` its dof) to
+    /// the iterate `u` and returns `|delta|²`. A problem that keeps quantities of the
+    /// iterate (the increment `u − u_n`) updates them here in the same pass.
+    fn apply_correction(&mut self, u: &mut [f64], free: &[usize], delta: &[f64]) -> f64 {
+        let mut c2 = 0.0;
+        for (&d, &x) in free.iter().zip(delta) {
+            u[d] += x;
+            c2 += x * x;
+        }
+        c2
+    }
 }
 
 /// How the equilibrium loop ended.
@@ -186,11 +198,9 @@ where
     let affine = problem.is_affine();
     let mut iterations = 0;
     let mut last_correction: Option<f64> = None;
-    let mut predicted = affine && problem.predict(u);
+    let mut predicted = affine && problem.predict(u, &sys.dofs().free, &mut scratch.rhs);
     loop {
-        if predicted {
-            gather(problem.residual(), &sys.dofs().free, &mut scratch.rhs);
-        } else {
+        if !predicted {
             let ev = problem.evaluate(u, problem.wants_tangent(iterations));
             if let Some(f) = ev.failure {
                 return Ok(Outcome::MaterialFailure(f));
@@ -233,12 +243,7 @@ where
         if let Corrected::Failed(why) = correction.correct(sys, u, &mut scratch.rhs)? {
             return Ok(Outcome::ConstraintFailure(why));
         }
-        let mut c2 = 0.0;
-        for (eq, &d) in sys.dofs().free.iter().enumerate() {
-            let delta = scratch.rhs[eq];
-            u[d] += delta;
-            c2 += delta * delta;
-        }
+        let c2 = problem.apply_correction(u, &sys.dofs().free, &scratch.rhs);
         last_correction = Some(c2.sqrt());
         iterations += 1;
     }

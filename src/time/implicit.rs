@@ -20,7 +20,7 @@ use super::forces::{external_force, gravity_force};
 use super::{Rejection, State, StepOutcome, StepReport};
 use crate::assembly::internal::{new_stores, PointPass, PointTotals};
 use crate::assembly::{Assembler, Mass};
-use crate::energy::{step_work, Dissipation, Ledger, StepIncrements, StepVectors};
+use crate::energy::{work_integrands, Dissipation, Ledger, StepIncrements, StepWork};
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;
 use crate::model::{IterationMethod, Model};
@@ -71,8 +71,9 @@ pub(crate) struct Operators {
     /// The constant tangent of `Response::Constant` for the current step size.
     pub kt: Vec<f64>,
     pub scheme: Scheme,
-    /// Constrained dofs, for sums over the free dofs.
-    pub constrained: Vec<bool>,
+    /// 1 on free dofs, 0 on constrained ones (sums over the free dofs without a
+    /// branch).
+    pub free_mask: Vec<f64>,
     pub test: Convergence,
 }
 
@@ -92,9 +93,9 @@ impl Operators {
         } else {
             Response::StateDependent(a.iteration)
         };
-        let mut constrained = vec![false; model.mesh.n_dofs()];
+        let mut free_mask = vec![1.0; model.mesh.n_dofs()];
         for c in &model.constraints {
-            constrained[c.dof] = true;
+            free_mask[c.dof] = 0.0;
         }
         let mut ops = Operators {
             asm,
@@ -104,7 +105,7 @@ impl Operators {
             response,
             kt: Vec::new(),
             scheme,
-            constrained,
+            free_mask,
             test: Convergence {
                 tolerance: a.tolerance,
                 displacement_tolerance: a.displacement_tolerance,
@@ -228,10 +229,6 @@ impl Operators {
         }
     }
 
-    fn damped(&self) -> bool {
-        matches!(self.scheme, Scheme::BackwardEuler { damp_m, damp_k, .. } if damp_m != 0.0 || damp_k != 0.0)
-    }
-
     fn internal(
         &self,
         model: &Model,
@@ -332,12 +329,14 @@ pub(crate) struct Scratch {
     kt_du: Vec<f64>,
     /// The residual (all dofs).
     r: Vec<f64>,
-    /// Damping force `C v_{n+1}` for the ledger.
-    f_damp: Vec<f64>,
     /// Tangent of the last evaluation (state-dependent materials).
     kt: Vec<f64>,
     /// Material totals of the last evaluation.
     totals: PointTotals,
+    /// The ledger sums of the last evaluation: the four work integrands (applied
+    /// loads), kinetic energy, the scheme's loss, and for elastic models the stored
+    /// energy and `½ Δu·K Δu`.
+    ledger_sums: [f64; 8],
     nl: nonlinear::Scratch,
 }
 
@@ -365,13 +364,13 @@ impl Scratch {
             m_du: z(),
             kt_du: z(),
             r: z(),
-            f_damp: if ops.damped() { z() } else { Vec::new() },
             kt: if matches!(ops.response, Response::StateDependent(_)) {
                 vec![0.0; ops.asm.pattern.nnz()]
             } else {
                 Vec::new()
             },
             totals: PointTotals::default(),
+            ledger_sums: [0.0; 8],
             nl: nonlinear::Scratch::new(n_free, ops.test.max_iterations),
         }
     }
@@ -393,19 +392,17 @@ impl StepProblem for ImplicitStep<'_> {
         !matches!(self.ops.response, Response::StateDependent(_))
     }
 
-    fn predict(&mut self, u: &[f64]) -> bool {
+    fn predict(&mut self, u: &[f64], free: &[usize], rhs: &mut Vec<f64>) -> bool {
         let (ops, s, w) = (self.ops, &*self.s, &mut *self.w);
         let base: &[f64] = match ops.response {
             Response::Elastic => &s.f_int,
             Response::Constant if s.f_pred_h == ops.h() && !s.f_pred.is_empty() => &s.f_pred,
             _ => return false,
         };
+        let _ = u; // The start of the step: its increment Δu_c is in `w.du`.
         let (c_m, c_k, c_t) = ops.coefficients();
         if self.moving {
-            // Δu_c = u − u_n is nonzero on prescribed dofs only.
-            for (d, (a, b)) in w.du.iter_mut().zip(u.iter().zip(&s.u)) {
-                *d = a - b;
-            }
+            // Δu_c is nonzero on prescribed dofs only.
             let p = &ops.asm.pattern;
             ops.mass.matvec(p, &w.du, &mut w.m_du);
             p.matvec(&ops.k, &w.du, &mut w.kdu);
@@ -413,22 +410,23 @@ impl StepProblem for ImplicitStep<'_> {
                 p.matvec(&ops.kt, &w.du, &mut w.kt_du);
             }
         }
-        let inertia = ops.dynamic().map(|(h, _, _)| h);
+        let inv_h = ops.dynamic().map(|(h, _, _)| 1.0 / h);
         let moving = self.moving;
         let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext_np1, &w.m_du, &w.kdu, &w.kt_du);
-        w.r.par_iter_mut().enumerate().for_each(|(i, r)| {
-            let mut x = base[i] - f_ext[i];
-            if let Some(h) = inertia {
-                x -= mv_n[i] / h;
+        rhs.clear();
+        rhs.extend(free.iter().map(|&i| {
+            let mut r = base[i] - f_ext[i];
+            if let Some(inv_h) = inv_h {
+                r -= mv_n[i] * inv_h;
             }
             if moving {
-                x += c_m * m_du[i] + c_k * kdu[i];
+                r += c_m * m_du[i] + c_k * kdu[i];
                 if c_t != 0.0 {
-                    x += c_t * kt_du[i];
+                    r += c_t * kt_du[i];
                 }
             }
-            *r = x;
-        });
+            -r
+        }));
         true
     }
 
@@ -445,93 +443,89 @@ impl StepProblem for ImplicitStep<'_> {
         let (s, w) = (&mut *self.s, &mut *self.w);
         let h = ops.h();
         let dynamic = ops.dynamic();
-        w.du.par_iter_mut()
-            .zip(w.v_np1.par_iter_mut())
-            .zip(u.par_iter().zip(s.u.par_iter()))
-            .for_each(|((du, v), (a, b))| {
-                *du = a - b;
-                *v = *du / h;
-            });
+        // `w.du` is `u − u_n`: set at the start of the step and kept by
+        // `apply_correction`. `mv_np1` holds M Δu until the residual pass scales it to M v = M Δu/h, and
+        // `kdu` holds K Δu (the elastic force increment, and h K v for damping).
         let p = &ops.asm.pattern;
         let mut failure = None;
-        match ops.response {
-            Response::Elastic => {
-                // K Δu (and M v with a consistent mass) in one pass over the pattern.
-                match (&ops.mass, dynamic.is_some()) {
+        let elastic = ops.response == Response::Elastic;
+        if elastic {
+            // K Δu (and M Δu with a consistent mass) in one pass over the pattern.
+            match (&ops.mass, dynamic.is_some()) {
+                (Mass::Consistent(m), true) => {
+                    p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.du, &mut w.mv_np1)
+                }
+                (_, true) => {
+                    p.matvec(&ops.k, &w.du, &mut w.kdu);
+                    ops.mass.matvec(p, &w.du, &mut w.mv_np1);
+                }
+                (_, false) => p.matvec(&ops.k, &w.du, &mut w.kdu),
+            }
+        } else {
+            let pred = (!w.f_pred_np1.is_empty()).then_some(&mut w.f_pred_np1[..]);
+            let kt = tangent.then_some(&mut w.kt[..]);
+            let pass = PointPass {
+                u,
+                dt: h,
+                at_rest: false,
+            };
+            w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int_np1, pred, kt);
+            failure = w.totals.failure;
+            if let Some((_, _, damp_k)) = dynamic {
+                match (&ops.mass, damp_k != 0.0) {
                     (Mass::Consistent(m), true) => {
-                        p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.v_np1, &mut w.mv_np1)
+                        p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.du, &mut w.mv_np1)
                     }
                     (_, true) => {
                         p.matvec(&ops.k, &w.du, &mut w.kdu);
-                        ops.mass.matvec(p, &w.v_np1, &mut w.mv_np1);
+                        ops.mass.matvec(p, &w.du, &mut w.mv_np1);
                     }
-                    (_, false) => p.matvec(&ops.k, &w.du, &mut w.kdu),
-                }
-                w.f_int_np1
-                    .par_iter_mut()
-                    .zip(s.f_int.par_iter().zip(w.kdu.par_iter()))
-                    .for_each(|(f, (f0, kd))| *f = f0 + kd);
-            }
-            _ => {
-                let pred = (!w.f_pred_np1.is_empty()).then_some(&mut w.f_pred_np1[..]);
-                let kt = tangent.then_some(&mut w.kt[..]);
-                let pass = PointPass {
-                    u,
-                    dt: h,
-                    at_rest: false,
-                };
-                w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int_np1, pred, kt);
-                failure = w.totals.failure;
-                if let Some((_, _, damp_k)) = dynamic {
-                    ops.mass.matvec(p, &w.v_np1, &mut w.mv_np1);
-                    if damp_k != 0.0 {
-                        p.matvec(&ops.k, &w.v_np1, &mut w.kdu);
-                    }
+                    (_, false) => ops.mass.matvec(p, &w.du, &mut w.mv_np1),
                 }
             }
         }
-        // The residual and its scales, in one pass.
-        let elastic = ops.response == Response::Elastic;
-        let (mv, mv_n, kdu, f_int, f_ext, du) =
-            (&w.mv_np1, &s.mv, &w.kdu, &w.f_int_np1, &w.f_ext_np1, &w.du);
-        let fixed = &ops.constrained;
+        // The residual and its scales in one pass; it also finishes M v, v and, for
+        // elastic models, f_int = f_int,n + K Δu, and sums the step's ledger terms
+        // (with the applied loads: `finish` adds what the reactions do).
+        let (damp_m, damp_k) = dynamic.map_or((0.0, 0.0), |(_, m, k)| (m, k));
+        let c = PassCoefficients {
+            inv_h: 1.0 / h,
+            damp_m,
+            damp_k,
+        };
+        let inputs = PassInputs {
+            u,
+            du: &w.du,
+            kdu: &w.kdu,
+            f_ext: &w.f_ext_np1,
+            mv_n: &s.mv,
+            v_n: &s.v,
+            f_int_n: &s.f_int,
+            f_ext_n: &s.f_ext,
+            free: &ops.free_mask,
+        };
         let sums =
-            w.r.par_iter_mut()
-                .enumerate()
-                .with_min_len(4096)
-                .fold(
-                    || [0.0f64; 3],
-                    |mut acc, (i, r)| {
-                        let (inertia, damping, momenta) = match dynamic {
-                            Some((h, damp_m, damp_k)) => {
-                                let kv = if damp_k == 0.0 {
-                                    0.0
-                                } else if elastic {
-                                    kdu[i] / h
-                                } else {
-                                    kdu[i]
-                                };
-                                (
-                                    (mv[i] - mv_n[i]) / h,
-                                    damp_m * mv[i] + damp_k * kv,
-                                    (mv[i].abs() + mv_n[i].abs()) / h,
-                                )
-                            }
-                            None => (0.0, 0.0, 0.0),
-                        };
-                        *r = inertia + damping + f_int[i] - f_ext[i];
-                        if !fixed[i] {
-                            acc[0] += f_ext[i] * f_ext[i] + f_int[i] * f_int[i] + inertia * inertia;
-                            acc[1] += du[i] * du[i];
-                        }
-                        // Over every dof: the reactions size the forces of a model whose
-                        // free dofs carry no load.
-                        let m = f_ext[i].abs() + f_int[i].abs() + momenta + damping.abs();
-                        acc[2] += m * m;
-                        acc
-                    },
+            w.r.par_chunks_mut(PASS_CHUNK)
+                .zip(w.f_int_np1.par_chunks_mut(PASS_CHUNK))
+                .zip(
+                    w.mv_np1
+                        .par_chunks_mut(PASS_CHUNK)
+                        .zip(w.v_np1.par_chunks_mut(PASS_CHUNK)),
                 )
-                .reduce(|| [0.0; 3], |a, b| [a[0] + b[0], a[1] + b[1], a[2] + b[2]]);
+                .enumerate()
+                .map(|(k, ((r, f_int), (mv, v)))| {
+                    let lo = k * PASS_CHUNK;
+                    let inp = inputs.range(lo, lo + r.len());
+                    let out = PassOutputs { r, f_int, mv, v };
+                    match (dynamic.is_some(), elastic) {
+                        (true, true) => residual_chunk::<true, true>(&inp, out, &c),
+                        (true, false) => residual_chunk::<true, false>(&inp, out, &c),
+                        (false, true) => residual_chunk::<false, true>(&inp, out, &c),
+                        (false, false) => residual_chunk::<false, false>(&inp, out, &c),
+                    }
+                })
+                .reduce(|| [0.0; 11], |a, b| std::array::from_fn(|k| a[k] + b[k]));
+        w.ledger_sums.copy_from_slice(&sums[3..]);
         Evaluation {
             force_scale2: sums[0],
             magnitude2: sums[2],
@@ -552,6 +546,123 @@ impl StepProblem for ImplicitStep<'_> {
     fn update_matrix(&mut self, sys: &mut EffectiveSystem) -> Result<Factored> {
         self.ops.refactor(sys, &self.w.kt)
     }
+
+    fn apply_correction(&mut self, u: &mut [f64], free: &[usize], delta: &[f64]) -> f64 {
+        let du = &mut self.w.du;
+        let mut c2 = 0.0;
+        for (&d, &x) in free.iter().zip(delta) {
+            u[d] += x;
+            du[d] += x;
+            c2 += x * x;
+        }
+        c2
+    }
+}
+
+/// Dofs per parallel chunk of the residual pass.
+const PASS_CHUNK: usize = 8192;
+
+/// Coefficients of the residual pass.
+struct PassCoefficients {
+    inv_h: f64,
+    damp_m: f64,
+    damp_k: f64,
+}
+
+/// What the residual pass reads (whole vectors, or one chunk of each).
+#[derive(Clone, Copy)]
+struct PassInputs<'a> {
+    u: &'a [f64],
+    du: &'a [f64],
+    kdu: &'a [f64],
+    f_ext: &'a [f64],
+    mv_n: &'a [f64],
+    v_n: &'a [f64],
+    f_int_n: &'a [f64],
+    f_ext_n: &'a [f64],
+    /// 1 on free dofs, 0 on constrained ones.
+    free: &'a [f64],
+}
+
+impl<'a> PassInputs<'a> {
+    fn range(&self, lo: usize, hi: usize) -> PassInputs<'a> {
+        PassInputs {
+            u: &self.u[lo..hi],
+            du: &self.du[lo..hi],
+            kdu: &self.kdu[lo..hi],
+            f_ext: &self.f_ext[lo..hi],
+            mv_n: &self.mv_n[lo..hi],
+            v_n: &self.v_n[lo..hi],
+            f_int_n: &self.f_int_n[lo..hi],
+            f_ext_n: &self.f_ext_n[lo..hi],
+            free: &self.free[lo..hi],
+        }
+    }
+}
+
+/// What the residual pass writes (one chunk of each vector).
+struct PassOutputs<'a> {
+    r: &'a mut [f64],
+    f_int: &'a mut [f64],
+    /// `M Δu` on entry, `M v` on exit (dynamic).
+    mv: &'a mut [f64],
+    v: &'a mut [f64],
+}
+
+/// The residual pass over one chunk of dofs, specialised for inertia (`DYN`) and
+/// for elastic models (`ELASTIC`, where `f_int = f_int,n + K Δu` is formed here).
+/// Returns `[Σ_free (f_ext² + f_int² + inertia²), Σ_free Δu², Σ magnitude², the
+/// four work integrands, E_kin, the scheme's loss, E_el, ½Δu·KΔu]`.
+#[inline]
+fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
+    inp: &PassInputs,
+    out: PassOutputs,
+    c: &PassCoefficients,
+) -> [f64; 11] {
+    let n = out.r.len();
+    let PassOutputs { r, f_int, mv, v } = out;
+    let (f_int, mv, v) = (&mut f_int[..n], &mut mv[..n], &mut v[..n]);
+    let (u, du, kdu, f_ext) = (&inp.u[..n], &inp.du[..n], &inp.kdu[..n], &inp.f_ext[..n]);
+    let (mv_n, v_n, f_int_n) = (&inp.mv_n[..n], &inp.v_n[..n], &inp.f_int_n[..n]);
+    let (f_ext_n, free) = (&inp.f_ext_n[..n], &inp.free[..n]);
+    let mut acc = [0.0f64; 11];
+    for i in 0..n {
+        if ELASTIC {
+            f_int[i] = f_int_n[i] + kdu[i];
+        }
+        let (inertia, damping, momenta) = if DYN {
+            mv[i] *= c.inv_h;
+            v[i] = du[i] * c.inv_h;
+            (
+                (mv[i] - mv_n[i]) * c.inv_h,
+                c.damp_m * mv[i] + c.damp_k * kdu[i] * c.inv_h,
+                (mv[i].abs() + mv_n[i].abs()) * c.inv_h,
+            )
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        let fi = f_int[i];
+        r[i] = inertia + damping + fi - f_ext[i];
+        acc[0] += free[i] * (f_ext[i] * f_ext[i] + fi * fi + inertia * inertia);
+        acc[1] += free[i] * du[i] * du[i];
+        // Over every dof: the reactions size the forces of a model whose free dofs
+        // carry no load.
+        let m = f_ext[i].abs() + fi.abs() + momenta + damping.abs();
+        acc[2] += m * m;
+        let work = work_integrands(du[i], f_int_n[i], fi, f_ext_n[i], f_ext[i], damping);
+        for k in 0..4 {
+            acc[3 + k] += work[k];
+        }
+        if DYN {
+            acc[7] += 0.5 * v[i] * mv[i];
+            acc[8] += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);
+        }
+        if ELASTIC {
+            acc[9] += 0.5 * u[i] * fi;
+            acc[10] += 0.5 * du[i] * kdu[i];
+        }
+    }
+    acc
 }
 
 /// Runs one implicit step from `s` to `t + h` with `correction`; on acceptance `s`
@@ -567,13 +678,16 @@ pub(crate) fn step(
     let h = ops.h();
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
-    // The start of the iteration: u_n with the prescribed values of t_{n+1}.
+    // The start of the iteration: u_n with the prescribed values of t_{n+1}, and its
+    // increment Δu_c (zero on the free dofs).
     w.u_np1.copy_from_slice(&s.u);
+    w.du.fill(0.0);
     let mut moving = false;
     for c in &model.constraints {
         let target = c.at(t1);
         if target != s.u[c.dof] {
             w.u_np1[c.dof] = target;
+            w.du[c.dof] = target - s.u[c.dof];
             moving = true;
         }
     }
@@ -611,58 +725,24 @@ pub(crate) fn step(
     Ok(StepOutcome::Accepted(report))
 }
 
-/// Books the converged step and makes it the state.
+/// Books the converged step and makes it the state. The last evaluation summed the
+/// step's ledger terms with the applied loads; the reactions (the residual on the
+/// constrained dofs) are added here, with their part of the work terms.
 fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f64) {
-    // Support reactions: on constrained dofs the residual is what the supports give.
+    let mut sums = w.ledger_sums;
     for &d in &dofs.constrained {
-        w.f_ext_np1[d] += w.r[d];
+        let reaction = w.r[d];
+        w.f_ext_np1[d] += reaction;
+        // External work and load jump are linear in f_ext,n+1.
+        sums[1] += w.du[d] * reaction;
+        sums[2] += w.du[d] * reaction;
     }
-    let dynamic = ops.dynamic();
-    let elastic = ops.response == Response::Elastic;
-    if let Some((h, damp_m, damp_k)) = dynamic {
-        if ops.damped() {
-            let (mv, kdu) = (&w.mv_np1, &w.kdu);
-            w.f_damp.par_iter_mut().enumerate().for_each(|(i, f)| {
-                let kv = if elastic { kdu[i] / h } else { kdu[i] };
-                *f = damp_m * mv[i] + damp_k * kv;
-            });
-        }
-    }
-    // The scheme's lines (kinetic energy and its loss) and, for elastic models, the
-    // stored energy and the material's algorithmic loss, in one pass.
-    let (v, mv, v_n, mv_n) = (&w.v_np1, &w.mv_np1, &s.v, &s.mv);
-    let (u1, f_int, du, kdu) = (&w.u_np1, &w.f_int_np1, &w.du, &w.kdu);
-    let sums = (0..v.len())
-        .into_par_iter()
-        .with_min_len(4096)
-        .fold(
-            || [0.0f64; 4],
-            |mut acc, i| {
-                if dynamic.is_some() {
-                    acc[0] += 0.5 * v[i] * mv[i];
-                    acc[1] += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);
-                }
-                if elastic {
-                    acc[2] += 0.5 * u1[i] * f_int[i];
-                    acc[3] += 0.5 * du[i] * kdu[i];
-                }
-                acc
-            },
-        )
-        .reduce(|| [0.0; 4], |a, b| std::array::from_fn(|k| a[k] + b[k]));
-    let work = step_work(&StepVectors {
-        du: &w.du,
-        f_int_n: &s.f_int,
-        f_int_np1: &w.f_int_np1,
-        f_ext_n: &s.f_ext,
-        f_ext_np1: &w.f_ext_np1,
-        f_damp_np1: ops.damped().then_some(&w.f_damp[..]),
-    });
-    let (elastic_energy, material) = if elastic {
+    let work = StepWork::from_sums([sums[0], sums[1], sums[2], sums[3]]);
+    let (elastic_energy, material) = if ops.response == Response::Elastic {
         (
-            sums[2],
+            sums[6],
             Dissipation {
-                numerical: sums[3],
+                numerical: sums[7],
                 ..Default::default()
             },
         )
@@ -670,17 +750,17 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
         (w.totals.psi, w.totals.dissipation)
     };
     s.ledger.record(&StepIncrements {
-        kinetic: sums[0],
+        kinetic: sums[4],
         elastic: elastic_energy,
         work,
         material,
-        scheme_loss: sums[1],
+        scheme_loss: sums[5],
         contact: 0.0,
     });
     std::mem::swap(&mut s.u, &mut w.u_np1);
     std::mem::swap(&mut s.f_int, &mut w.f_int_np1);
     std::mem::swap(&mut s.f_ext, &mut w.f_ext_np1);
-    if dynamic.is_some() {
+    if ops.dynamic().is_some() {
         std::mem::swap(&mut s.v, &mut w.v_np1);
         std::mem::swap(&mut s.mv, &mut w.mv_np1);
     }
