@@ -11,11 +11,15 @@
 //! problems because it books the scheme's own numerical loss as its own line.
 //!
 //! Data flows one way: scenario file ([`config`]) → validated [`model::Model`] →
-//! time loop ([`time`]) → ledger ([`energy`]) and output ([`output`]). The pieces:
+//! integrator ([`time`]) whose implicit steps go through one equilibrium loop
+//! ([`nonlinear`]) → ledger ([`energy`]) and output ([`output`]). The pieces:
 //! [`mesh`] (nodes, blocks, sets, generators, Gmsh), [`fe`] (reference elements,
-//! element matrices), [`material`] (constitutive models), [`assembly`] (pattern,
-//! parallel scatter, loads), [`linsolve`] (faer and CHOLMOD Cholesky behind one
-//! trait). [`run`] ties them together the way the `rothe` command does.
+//! element matrices), [`material`] (constitutive models, Gauss-point store,
+//! material-point driver), [`assembly`] (pattern, parallel scatter, Gauss-point loop,
+//! loads), [`system`] (free dofs and the factorised effective matrix), [`linsolve`]
+//! (faer and CHOLMOD Cholesky behind one trait). [`run`] ties them together the way
+//! the `rothe` command does. `ARCHITECTURE.md` in the repository draws the layers and
+//! says where to start to add a material, a time scheme or a constraint type.
 
 // Element and material kernels index small fixed-size arrays by component: index
 // loops read like the formulas they implement.

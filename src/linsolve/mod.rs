@@ -9,7 +9,7 @@
 //! [`Error::NotPositiveDefinite`] with the column it happened at.
 //!
 //! Backends: [`faer_backend::FaerCholesky`] (default, pure Rust) and, with the
-//! `cholmod` feature, [`cholmod_backend::CholmodCholesky`] (SuiteSparse). An
+//! `cholmod` feature, `cholmod_backend::CholmodCholesky` (SuiteSparse). An
 //! elimination order proposed with [`SymmetricSolver::set_ordering`] is used by both,
 //! so the two compare factorisation codes on the same factor.
 
