@@ -45,7 +45,7 @@ fn main() -> rothe::Result<()> {
     let mut s = be.initial_state();
     let t_steps = Instant::now();
     let (mut solves, mut n, mut cuts) = (0, 0, 0);
-    march(&mut be, &mut s, StepControl::of(&model), |_, m| {
+    march(&mut be, &mut s, StepControl::of(&model), |_, _, m| {
         match m {
             Marched::Step(r) => {
                 solves += r.iterations;

@@ -50,6 +50,27 @@ pub enum Error {
     /// The time integration could not continue.
     #[error("time stepping: {0}")]
     Stepping(String),
+    /// The model would not fit in the memory available.
+    #[error("memory: {message}")]
+    Memory {
+        /// The estimate and what is available.
+        message: String,
+    },
+    /// A quantity of the state stopped being a finite number.
+    #[error("non-finite value at t = {t:.6e}: {quantity} is {value} at {location}")]
+    NonFinite {
+        /// Which quantity (`u`, `f_int`, a ledger line, ...).
+        quantity: String,
+        /// Its value (NaN or an infinity).
+        value: f64,
+        /// Where: dof (node, coordinates, body, element) or "the whole model".
+        location: String,
+        /// Time of the step.
+        t: f64,
+    },
+    /// A bug: something that must not happen did (a panic caught at the top).
+    #[error("internal error (please report it with the input file): {0}")]
+    Internal(String),
 }
 
 impl Error {

@@ -26,6 +26,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod assembly;
+pub mod check;
 pub mod config;
 pub mod energy;
 pub mod error;

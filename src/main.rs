@@ -1,11 +1,16 @@
-//! The `rothe` command: `run`, `check`.
+//! The `rothe` command: `run`, `check`, `material`.
+//!
+//! Errors print as `error: <field or file>: <what is wrong>` and exit with status 1.
+//! A panic never reaches the user as a Rust backtrace: it is reported as an internal
+//! error naming the input file, and a run's `summary.json` says `failed`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use rothe::config::LoadOptions;
 use rothe::linsolve::Backend;
-use rothe::run::{run, RunOptions};
+use rothe::run::{panic_message, run, RunOptions};
 
 #[derive(Parser)]
 #[command(
@@ -33,6 +38,9 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Run even when the memory estimate exceeds the memory available.
+        #[arg(long)]
+        ignore_memory: bool,
     },
     /// Drive one material point along a strain or stress path; writes material.csv.
     Material {
@@ -42,35 +50,103 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
-    /// Validate a scenario and print its size, the explicit CFL step and a memory
-    /// estimate, without solving.
+    /// Validate a scenario and print its size, steps and output volume, the explicit
+    /// CFL step and the memory it needs, without solving.
     Check {
         /// Scenario file (TOML).
         scenario: PathBuf,
+        /// Report even when the memory estimate exceeds the memory available.
+        #[arg(long)]
+        ignore_memory: bool,
     },
+}
+
+fn load_options(ignore_memory: bool) -> LoadOptions {
+    if ignore_memory {
+        LoadOptions::unlimited()
+    } else {
+        LoadOptions::default()
+    }
+}
+
+fn run_command(
+    scenario: &Path,
+    out: &Path,
+    backend: Backend,
+    quiet: bool,
+    ignore_memory: bool,
+) -> rothe::Result<()> {
+    let opts = load_options(ignore_memory);
+    let model = rothe::config::load_with(scenario, &opts)?;
+    let summary = run(
+        &model,
+        &RunOptions {
+            out: out.to_path_buf(),
+            backend,
+            progress: !quiet,
+            memory_limit: opts.memory_limit,
+        },
+    )?;
+    eprintln!(
+        "{} steps, t = {:.6e} s, {} dofs; energy balance residual {:.2e} (relative {:.2e}); output in {}",
+        summary.steps,
+        summary.t_end,
+        summary.dofs,
+        summary.energy.balance_residual,
+        summary.energy.balance_residual_rel,
+        out.display()
+    );
+    Ok(())
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Run { scenario, out, backend, quiet } => rothe::config::load(&scenario).and_then(|model| {
-            let summary = run(&model, &RunOptions { out: out.clone(), backend, progress: !quiet })?;
-            eprintln!(
-                "{} steps, t = {:.6e} s, {} dofs; energy balance residual {:.2e} (relative {:.2e}); output in {}",
-                summary.steps,
-                summary.t_end,
-                summary.dofs,
-                summary.energy.balance_residual,
-                summary.energy.balance_residual_rel,
-                out.display()
-            );
-            Ok(())
-        }),
-        Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out).map(|records| {
-            eprintln!("{} steps; wrote {}", records.len() - 1, out.join("material.csv").display());
-        }),
-        Command::Check { scenario } => rothe::config::load(&scenario).and_then(|model| check(&model)),
+    // A panic is reported below as an internal error, not printed by the default hook.
+    std::panic::set_hook(Box::new(|_| {}));
+    let input = match &cli.command {
+        Command::Run { scenario, .. } | Command::Check { scenario, .. } => scenario.clone(),
+        Command::Material { file, .. } => file.clone(),
     };
+    let out_dir = match &cli.command {
+        Command::Run { out, .. } => Some(out.clone()),
+        _ => None,
+    };
+    let result = std::panic::catch_unwind(|| match cli.command {
+        Command::Run {
+            scenario,
+            out,
+            backend,
+            quiet,
+            ignore_memory,
+        } => run_command(&scenario, &out, backend, quiet, ignore_memory),
+        Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out)
+            .map(|steps| {
+                eprintln!(
+                    "{steps} steps; wrote {}",
+                    out.join("material.csv").display()
+                );
+            }),
+        Command::Check {
+            scenario,
+            ignore_memory,
+        } => {
+            let opts = load_options(ignore_memory);
+            rothe::config::load_with(&scenario, &opts)
+                .and_then(|model| rothe::check::report(&model, opts.memory_limit))
+                .map(|report| print!("{report}"))
+        }
+    });
+    let result = result.unwrap_or_else(|p| {
+        let e = rothe::Error::Internal(format!(
+            "{} (input {})",
+            panic_message(p.as_ref()),
+            input.display()
+        ));
+        if let Some(out) = out_dir {
+            mark_failed(&out.join("summary.json"), &e);
+        }
+        Err(e)
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -80,61 +156,17 @@ fn main() -> ExitCode {
     }
 }
 
-fn check(model: &rothe::model::Model) -> rothe::Result<()> {
-    use rothe::assembly::Pattern;
-    use rothe::system::{DofMap, EffectiveSystem};
-    let mesh = &model.mesh;
-    let pattern = Pattern::new(mesh);
-    let dofs = DofMap::new(mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let system = EffectiveSystem::new(
-        &pattern,
-        dofs,
-        Backend::Faer,
-        model.analysis.ordering,
-        &mesh.coords,
-    )?;
-    let dofs = system.dofs();
-    let nd = system.nested_dissection();
-    let solver = &system;
-    let nnz_l = solver.factor_nnz().unwrap_or(0);
-    let nnz_a = system.matrix().row_idx.len();
-    // K and M values (full storage) + adjacency, the reduced lower matrix, the factor.
-    let bytes = 2 * pattern.nnz() * 8
-        + pattern.adj.len() * 4
-        + nnz_a * 16
-        + nnz_l * 8
-        + 12 * mesh.n_dofs() * 8;
-    println!("bodies      {}", model.bodies.len());
-    for (i, b) in model.bodies.iter().enumerate() {
-        let els: usize = mesh
-            .blocks
-            .iter()
-            .filter(|bl| bl.body == i)
-            .map(|bl| bl.elements.len())
-            .sum();
-        println!(
-            "  {:<12} {} elements, thickness {} m, velocity {:?} m/s",
-            b.name, els, b.thickness, b.velocity
-        );
+/// After a panic outside the run's own guard: marks an existing `summary.json` as
+/// failed with the error (or writes a minimal one).
+fn mark_failed(path: &Path, e: &rothe::Error) {
+    let mut v: serde_json::Value = std::fs::read_to_string(path)
+        .ok()
+        .and_then(|s| serde_json::from_str(&s).ok())
+        .unwrap_or_else(|| serde_json::json!({}));
+    v["status"] = "failed".into();
+    v["error"] = e.to_string().into();
+    if let Ok(text) = serde_json::to_string_pretty(&v) {
+        let _ = std::fs::create_dir_all(path.parent().unwrap_or(Path::new(".")));
+        let _ = std::fs::write(path, text);
     }
-    println!("nodes       {}", mesh.n_nodes());
-    println!("elements    {}", mesh.n_elements());
-    println!("dofs        {} ({} free)", mesh.n_dofs(), dofs.n_free());
-    println!(
-        "steps       {} of h = {:e} s to T = {:e} s",
-        model.analysis.n_steps(),
-        model.analysis.dt,
-        model.analysis.t_end
-    );
-    if let Some(c) = rothe::time::cfl::critical_step(model) {
-        println!("CFL step    {:.4e} s (explicit central differences; block {}, element {}); h / CFL = {:.3}", c.dt, c.block, c.element, model.analysis.dt / c.dt);
-    }
-    println!(
-        "nnz(K_eff)  {} (lower), nnz(L) {} (faer, {})",
-        nnz_a,
-        nnz_l,
-        if nd { "nested dissection" } else { "AMD" }
-    );
-    println!("memory      about {:.1} MB", bytes as f64 / 1e6);
-    Ok(())
 }

@@ -1,4 +1,7 @@
-//! Large zeroed buffers, filled eagerly.
+//! Memory: large zeroed buffers filled eagerly, what the machine has available, and
+//! the estimate of what a model will take, so a run that would not fit is refused
+//! before it allocates (`rothe check` prints the estimate, `rothe run` checks it;
+//! `--ignore-memory` overrides).
 //!
 //! `vec![0.0; n]` gets lazily zeroed pages from the kernel, so the page faults land
 //! later inside the parallel scatter or the numeric factorisation, where they contend
@@ -8,9 +11,147 @@
 //! pages through `madvise` were measured too and were slower here: the kernel's
 //! compaction stalls outweighed the faults they save.)
 
+use crate::error::{Error, Result};
+
 /// A vector of `n` default values with every page already touched.
 pub fn zeroed<T: Copy + Default>(n: usize) -> Vec<T> {
     let mut v: Vec<T> = Vec::with_capacity(n);
     v.resize(n, T::default());
     v
+}
+
+/// Bytes of memory available to this process: the kernel's `MemAvailable`, or a
+/// smaller cgroup limit (v2 `memory.max`, v1 `memory.limit_in_bytes`) less what the
+/// cgroup uses. `None` where neither can be read (not Linux).
+pub fn available() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| {
+        s.lines()
+            .find(|l| l.starts_with("MemAvailable:"))
+            .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+            .map(|kb| kb * 1024)
+    });
+    let read = |p: &str| -> Option<u64> { std::fs::read_to_string(p).ok()?.trim().parse().ok() };
+    let cgroup = read("/sys/fs/cgroup/memory.max")
+        .map(|max| max.saturating_sub(read("/sys/fs/cgroup/memory.current").unwrap_or(0)))
+        .or_else(|| {
+            read("/sys/fs/cgroup/memory/memory.limit_in_bytes").map(|max| {
+                max.saturating_sub(read("/sys/fs/cgroup/memory/memory.usage_in_bytes").unwrap_or(0))
+            })
+        });
+    match (meminfo, cgroup) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// Nonzeros of a sparse Cholesky factor of a 2D finite-element matrix with `dofs`
+/// unknowns, before the analysis tells the exact figure: `5 n log₂ n`, from the
+/// nested-dissection bound `O(n log n)` fitted to W1 (89 per dof at 0.5M dofs, 104
+/// at 2M, both within 10 % of the formula).
+pub fn factor_nnz_estimate(dofs: usize) -> u64 {
+    let n = dofs.max(2) as f64;
+    (5.0 * n * n.log2()) as u64
+}
+
+/// The memory a model takes, by part, in bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate {
+    /// Nodes, elements, sets and the node adjacency.
+    pub mesh: u64,
+    /// `K`, `M` (and a tangent for state-dependent materials) on the shared pattern,
+    /// the reduced effective matrix.
+    pub matrices: u64,
+    /// The Cholesky factor and its workspace.
+    pub factor: u64,
+    /// State and scratch vectors and the Gauss-point stores.
+    pub state: u64,
+}
+
+impl Estimate {
+    /// The whole estimate.
+    pub fn total(&self) -> u64 {
+        self.mesh + self.matrices + self.factor + self.state
+    }
+
+    /// An estimate for `nodes` nodes of 2D elements with `elements` elements,
+    /// `points` Gauss points of `history` values each, the factor with `factor_nnz`
+    /// entries (the exact figure once analysed, else [`factor_nnz_estimate`]) and
+    /// `tangent` when a state-dependent tangent is kept besides `K` and `M`.
+    pub fn of(
+        nodes: u64,
+        elements: u64,
+        points: u64,
+        history: u64,
+        factor_nnz: u64,
+        tangent: bool,
+    ) -> Estimate {
+        // A node of a Q4 or T3 mesh has about 9 neighbours (itself included): 36 values
+        // per node in each full-storage matrix, about half plus a diagonal in the
+        // reduced lower triangle (value, row index, source position).
+        let per_node_matrix = 36 * 8;
+        let n_matrices = if tangent { 3 } else { 2 };
+        let dofs = 2 * nodes;
+        Estimate {
+            mesh: nodes * (16 + 8 + 9 * 4 + 8) + elements * (4 * 8 + 16),
+            matrices: nodes * (n_matrices * per_node_matrix + 20 * 24),
+            factor: factor_nnz * 8 + dofs * 64,
+            state: dofs * 8 * 30 + points * (7 + history) * 8 * 2,
+        }
+    }
+
+    /// Refuses (an error with the estimate and the memory available) when the
+    /// estimate exceeds what the machine has; passes when nothing can be read.
+    pub fn check(&self, available: Option<u64>, what: &str) -> Result<()> {
+        match available {
+            Some(a) if self.total() > a => Err(Error::Memory {
+                message: format!(
+                    "{what} needs about {} (mesh {}, matrices {}, factor {}, state {}), but \
+                     only {} is available; use a coarser mesh, or `--ignore-memory` to try anyway",
+                    human(self.total()),
+                    human(self.mesh),
+                    human(self.matrices),
+                    human(self.factor),
+                    human(self.state),
+                    human(a)
+                ),
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A byte count for people: `1.2 GB`.
+pub fn human(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b >= 1e9 {
+        format!("{:.1} GB", b / 1e9)
+    } else if b >= 1e6 {
+        format!("{:.1} MB", b / 1e6)
+    } else if b >= 1e3 {
+        format!("{:.1} kB", b / 1e3)
+    } else {
+        format!("{bytes} B")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn estimates_and_refusals() {
+        let e = Estimate::of(1000, 900, 3600, 3, 50_000, false);
+        assert!(e.total() > 0);
+        assert!(e.check(Some(e.total() + 1), "w").is_ok());
+        let msg = e.check(Some(10), "the run").unwrap_err().to_string();
+        assert!(msg.contains("only 10 B is available"), "{msg}");
+        assert!(e.check(None, "w").is_ok());
+        assert!(available().is_none_or(|a| a > 0));
+        assert_eq!(human(1_500_000), "1.5 MB");
+        // The factor estimate is within 15 % of W1's measured factors.
+        for (dofs, nnz) in [(503_000usize, 44.6e6), (2_004_000, 208e6)] {
+            let est = factor_nnz_estimate(dofs) as f64;
+            assert!((est / nnz - 1.0).abs() < 0.15, "{dofs}: {est} vs {nnz}");
+        }
+    }
 }

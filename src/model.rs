@@ -61,8 +61,13 @@ impl TimeFunction {
                 }
             }
             TimeFunction::Table { points } => {
-                let first = points[0];
-                let last = points[points.len() - 1];
+                // Validation keeps tables non-empty; a NaN time has no value.
+                let (Some(&first), Some(&last)) = (points.first(), points.last()) else {
+                    return f64::NAN;
+                };
+                if t.is_nan() {
+                    return f64::NAN;
+                }
                 if t <= first[0] {
                     return first[1];
                 }

@@ -1,15 +1,19 @@
 //! A whole run as the `rothe run` command does it: build the integrator the analysis
 //! asks for, march it to the end time, and hand every accepted state to the
-//! recorder. Output is written as the run goes; on failure `summary.json` records the
-//! error and everything written before stays valid.
+//! recorder. Output is written as the run goes: `summary.json` exists from the first
+//! step on with `status = "running"` and is refreshed at the VTK cadence and every few
+//! seconds, so an interrupted run is never taken for a complete one; on failure it
+//! records the error, and everything written before stays valid. A panic inside the
+//! run is caught and reported as an internal error, with `status = "failed"`.
 
+use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::energy::Ledger;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::linsolve::Backend;
 use crate::model::{AnalysisKind, Model};
 use crate::output::recorder::{Recorder, Snapshot};
@@ -28,7 +32,25 @@ pub struct RunOptions {
     pub backend: Backend,
     /// Show a progress bar on stderr.
     pub progress: bool,
+    /// Refuse a factor whose memory estimate exceeds this many bytes, before it is
+    /// allocated (`None`: no limit).
+    pub memory_limit: Option<u64>,
 }
+
+impl RunOptions {
+    /// Options for a run into `out` on `backend`, quiet, without a memory limit.
+    pub fn new(out: impl Into<PathBuf>, backend: Backend) -> Self {
+        RunOptions {
+            out: out.into(),
+            backend,
+            progress: false,
+            memory_limit: None,
+        }
+    }
+}
+
+/// How often `summary.json` is refreshed while a run goes, besides the VTK cadence.
+const SUMMARY_EVERY: Duration = Duration::from_secs(5);
 
 fn progress(n: usize, show: bool) -> ProgressBar {
     if !show {
@@ -58,6 +80,15 @@ fn snapshot(s: &State, iterations: usize, nl_residual: f64) -> Snapshot<'_> {
     }
 }
 
+/// The message of a caught panic.
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".into())
+}
+
 /// Runs `model` and writes `history.csv`, `summary.json` and VTK files to `opts.out`.
 pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
     let start = Instant::now();
@@ -82,31 +113,53 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             factor_nnz: None,
         },
     };
-    let result = match a.kind {
-        AnalysisKind::Dynamic => BackwardEuler::new(model, opts.backend)
+    let summary_path = opts.out.join("summary.json");
+    summary.write(&summary_path)?;
+    let result = catch_unwind(AssertUnwindSafe(|| match a.kind {
+        AnalysisKind::Dynamic => {
+            BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
+                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
+        }
+        AnalysisKind::Static => Statics::with_memory_limit(model, opts.backend, opts.memory_limit)
             .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
-        AnalysisKind::Static => Statics::new(model, opts.backend)
-            .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
-    };
+    }))
+    .unwrap_or_else(|p| Err(Error::Internal(panic_message(p.as_ref()))));
     summary.probes = rec.probes().clone();
     summary.timing.total_s = start.elapsed().as_secs_f64();
     match result {
         Ok(()) => {
             summary.status = "completed".into();
-            summary.write(&opts.out.join("summary.json"))?;
+            summary.write(&summary_path)?;
             Ok(summary)
         }
         Err(e) => {
             summary.status = "failed".into();
             summary.error = Some(e.to_string());
-            summary.write(&opts.out.join("summary.json"))?;
+            summary.write(&summary_path)?;
             Err(e)
         }
     }
 }
 
+/// The summary's view of a state and an integrator.
+fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I, rec: &Recorder) {
+    let facts = integrator.solver();
+    let timing = integrator.timing();
+    summary.steps = s.step;
+    summary.t_end = s.t;
+    summary.energy = EnergySummary::from(&s.ledger);
+    summary.probes = rec.probes().clone();
+    summary.timing.assembly_s = timing.assembly_s;
+    summary.timing.factorization_s = timing.factorization_s;
+    summary.timing.solve_s = timing.solve_s;
+    summary.solver.backend = facts.backend.into();
+    summary.solver.factorizations = facts.factorizations;
+    summary.solver.factor_nnz = facts.factor_nnz;
+}
+
 /// Marches `integrator` from its initial state to the end time, recording every
-/// accepted state, and fills the summary (also when the march fails part way).
+/// accepted state and refreshing `summary.json`, and fills the summary (also when the
+/// march fails part way).
 fn integrate<I: Integrator>(
     model: &Model,
     integrator: &mut I,
@@ -116,17 +169,30 @@ fn integrate<I: Integrator>(
 ) -> Result<()> {
     let mut s = integrator.initial_state()?;
     rec.record(model, &snapshot(&s, 0, 0.0))?;
+    let summary_path = opts.out.join("summary.json");
+    fill(summary, &s, integrator, rec);
+    summary.write(&summary_path)?;
+    let mut last_write = Instant::now();
     let n_steps = model.analysis.n_steps();
+    let vtk_every = model.analysis.vtk_every;
     let pb = progress(n_steps, opts.progress);
     let t_end = model.analysis.t_end;
     let (mut iterations, mut step_cuts) = (0, 0);
     let control = StepControl::of(model);
-    let outcome = march(integrator, &mut s, control, |s, m| {
+    let outcome = march(integrator, &mut s, control, |integrator, s, m| {
         match m {
             Marched::Step(report) => {
                 iterations += report.iterations;
                 rec.record(model, &snapshot(s, report.iterations, report.nl_residual))?;
                 pb.set_position(((s.t / t_end) * n_steps as f64) as u64);
+                let on_cadence = vtk_every > 0 && s.step % vtk_every == 0;
+                if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {
+                    fill(summary, s, integrator, rec);
+                    summary.solver.iterations = iterations;
+                    summary.solver.step_cuts = step_cuts;
+                    summary.write(&summary_path)?;
+                    last_write = Instant::now();
+                }
             }
             Marched::Cut { h, reason } => {
                 step_cuts += 1;
@@ -136,23 +202,8 @@ fn integrate<I: Integrator>(
         Ok(())
     });
     pb.finish_and_clear();
-    let facts = integrator.solver();
-    let timing = integrator.timing();
-    summary.steps = s.step;
-    summary.t_end = s.t;
-    summary.energy = EnergySummary::from(&s.ledger);
-    summary.timing = TimingSummary {
-        assembly_s: timing.assembly_s,
-        factorization_s: timing.factorization_s,
-        solve_s: timing.solve_s,
-        total_s: 0.0,
-    };
-    summary.solver = SolverSummary {
-        backend: facts.backend.into(),
-        factorizations: facts.factorizations,
-        iterations,
-        step_cuts,
-        factor_nnz: facts.factor_nnz,
-    };
+    fill(summary, &s, integrator, rec);
+    summary.solver.iterations = iterations;
+    summary.solver.step_cuts = step_cuts;
     outcome
 }

@@ -26,6 +26,7 @@ const TOL: f64 = 1e-10;
 
 /// A fresh solver of every backend this build has.
 fn backends() -> Vec<Box<dyn SymmetricSolver>> {
+    #[allow(unused_mut)] // pushed to only with the cholmod feature
     let mut v: Vec<Box<dyn SymmetricSolver>> = vec![Box::new(FaerCholesky::new())];
     #[cfg(feature = "cholmod")]
     v.push(Box::new(CholmodCholesky::new().expect("cholmod starts")));
@@ -521,6 +522,7 @@ fn full_run_histories_agree() {
             out: out.clone(),
             backend,
             progress: false,
+            memory_limit: None,
         };
         let summary = rothe::run::run(&model, &opts).unwrap();
         assert_eq!(summary.status, "completed");

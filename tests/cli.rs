@@ -161,7 +161,7 @@ fn bad_input_gives_clear_errors() {
                 "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
                 "mesh = { kind = \"gmsh\", file = \"flat.msh\" }",
             ),
-            vec!["inverted or degenerate"],
+            vec!["flat.msh", "element with Gmsh tag 4", "degenerate"],
         ),
     ];
     let rh_soft = good().replace("model = \"elastic\"", "model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 10.0 }\ncompression = { law = \"bilinear\", strength = 30e6, post_yield_modulus = 1e9 }");

@@ -68,7 +68,7 @@ fn static_ledger_closes() {
     let m = model(&text);
     let mut st = Statics::new(&m, Backend::Faer).unwrap();
     let mut s = st.initial_state();
-    march(&mut st, &mut s, StepControl::of(&m), |s, _| {
+    march(&mut st, &mut s, StepControl::of(&m), |_, s, _| {
         let l = &s.ledger;
         assert!(
             l.residual().abs() <= 1e-6 * l.scale(),
@@ -203,7 +203,7 @@ function = {{ kind = "ramp", t0 = 0.0, t1 = 2.0e-2 }}
         });
         let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
         let mut s = be.initial_state();
-        march(&mut be, &mut s, StepControl::of(&m), |_, _| Ok(())).unwrap();
+        march(&mut be, &mut s, StepControl::of(&m), |_, _, _| Ok(())).unwrap();
         let d = s.ledger.dissipated().plastic;
         eprintln!("mesh {nx}x{ny}: plastic dissipation {d} J");
         let want = 140.0 * 0.05 * 0.1;

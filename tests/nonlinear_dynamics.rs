@@ -29,6 +29,7 @@ fn run_text(text: &str, dir: &std::path::Path) -> rothe::Result<rothe::output::s
             out: dir.into(),
             backend: Backend::Faer,
             progress: false,
+            memory_limit: None,
         },
     )
 }
@@ -72,7 +73,7 @@ function = {{ kind = "ramp", t0 = 0.0, t1 = 2.0e-3 }}
     let mut be = rothe::time::backward_euler::BackwardEuler::new(&model, Backend::Faer).unwrap();
     let mut s = be.initial_state();
     let control = rothe::time::march::StepControl::of(&model);
-    rothe::time::march::march(&mut be, &mut s, control, |s: &rothe::time::State, _| {
+    rothe::time::march::march(&mut be, &mut s, control, |_, s: &rothe::time::State, _| {
         let l = &s.ledger;
         assert!(
             l.residual().abs() <= 1e-6 * l.scale(),

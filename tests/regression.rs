@@ -103,6 +103,7 @@ fn histories_match_their_references() {
                 out: out.clone(),
                 backend: Backend::Faer,
                 progress: false,
+                memory_limit: None,
             },
         )
         .unwrap();

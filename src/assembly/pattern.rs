@@ -158,22 +158,67 @@ impl Pattern {
 
 /// Greedy colouring of the elements of one block so that no two elements of a colour
 /// share a node: elements of one colour can be scattered in parallel without races.
+/// The first 64 colours are tracked with a bit mask per node; a node shared by more
+/// elements than that (a fan of triangles around one node) takes further colours from
+/// a list kept for it, so any mesh can be coloured.
 pub fn colour_elements(conn: &[usize], nn: usize, n_nodes: usize) -> Vec<Vec<usize>> {
     let n_el = conn.len() / nn;
     let mut node_mask = vec![0u64; n_nodes];
+    let mut node_extra: Vec<Vec<u32>> = Vec::new();
     let mut colours: Vec<Vec<usize>> = Vec::new();
     for e in 0..n_el {
         let nodes = &conn[e * nn..(e + 1) * nn];
         let used = nodes.iter().fold(0u64, |acc, &v| acc | node_mask[v]);
-        let c = (!used).trailing_zeros() as usize;
-        assert!(c < 64, "element colouring needs more than 64 colours");
+        let c = if used != u64::MAX {
+            (!used).trailing_zeros() as usize
+        } else {
+            if node_extra.is_empty() {
+                node_extra = vec![Vec::new(); n_nodes];
+            }
+            (64..)
+                .find(|&c| nodes.iter().all(|&v| !node_extra[v].contains(&(c as u32))))
+                .expect("a free colour exists")
+        };
         if c == colours.len() {
             colours.push(Vec::new());
         }
         colours[c].push(e);
         for &v in nodes {
-            node_mask[v] |= 1 << c;
+            if c < 64 {
+                node_mask[v] |= 1 << c;
+            } else {
+                node_extra[v].push(c as u32);
+            }
         }
     }
     colours
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fan_of_more_than_64_elements_is_coloured() {
+        // 100 triangles around node 0: every element needs its own colour.
+        let m = 100;
+        let conn: Vec<usize> = (0..m).flat_map(|k| [0, 1 + k, 1 + (k + 1) % m]).collect();
+        let colours = colour_elements(&conn, 3, m + 1);
+        assert_eq!(colours.len(), m);
+        let mut seen = vec![false; m];
+        for colour in &colours {
+            let mut nodes: Vec<usize> = colour
+                .iter()
+                .flat_map(|&e| conn[3 * e..3 * e + 3].to_vec())
+                .collect();
+            let len = nodes.len();
+            nodes.sort_unstable();
+            nodes.dedup();
+            assert_eq!(nodes.len(), len, "a colour shares a node");
+            for &e in colour {
+                seen[e] = true;
+            }
+        }
+        assert!(seen.iter().all(|&x| x));
+    }
 }

@@ -6,11 +6,44 @@
 
 mod validate;
 
-pub use validate::material;
+pub use validate::{material, HUGE_STEPS};
 
 /// Checks that `v` is positive and finite; the error names `field`.
 pub fn positive_pub(field: &str, v: f64) -> Result<()> {
     validate::positive(field, v)
+}
+
+/// Checks that every entry of `v` is finite; the error names `field`.
+pub fn finite_pub(field: &str, v: &[f64]) -> Result<()> {
+    validate::finite(field, v)
+}
+
+/// Checks a time function's numbers and shape; the error names `field`.
+pub fn check_function_pub(field: &str, f: &TimeFunction) -> Result<()> {
+    validate::check_function(field, f)
+}
+
+/// How a scenario is loaded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoadOptions {
+    /// Refuse a model whose memory estimate exceeds this many bytes (`None`: no
+    /// limit). Default: the memory available on this machine.
+    pub memory_limit: Option<u64>,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            memory_limit: crate::memory::available(),
+        }
+    }
+}
+
+impl LoadOptions {
+    /// No memory limit (`--ignore-memory`).
+    pub fn unlimited() -> Self {
+        LoadOptions { memory_limit: None }
+    }
 }
 
 use std::collections::BTreeMap;
@@ -438,8 +471,14 @@ pub struct ProbeSpec {
     pub set: Option<String>,
 }
 
-/// Reads, parses and validates a scenario file.
+/// Reads, parses and validates a scenario file (refusing a model that would not
+/// fit in the memory available).
 pub fn load(path: &Path) -> Result<Model> {
+    load_with(path, &LoadOptions::default())
+}
+
+/// [`load`] with options.
+pub fn load_with(path: &Path, opts: &LoadOptions) -> Result<Model> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let scenario = parse(&text).map_err(|e| match e {
         Error::Config { field, message } => Error::Config {
@@ -449,7 +488,7 @@ pub fn load(path: &Path) -> Result<Model> {
         other => other,
     })?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    validate::build(&scenario, dir).map_err(|e| match e {
+    validate::build(&scenario, dir, opts).map_err(|e| match e {
         Error::Config { field, message } => Error::Config {
             field: format!("{}: {field}", path.display()),
             message,
@@ -474,5 +513,10 @@ pub fn parse(text: &str) -> Result<Scenario> {
 
 /// Parses and validates scenario text; relative mesh paths resolve against `dir`.
 pub fn from_str(text: &str, dir: &Path) -> Result<Model> {
-    validate::build(&parse(text)?, dir)
+    validate::build(&parse(text)?, dir, &LoadOptions::default())
+}
+
+/// The memory estimate of a model (the factor's exact nonzeros when known).
+pub fn memory_estimate(model: &Model, factor_nnz: Option<usize>) -> crate::memory::Estimate {
+    validate::estimate(&model.mesh, &model.materials, factor_nnz)
 }

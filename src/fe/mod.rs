@@ -152,9 +152,10 @@ pub fn kinematics(kind: ElementKind, x: &[[f64; 2]], xi: [f64; 2]) -> PointKinem
     PointKinematics { n, dndx, det_j }
 }
 
-/// Smallest Jacobian determinant over the element's nodes and Gauss points (a
-/// non-positive value means an inverted or degenerate element).
-pub fn min_jacobian(kind: ElementKind, x: &[[f64; 2]]) -> f64 {
+/// Smallest and largest Jacobian determinant over the element's corners and Gauss
+/// points (a non-positive minimum means an inverted, degenerate or distorted
+/// element; see `mesh::Shape`).
+pub fn jacobian_range(kind: ElementKind, x: &[[f64; 2]]) -> (f64, f64) {
     let corners: &[[f64; 2]] = match kind {
         ElementKind::Quad4 => &[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
         _ => &[[1.0 / 3.0, 1.0 / 3.0]],
@@ -163,7 +164,9 @@ pub fn min_jacobian(kind: ElementKind, x: &[[f64; 2]]) -> f64 {
         .iter()
         .chain(stiffness_rule(kind).iter().map(|q| &q.0))
         .map(|&xi| kinematics(kind, x, xi).det_j)
-        .fold(f64::INFINITY, f64::min)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), j| {
+            (lo.min(j), hi.max(j))
+        })
 }
 
 /// Isotropic linear elasticity matrix (Voigt, engineering shear) for `plane`.

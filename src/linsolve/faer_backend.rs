@@ -96,13 +96,11 @@ impl SymmetricSolver for FaerCholesky {
             backend: NAME,
             message: format!("symbolic analysis failed: {e:?}"),
         })?;
-        let oom = |what: &str| Error::Solver {
-            backend: NAME,
-            message: format!("out of memory allocating the {what}"),
-        };
-        self.l_values = crate::memory::zeroed(sym.len_val());
-        let freq = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
-        self.factor_scratch = Some(MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?);
+        // The factor values and the workspace are allocated by the first numeric
+        // factorisation, so the caller can check the memory the analysis implies
+        // (`factor_nnz`) before it is taken.
+        self.l_values = Vec::new();
+        self.factor_scratch = None;
         self.symbolic = Some(sym);
         self.solve_scratch = None;
         self.solve_cols = 0;
@@ -114,6 +112,22 @@ impl SymmetricSolver for FaerCholesky {
     fn factorize(&mut self, a: &LowerCsc) -> Result<()> {
         let sym = self.symbolic.as_ref().ok_or_else(|| not_analysed(NAME))?;
         self.factorized = false;
+        if self.factor_scratch.is_none() {
+            let oom = |what: &str| Error::Solver {
+                backend: NAME,
+                message: format!("out of memory allocating the {what}"),
+            };
+            let len = sym.len_val();
+            let mut values = Vec::new();
+            values
+                .try_reserve_exact(len)
+                .map_err(|_| oom("factor values"))?;
+            values.resize(len, 0.0);
+            self.l_values = values;
+            let freq = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
+            self.factor_scratch =
+                Some(MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?);
+        }
         let mat = SparseColMatRef::new(Self::pattern(a), &a.values);
         let stack = MemStack::new(self.factor_scratch.as_mut().expect("set by analyze"));
         let simplicial = matches!(sym.raw(), SymbolicCholeskyRaw::Simplicial(_));

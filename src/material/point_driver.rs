@@ -146,45 +146,95 @@ fn targets(p: &PathSpec, t: f64) -> [(bool, f64); 3] {
     }
 }
 
-/// Validates the path; `field` prefixes errors.
+/// Validates the path: every number finite, steps that fit a counter, a table path
+/// with as many strains as strictly increasing times.
 fn check(p: &PathSpec) -> Result<()> {
     crate::config::positive_pub("path.dt", p.dt)?;
     crate::config::positive_pub("path.t_end", p.t_end)?;
     crate::config::positive_pub("path.length", p.length)?;
+    let steps = (p.t_end / p.dt).round();
+    if !(steps <= MAX_POINT_STEPS) {
+        return Err(Error::config(
+            "path.dt",
+            format!("t_end / dt = {steps:e} steps; at most {MAX_POINT_STEPS:e} are taken"),
+        ));
+    }
+    crate::config::finite_pub("path.amplitude", &[p.amplitude])?;
+    crate::config::finite_pub("path.ratio", &[p.ratio])?;
+    crate::config::check_function_pub("path.function", &p.function)?;
     if p.kind == PathKind::Table {
         if p.times.is_empty() || p.times.len() != p.strains.len() {
             return Err(Error::config(
                 "path.strains",
-                "a table path needs `times` and as many `strains`",
+                format!(
+                    "a table path needs `times` and as many `strains` (got {} times, {} strains)",
+                    p.times.len(),
+                    p.strains.len()
+                ),
             ));
         }
-        if p.times.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(Error::config("path.times", "must increase strictly"));
+        crate::config::finite_pub("path.times", &p.times)?;
+        for (i, e) in p.strains.iter().enumerate() {
+            crate::config::finite_pub(&format!("path.strains[{i}]"), e)?;
         }
-    } else if !p.amplitude.is_finite() {
-        return Err(Error::config("path.amplitude", "must be finite"));
+        if let Some(i) = p.times.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(Error::config(
+                "path.times",
+                format!(
+                    "must increase strictly, but times[{}] = {} follows times[{i}] = {}",
+                    i + 1,
+                    p.times[i + 1],
+                    p.times[i]
+                ),
+            ));
+        }
     }
     Ok(())
 }
 
+/// Steps a material-point path may take (one row each in `material.csv`).
+const MAX_POINT_STEPS: f64 = 1e8;
+
 /// Runs the path and returns one record per step (the first at `t = 0`).
 pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
+    let mut out = Vec::new();
+    run_path_with(mat, p, |r| {
+        out.push(r.clone());
+        Ok(())
+    })?;
+    Ok(out)
+}
+
+/// Runs the path and hands each record to `sink` as it is computed (the first at
+/// `t = 0`), so a long path needs no memory of its own.
+pub fn run_path_with<F>(mat: &Material, p: &PathSpec, mut sink: F) -> Result<usize>
+where
+    F: FnMut(&PointRecord) -> Result<()>,
+{
     check(p)?;
     let ns = mat.n_state();
     let mut state_n = vec![0.0; ns];
     mat.init_state(&mut state_n);
     let mut state = state_n.clone();
     let mut eps_n = [0.0; 3];
-    let mut out = vec![PointRecord {
+    sink(&PointRecord {
         t: 0.0,
         eps: eps_n,
         response: PointResponse::default(),
         state: state_n.clone(),
         dissipated: [0.0; 4],
         work: 0.0,
-    }];
+    })?;
     let n = (p.t_end / p.dt).round().max(1.0) as usize;
     let (mut diss, mut work) = ([0.0; 4], 0.0);
+    let mut record = PointRecord {
+        t: 0.0,
+        eps: eps_n,
+        response: PointResponse::default(),
+        state: state.clone(),
+        dissipated: diss,
+        work,
+    };
     for k in 1..=n {
         let t = k as f64 * p.dt;
         let tg = targets(p, t);
@@ -208,6 +258,12 @@ pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
                 &state_n,
                 &mut state,
             );
+            if resp.status != crate::material::PointStatus::Ok {
+                return Err(Error::Stepping(format!(
+                    "material point: the return mapping found no admissible state at t = {t:e} \
+                     (strain {eps:?})"
+                )));
+            }
             let free: Vec<usize> = (0..3).filter(|&i| !tg[i].0).collect();
             let r: Vec<f64> = free.iter().map(|&i| resp.sigma[i] - tg[i].1).collect();
             let scale = resp
@@ -219,7 +275,7 @@ pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
             if free.is_empty() || r.iter().all(|x| x.abs() <= 1e-12 * scale) {
                 break;
             }
-            if it == 50 {
+            if it == 50 || r.iter().any(|x| !x.is_finite()) {
                 return Err(Error::Stepping(format!(
                     "material point: no convergence of the mixed-control path at t = {t:e}"
                 )));
@@ -252,28 +308,43 @@ pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
         work += (0..3)
             .map(|i| resp.sigma[i] * (eps[i] - eps_n[i]))
             .sum::<f64>();
-        out.push(PointRecord {
-            t,
-            eps,
-            response: resp,
-            state: state.clone(),
-            dissipated: diss,
-            work,
-        });
+        record.t = t;
+        record.eps = eps;
+        record.response = resp;
+        record.state.clone_from(&state);
+        record.dissipated = diss;
+        record.work = work;
+        if let Some(bad) = record
+            .response
+            .sigma
+            .iter()
+            .chain(&eps)
+            .chain(&diss)
+            .find(|x| !x.is_finite())
+        {
+            return Err(Error::NonFinite {
+                quantity: "material point stress, strain or dissipation".into(),
+                value: *bad,
+                location: "the material point".into(),
+                t,
+            });
+        }
+        sink(&record)?;
         eps_n = eps;
         state_n.clone_from(&state);
     }
-    Ok(out)
+    Ok(n)
 }
 
-/// Reads a driver file, runs it and writes `out/material.csv`.
-pub fn run_file(file: &Path, out: &Path) -> Result<Vec<PointRecord>> {
+/// Reads a driver file, runs it and writes `out/material.csv` row by row as the path
+/// is computed (a failure part way keeps the rows written). Returns the steps taken.
+pub fn run_file(file: &Path, out: &Path) -> Result<usize> {
     let text = std::fs::read_to_string(file).map_err(|e| Error::io(file, e))?;
     let spec: DriverFile = toml::from_str(&text)
         .map_err(|e| Error::config(file.display().to_string(), e.message().to_string()))?;
     let mat = crate::config::material("point", "material", &spec.material)
         .map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
-    let records = run_path(&mat, &spec.path)?;
+    check(&spec.path).map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let path = out.join("material.csv");
     let mut w =
@@ -285,8 +356,10 @@ pub fn run_file(file: &Path, out: &Path) -> Result<Vec<PointRecord>> {
     header.extend(["D_viscous", "D_damage", "D_plastic", "D_num", "work"]);
     let io = |e| Error::io(&path, e);
     writeln!(w, "{}", header.join(",")).map_err(io)?;
-    for r in &records {
-        let mut row = vec![
+    let mut line = String::new();
+    let steps = run_path_with(&mat, &spec.path, |r| {
+        line.clear();
+        let values = [
             r.t,
             r.eps[0],
             r.eps[1],
@@ -295,13 +368,23 @@ pub fn run_file(file: &Path, out: &Path) -> Result<Vec<PointRecord>> {
             r.response.sigma[1],
             r.response.sigma[2],
             r.response.psi,
-        ];
-        row.extend(&r.state);
-        row.extend(r.dissipated);
-        row.push(r.work);
-        let line: Vec<String> = row.iter().map(|v| format!("{v:.12e}")).collect();
-        writeln!(w, "{}", line.join(",")).map_err(io)?;
-    }
+        ]
+        .into_iter()
+        .chain(r.state.iter().copied())
+        .chain(r.dissipated)
+        .chain([r.work]);
+        for (k, v) in values.enumerate() {
+            if k > 0 {
+                line.push(',');
+            }
+            line.push_str(&format!("{v:.12e}"));
+        }
+        writeln!(w, "{line}").map_err(io)?;
+        if r.t == 0.0 {
+            w.flush().map_err(io)?;
+        }
+        Ok(())
+    });
     w.flush().map_err(io)?;
-    Ok(records)
+    steps
 }

@@ -4,7 +4,10 @@
 //! physical groups become sets: a physical surface gives a node set, a physical curve
 //! gives a node set and an edge set (its 2-node line elements), a physical point gives
 //! a node set. Sets are named by their `$PhysicalNames` entry, or `physical_<dim>_<tag>`
-//! when the file names none. Elements given clockwise are turned counter-clockwise.
+//! when the file names none; a named group without elements is an empty set.
+//! Elements given clockwise are turned counter-clockwise. The file's node and element
+//! tags are kept for messages, and the part is checked (finite coordinates, every
+//! node in an element, no degenerate or distorted element) before it is used.
 //! `mshio` does not read `$PhysicalNames`, so that small text section is read here.
 
 use std::collections::{BTreeMap, HashMap};
@@ -16,7 +19,10 @@ use crate::error::{Error, Result};
 /// Reads a Gmsh v4.1 file into a [`Part`].
 pub fn read(path: &Path) -> Result<Part> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse(&bytes).map_err(|m| Error::Mesh(format!("{}: {m}", path.display())))
+    let part = parse(&bytes).map_err(|m| Error::Mesh(format!("{}: {m}", path.display())))?;
+    part.check()
+        .map_err(|m| Error::Mesh(format!("{}: {m}", path.display())))?;
+    Ok(part)
 }
 
 /// Parses the bytes of a Gmsh v4.1 file into a [`Part`].
@@ -38,6 +44,7 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     // Node tags to dense indices.
     let mut tag_to_index: HashMap<u64, usize> = HashMap::new();
     let mut coords = Vec::new();
+    let mut node_tags = Vec::new();
     let mut running_tag = nodes.min_node_tag;
     for block in &nodes.node_blocks {
         match &block.node_tags {
@@ -45,15 +52,20 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
                 let mut pairs: Vec<(u64, usize)> = tags.iter().map(|(&t, &i)| (t, i)).collect();
                 pairs.sort_by_key(|p| p.1);
                 for (tag, i) in pairs {
-                    let n = &block.nodes[i];
+                    let n = block
+                        .nodes
+                        .get(i)
+                        .ok_or_else(|| format!("node tag {tag} points past its node block"))?;
                     tag_to_index.insert(tag, coords.len());
                     coords.push([n.x, n.y]);
+                    node_tags.push(tag);
                 }
             }
             None => {
                 for n in &block.nodes {
                     tag_to_index.insert(running_tag, coords.len());
                     coords.push([n.x, n.y]);
+                    node_tags.push(running_tag);
                     running_tag += 1;
                 }
             }
@@ -86,8 +98,8 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
             .unwrap_or_else(|| format!("physical_{dim}_{tag}"))
     };
 
-    let mut quads = Vec::new();
-    let mut tris = Vec::new();
+    let (mut quads, mut quad_tags) = (Vec::new(), Vec::new());
+    let (mut tris, mut tri_tags) = (Vec::new(), Vec::new());
     let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut edge_sets: BTreeMap<String, Vec<[usize; 2]>> = BTreeMap::new();
     for block in &elements.element_blocks {
@@ -102,6 +114,19 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
                 .iter()
                 .map(|&t| index(t))
                 .collect::<std::result::Result<_, _>>()?;
+            let wanted = match block.element_type {
+                mshio::ElementType::Qua4 => 4,
+                mshio::ElementType::Tri3 => 3,
+                mshio::ElementType::Lin2 => 2,
+                _ => 0,
+            };
+            if ns.len() < wanted {
+                return Err(format!(
+                    "element with Gmsh tag {} has {} nodes, its type needs {wanted}",
+                    el.element_tag,
+                    ns.len()
+                ));
+            }
             match block.element_type {
                 mshio::ElementType::Qua4 => {
                     let mut q = [ns[0], ns[1], ns[2], ns[3]];
@@ -109,6 +134,7 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
                         q.swap(1, 3);
                     }
                     quads.extend_from_slice(&q);
+                    quad_tags.push(el.element_tag);
                 }
                 mshio::ElementType::Tri3 => {
                     let mut t = [ns[0], ns[1], ns[2]];
@@ -116,6 +142,7 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
                         t.swap(1, 2);
                     }
                     tris.extend_from_slice(&t);
+                    tri_tags.push(el.element_tag);
                 }
                 mshio::ElementType::Lin2 => {
                     for &g in &groups {
@@ -145,17 +172,26 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
         nodes.sort_unstable();
         nodes.dedup();
     }
+    // A named group without elements is an empty set, not an unknown one.
+    for (&(dim, _), name) in &names {
+        node_sets.entry(name.clone()).or_default();
+        if dim == 1 {
+            edge_sets.entry(name.clone()).or_default();
+        }
+    }
     let mut blocks = Vec::new();
     if !quads.is_empty() {
         blocks.push(Elements {
             kind: ElementKind::Quad4,
             conn: quads,
+            tags: Some(quad_tags),
         });
     }
     if !tris.is_empty() {
         blocks.push(Elements {
             kind: ElementKind::Tri3,
             conn: tris,
+            tags: Some(tri_tags),
         });
     }
     if blocks.is_empty() {
@@ -168,6 +204,7 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
         blocks,
         node_sets,
         edge_sets,
+        node_tags: Some(node_tags),
     })
 }
 

@@ -20,6 +20,9 @@ pub struct Elements {
     pub kind: ElementKind,
     /// Node indices, `kind.nodes()` per element.
     pub conn: Vec<usize>,
+    /// The element tags of the file the elements came from (Gmsh), for messages;
+    /// `None` for generated meshes, whose elements are named by their index.
+    pub tags: Option<Vec<u64>>,
 }
 
 impl Elements {
@@ -38,6 +41,85 @@ impl Elements {
         let n = self.kind.nodes();
         &self.conn[e * n..(e + 1) * n]
     }
+
+    /// Elements of `kind` with connectivity `conn` and no file tags.
+    pub fn new(kind: ElementKind, conn: Vec<usize>) -> Self {
+        Elements {
+            kind,
+            conn,
+            tags: None,
+        }
+    }
+
+    /// How element `e` is named in messages: its file tag, or its index.
+    pub fn name(&self, e: usize) -> String {
+        match &self.tags {
+            Some(t) => format!("element with Gmsh tag {}", t[e]),
+            None => format!("element {e}"),
+        }
+    }
+}
+
+/// The shape of a continuum element, from the Jacobian of its reference map at its
+/// corners and Gauss points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// Positive Jacobian everywhere.
+    Valid,
+    /// Negative Jacobian everywhere: the nodes run clockwise.
+    Inverted,
+    /// Zero area: coincident or collinear nodes.
+    Degenerate,
+    /// The Jacobian changes sign: a non-convex or self-intersecting quadrilateral.
+    Distorted,
+}
+
+impl Shape {
+    /// The shape of a Quad4 or Tri3 with node coordinates `x` (bars: by length).
+    pub fn of(kind: ElementKind, x: &[[f64; 2]]) -> Shape {
+        let dist =
+            |p: [f64; 2], q: [f64; 2]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+        let size = (0..x.len())
+            .map(|a| dist(x[a], x[(a + 1) % x.len()]))
+            .fold(0.0, f64::max);
+        if kind == ElementKind::Bar2 {
+            return if size > 0.0 {
+                Shape::Valid
+            } else {
+                Shape::Degenerate
+            };
+        }
+        let area = 0.5
+            * (0..x.len())
+                .map(|a| {
+                    let b = (a + 1) % x.len();
+                    x[a][0] * x[b][1] - x[b][0] * x[a][1]
+                })
+                .sum::<f64>();
+        if !(area.abs() > 1e-12 * size * size) {
+            return Shape::Degenerate;
+        }
+        let (lo, hi) = crate::fe::jacobian_range(kind, x);
+        if lo > 0.0 {
+            Shape::Valid
+        } else if hi < 0.0 {
+            Shape::Inverted
+        } else {
+            Shape::Distorted
+        }
+    }
+
+    /// What is wrong, for messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Shape::Valid => "valid",
+            Shape::Inverted => "inverted: its nodes run clockwise (they must run counter-clockwise)",
+            Shape::Degenerate => "degenerate: its area is zero (coincident or collinear nodes)",
+            Shape::Distorted => {
+                "distorted: its Jacobian changes sign (a non-convex or self-intersecting quadrilateral)"
+            }
+        }
+    }
 }
 
 /// The geometry of one body: nodes, continuum elements and named sets.
@@ -51,6 +133,58 @@ pub struct Part {
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Named boundary edge sets (node pairs, oriented with the body on the left).
     pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
+    /// The node tags of the file the part came from (Gmsh), for messages.
+    pub node_tags: Option<Vec<u64>>,
+}
+
+impl Part {
+    fn node_name(&self, n: usize) -> String {
+        match &self.node_tags {
+            Some(t) => format!("node with Gmsh tag {} at {:?}", t[n], self.coords[n]),
+            None => format!("node {n} at {:?}", self.coords[n]),
+        }
+    }
+
+    /// Checks that the coordinates are finite, that every node belongs to an element
+    /// and that every element is valid ([`Shape`]); the error names the node or the
+    /// element (by its file tag when the part came from a file).
+    pub fn check(&self) -> std::result::Result<(), String> {
+        if let Some(n) = self
+            .coords
+            .iter()
+            .position(|c| !(c[0].is_finite() && c[1].is_finite()))
+        {
+            return Err(format!("{} has a non-finite coordinate", self.node_name(n)));
+        }
+        let mut used = vec![false; self.coords.len()];
+        for b in &self.blocks {
+            for &n in &b.conn {
+                used[n] = true;
+            }
+        }
+        if let Some(n) = used.iter().position(|u| !u) {
+            return Err(format!(
+                "{} belongs to no element (remove it from the mesh, e.g. with Gmsh's \
+                 `Mesh.SaveAll = 0` and physical groups for the elements)",
+                self.node_name(n)
+            ));
+        }
+        for b in &self.blocks {
+            for e in 0..b.len() {
+                let x: Vec<[f64; 2]> = b.element(e).iter().map(|&n| self.coords[n]).collect();
+                let shape = Shape::of(b.kind, &x);
+                if shape != Shape::Valid {
+                    return Err(format!(
+                        "{} (nodes {:?}) is {}",
+                        b.name(e),
+                        b.element(e),
+                        shape.describe()
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// What an element block is made of and how thick it is.
@@ -115,6 +249,7 @@ impl Mesh {
                 elements: Elements {
                     kind: b.kind,
                     conn: b.conn.iter().map(|&n| n + off).collect(),
+                    tags: b.tags.clone(),
                 },
                 body,
                 material,
@@ -168,31 +303,45 @@ impl Mesh {
             .map(|(n, _)| n)
     }
 
-    /// Checks every continuum element for positive Jacobian at its Gauss points and
-    /// every bar for positive length: an inverted or degenerate element is an error
-    /// that names the block, the element and its nodes.
-    pub fn check_elements(&self) -> Result<()> {
-        for (bi, block) in self.blocks.iter().enumerate() {
+    /// Checks every element ([`Shape`]): an inverted, degenerate or distorted
+    /// element is an error that names its body, the element (by its file tag when it
+    /// has one) and its nodes.
+    pub fn check_elements(&self, body_names: &[String]) -> Result<()> {
+        for block in &self.blocks {
             for e in 0..block.elements.len() {
                 let nodes = block.elements.element(e);
                 let x: Vec<[f64; 2]> = nodes.iter().map(|&n| self.coords[n]).collect();
-                let ok = match block.elements.kind {
-                    ElementKind::Bar2 => {
-                        let l = ((x[1][0] - x[0][0]).powi(2) + (x[1][1] - x[0][1]).powi(2)).sqrt();
-                        l > 0.0
-                    }
-                    kind => crate::fe::min_jacobian(kind, &x) > 0.0,
-                };
-                if !ok {
+                let shape = Shape::of(block.elements.kind, &x);
+                if shape != Shape::Valid {
                     return Err(Error::Mesh(format!(
-                        "block {bi}, element {e} (nodes {nodes:?}) is inverted or degenerate \
-                         (non-positive Jacobian or zero length); continuum nodes must run \
-                         counter-clockwise"
+                        "body `{}`: {} (nodes {nodes:?}) is {}",
+                        body_names.get(block.body).map_or("?", |s| s.as_str()),
+                        block.elements.name(e),
+                        shape.describe()
                     )));
                 }
             }
         }
         Ok(())
+    }
+
+    /// The largest edge of the elements holding node `n` (0 for a node of no element).
+    pub fn element_size_at(&self, n: usize) -> f64 {
+        let dist =
+            |p: [f64; 2], q: [f64; 2]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+        let mut size: f64 = 0.0;
+        for b in &self.blocks {
+            for e in 0..b.elements.len() {
+                let nodes = b.elements.element(e);
+                if nodes.contains(&n) {
+                    for a in 0..nodes.len() {
+                        let c = (a + 1) % nodes.len();
+                        size = size.max(dist(self.coords[nodes[a]], self.coords[nodes[c]]));
+                    }
+                }
+            }
+        }
+        size
     }
 
     /// Characteristic length of element `e` of `block` (the CFL estimate takes the minimum):

@@ -70,9 +70,10 @@ pub fn rectangle(
     );
     Part {
         coords,
-        blocks: vec![Elements { kind, conn }],
+        blocks: vec![Elements::new(kind, conn)],
         node_sets,
         edge_sets,
+        node_tags: None,
     }
 }
 

@@ -122,6 +122,18 @@ pub enum Outcome {
     MaterialFailure(PointFailure),
     /// A constrained correction failed (e.g. the contact QP).
     ConstraintFailure(String),
+    /// The residual of the start of the step (or of an affine problem) is not a
+    /// finite number: the data of the step, not the iteration, is at fault, and a
+    /// smaller step would not help.
+    NonFinite {
+        /// The quantity found non-finite first (the loop reports `residual`; the
+        /// integrator names the vector it came from).
+        quantity: &'static str,
+        /// The dof where it was found.
+        dof: Option<usize>,
+        /// The value (NaN or an infinity).
+        value: f64,
+    },
 }
 
 impl Outcome {
@@ -214,8 +226,21 @@ where
             let small_correction = affine
                 || last_correction
                     .is_none_or(|c| c <= test.displacement_tolerance * ev.increment2.sqrt());
+            let finite = nl.is_finite() && ev.magnitude2.is_finite() && ev.increment2.is_finite();
+            if !finite && (iterations == 0 || affine) {
+                // Nothing an iteration did: the loads, the state or the materials.
+                let (dof, value) = match worst {
+                    Some((d, r)) if !r.is_finite() => (Some(d), r),
+                    _ => (None, if nl.is_finite() { f64::INFINITY } else { nl }),
+                };
+                return Ok(Outcome::NonFinite {
+                    quantity: "residual",
+                    dof,
+                    value,
+                });
+            }
             let at_roundoff = r2 <= ROUNDOFF * ROUNDOFF * ev.magnitude2;
-            if nl.is_finite()
+            if finite
                 && ((nl <= test.tolerance && small_correction) || at_roundoff)
                 && test.constraints_hold(&constraints)
             {
@@ -224,7 +249,7 @@ where
                     residual: nl,
                 });
             }
-            if iterations >= test.max_iterations || !nl.is_finite() {
+            if iterations >= test.max_iterations || !finite {
                 return Ok(Outcome::NotConverged {
                     iterations,
                     history: scratch.history.clone(),

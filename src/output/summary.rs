@@ -30,8 +30,17 @@ impl Default for ProbeSummary {
 }
 
 impl ProbeSummary {
-    /// Takes one sample.
+    /// Takes one sample. A NaN sample makes every extreme NaN (`f64::max` would
+    /// drop it and report the extremes of the other samples as if nothing happened).
     pub fn sample(&mut self, uy: f64) {
+        if uy.is_nan() || self.max_abs_uy.is_nan() {
+            *self = ProbeSummary {
+                max_abs_uy: f64::NAN,
+                min_uy: f64::NAN,
+                max_uy: f64::NAN,
+            };
+            return;
+        }
         self.max_abs_uy = self.max_abs_uy.max(uy.abs());
         self.min_uy = self.min_uy.min(uy);
         self.max_uy = self.max_uy.max(uy);
@@ -117,7 +126,7 @@ pub struct SolverSummary {
 /// The whole summary.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    /// `completed` or `failed`.
+    /// `running` (the run is going, or was killed), `completed` or `failed`.
     pub status: String,
     /// The error, when failed.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -143,9 +152,13 @@ pub struct Summary {
 }
 
 impl Summary {
-    /// Writes pretty JSON to `path`.
+    /// Writes pretty JSON to `path`, atomically (a temporary file renamed over it),
+    /// so a reader never sees half a summary.
     pub fn write(&self, path: &Path) -> Result<()> {
-        let text = serde_json::to_string_pretty(self).expect("summary serialises");
-        std::fs::write(path, text).map_err(|e| Error::io(path, e))
+        let text = serde_json::to_string_pretty(self)
+            .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))?;
+        let tmp = path.with_extension("json.tmp");
+        std::fs::write(&tmp, text).map_err(|e| Error::io(&tmp, e))?;
+        std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
     }
 }

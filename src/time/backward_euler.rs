@@ -29,6 +29,16 @@ pub struct BackwardEuler<'m> {
 impl<'m> BackwardEuler<'m> {
     /// Assembles `K`, `M`, the effective matrix, analyses and factorises it.
     pub fn new(model: &'m Model, backend: Backend) -> Result<Self> {
+        Self::with_memory_limit(model, backend, None)
+    }
+
+    /// [`BackwardEuler::new`], refusing a factor whose memory estimate exceeds
+    /// `memory_limit` bytes before it is allocated.
+    pub fn with_memory_limit(
+        model: &'m Model,
+        backend: Backend,
+        memory_limit: Option<u64>,
+    ) -> Result<Self> {
         let a = &model.analysis;
         let scheme = Scheme::BackwardEuler {
             h: a.dt,
@@ -36,7 +46,7 @@ impl<'m> BackwardEuler<'m> {
             damp_k: a.rayleigh[1],
         };
         Ok(BackwardEuler {
-            core: Core::new(model, backend, scheme)?,
+            core: Core::new(model, backend, scheme, memory_limit)?,
         })
     }
 

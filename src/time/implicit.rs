@@ -193,6 +193,7 @@ impl Operators {
         &self,
         model: &Model,
         backend: Backend,
+        memory_limit: Option<u64>,
     ) -> Result<(EffectiveSystem, Factored)> {
         let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
         let mut sys = EffectiveSystem::new(
@@ -202,6 +203,9 @@ impl Operators {
             model.analysis.ordering,
             &model.mesh.coords,
         )?;
+        // The analysis knows the factor's size: refuse before it is allocated.
+        crate::config::memory_estimate(model, sys.factor_nnz())
+            .check(memory_limit, "the factorisation")?;
         let factored = match self.response {
             Response::StateDependent(_) => {
                 let stores = new_stores(&model.mesh, &model.materials);
@@ -713,6 +717,27 @@ pub(crate) fn step(
             iterations,
             nl_residual: residual,
         },
+        Outcome::NonFinite { dof, value, .. } => {
+            // Name the vector the non-finite value came from: the loads first, then
+            // the committed state, then what the evaluation produced.
+            let found = first_non_finite(&[
+                ("f_ext (applied loads)", &w.f_ext_np1),
+                ("u (committed)", &s.u),
+                ("v (committed)", &s.v),
+                ("f_int (committed)", &s.f_int),
+                ("f_int", &w.f_int_np1),
+                ("M v", &w.mv_np1),
+                ("residual", &w.r),
+            ]);
+            let (quantity, dof, value) = found.unwrap_or(("residual", dof, value));
+            let outcome = Outcome::NonFinite {
+                quantity,
+                dof,
+                value,
+            };
+            let message = describe(model, &outcome, t1, h);
+            return Ok(StepOutcome::Rejected(Rejection { outcome, message }));
+        }
         other => {
             let message = describe(model, &other, t1, h);
             return Ok(StepOutcome::Rejected(Rejection {
@@ -722,7 +747,26 @@ pub(crate) fn step(
         }
     };
     finish(ops, sys.dofs(), w, s, t1);
+    if let Some((quantity, value)) = s.ledger.first_non_finite() {
+        return Err(Error::NonFinite {
+            quantity: format!("the ledger line {quantity}"),
+            value,
+            location: "the whole model".into(),
+            t: t1,
+        });
+    }
     Ok(StepOutcome::Accepted(report))
+}
+
+/// The first non-finite entry of the named vectors, in order.
+fn first_non_finite(
+    vectors: &[(&'static str, &[f64])],
+) -> Option<(&'static str, Option<usize>, f64)> {
+    vectors.iter().find_map(|(name, v)| {
+        v.iter()
+            .position(|x| !x.is_finite())
+            .map(|d| (*name, Some(d), v[d]))
+    })
 }
 
 /// Books the converged step and makes it the state. The last evaluation summed the
@@ -811,6 +855,15 @@ fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> String {
             model.describe_point(f.block, f.element)
         ),
         Outcome::ConstraintFailure(why) => format!("the constraint solve failed {when}: {why}"),
+        Outcome::NonFinite {
+            quantity,
+            dof,
+            value,
+        } => format!(
+            "{quantity} is {value} {when}{}",
+            dof.map(|d| format!(" at {}", model.describe_dof(d)))
+                .unwrap_or_default()
+        ),
     }
 }
 
@@ -828,12 +881,18 @@ pub(crate) struct Core<'m> {
 
 impl<'m> Core<'m> {
     /// Assembles, analyses and factorises; a matrix that is not positive definite
-    /// from the start is an error traced to its likely cause.
-    pub fn new(model: &'m Model, backend: Backend, scheme: Scheme) -> Result<Self> {
+    /// from the start is an error traced to its likely cause, and a factor that would
+    /// not fit in `memory_limit` bytes is refused before it is allocated.
+    pub fn new(
+        model: &'m Model,
+        backend: Backend,
+        scheme: Scheme,
+        memory_limit: Option<u64>,
+    ) -> Result<Self> {
         let t0 = Instant::now();
         let ops = Operators::new(model, scheme);
         let assembly_s = t0.elapsed().as_secs_f64();
-        let (sys, factored) = ops.initial_system(model, backend)?;
+        let (sys, factored) = ops.initial_system(model, backend, memory_limit)?;
         if let Factored::NotPositiveDefinite { dof, message } = factored {
             return Err(Error::Solver {
                 backend: sys.backend(),

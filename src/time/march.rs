@@ -1,9 +1,12 @@
 //! Adaptive step control for any [`Integrator`]: a step the equilibrium loop rejects
 //! is halved and retried from the same state; after four accepted steps at a reduced
-//! size the step doubles back, never beyond the requested one.
+//! size the step doubles back, never beyond the requested one. A step whose data is
+//! not finite (`Outcome::NonFinite`) stops the march at once: a smaller step would
+//! not help.
 
-use super::{Integrator, State, StepOutcome, StepReport};
+use super::{Integrator, Rejection, State, StepOutcome, StepReport};
 use crate::error::{Error, Result};
+use crate::nonlinear::Outcome;
 
 /// What [`march`] reports to its observer.
 pub enum Marched<'a> {
@@ -44,9 +47,10 @@ impl StepControl {
 /// Accepted steps at a reduced size before the step doubles back.
 const EASY_STEPS_TO_GROW: usize = 4;
 
-/// Integrates `s` to `control.t_end` (see the module docs). `observe` sees every
-/// accepted step and every cut; an error from it stops the march. On failure the
-/// error names the step and time, and `s` holds the last accepted state.
+/// Integrates `s` to `control.t_end` (see the module docs). `observe` sees the
+/// integrator (for its timings and solver facts), the state and every accepted step
+/// and every cut; an error from it stops the march. On failure the error names the
+/// step and time, and `s` holds the last accepted state.
 pub fn march<I, F>(
     integrator: &mut I,
     s: &mut State,
@@ -55,7 +59,7 @@ pub fn march<I, F>(
 ) -> Result<()>
 where
     I: Integrator + ?Sized,
-    F: FnMut(&State, Marched) -> Result<()>,
+    F: FnMut(&I, &State, Marched) -> Result<()>,
 {
     let StepControl {
         h: h0,
@@ -71,7 +75,7 @@ where
         }
         match integrator.step(s)? {
             StepOutcome::Accepted(report) => {
-                observe(s, Marched::Step(&report))?;
+                observe(integrator, s, Marched::Step(&report))?;
                 cuts_in_row = 0;
                 if h < h0 {
                     easy += 1;
@@ -81,11 +85,32 @@ where
                     }
                 }
             }
+            StepOutcome::Rejected(Rejection {
+                outcome:
+                    Outcome::NonFinite {
+                        quantity,
+                        dof,
+                        value,
+                    },
+                ..
+            }) => {
+                // Not the iteration's fault: a smaller step would not help.
+                return Err(Error::NonFinite {
+                    quantity: quantity.to_string(),
+                    value,
+                    location: match dof {
+                        Some(d) => integrator.model().describe_dof(d),
+                        None => "the whole model".into(),
+                    },
+                    t: s.t + integrator.h(),
+                });
+            }
             StepOutcome::Rejected(r) if cuts_in_row < max_cuts => {
                 cuts_in_row += 1;
                 easy = 0;
                 h *= 0.5;
                 observe(
+                    integrator,
                     s,
                     Marched::Cut {
                         h,

@@ -19,11 +19,21 @@ impl<'m> Statics<'m> {
     /// Assembles `K`, analyses and factorises it (an unsupported body is an error
     /// that says so).
     pub fn new(model: &'m Model, backend: Backend) -> Result<Self> {
+        Self::with_memory_limit(model, backend, None)
+    }
+
+    /// [`Statics::new`], refusing a factor whose memory estimate exceeds
+    /// `memory_limit` bytes before it is allocated.
+    pub fn with_memory_limit(
+        model: &'m Model,
+        backend: Backend,
+        memory_limit: Option<u64>,
+    ) -> Result<Self> {
         let scheme = Scheme::Static {
             dt: model.analysis.dt,
         };
         Ok(Statics {
-            core: Core::new(model, backend, scheme)?,
+            core: Core::new(model, backend, scheme, memory_limit)?,
         })
     }
 

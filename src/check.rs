@@ -1,0 +1,190 @@
+//! `rothe check`: what a scenario will take before it runs. The report gives the
+//! bodies, nodes, elements and dofs, the steps and the output they write (history
+//! rows, VTK files and their size), the explicit critical step, the nonzeros of the
+//! effective matrix and of its factor (from the symbolic analysis, so nothing large is
+//! allocated), and the memory the run needs against what the machine has. Huge step
+//! counts and outputs are warnings; a model that would not fit is an error unless the
+//! limit is lifted.
+
+use std::fmt;
+
+use crate::assembly::Pattern;
+use crate::error::Result;
+use crate::linsolve::Backend;
+use crate::memory::{human, Estimate};
+use crate::model::Model;
+use crate::system::{DofMap, EffectiveSystem};
+
+/// Output volumes from which `check` warns.
+const HUGE_OUTPUT: u64 = 20_000_000_000;
+
+/// What `rothe check` reports.
+#[derive(Clone, Debug)]
+pub struct Report {
+    /// Body lines: name, elements, thickness, velocity.
+    pub bodies: Vec<(String, usize, f64, [f64; 2])>,
+    /// Nodes.
+    pub nodes: usize,
+    /// Elements.
+    pub elements: usize,
+    /// Dofs and free dofs.
+    pub dofs: (usize, usize),
+    /// Steps, step size, end time.
+    pub steps: (usize, f64, f64),
+    /// History rows and their bytes.
+    pub history: (usize, u64),
+    /// VTK files and their total bytes.
+    pub vtk: (usize, u64),
+    /// The explicit critical step, its block and element, and `h / Δt_crit`.
+    pub cfl: Option<(f64, usize, usize, f64)>,
+    /// nnz of the effective matrix (lower) and of the factor.
+    pub nnz: (usize, usize),
+    /// Whether the ordering is nested dissection.
+    pub nested_dissection: bool,
+    /// The memory estimate with the factor's exact size.
+    pub memory: Estimate,
+    /// Memory available on this machine.
+    pub available: Option<u64>,
+    /// Warnings (huge step counts, huge outputs).
+    pub warnings: Vec<String>,
+}
+
+/// Analyses `model` (pattern and symbolic factorisation, no numeric work) and
+/// reports; refuses a model whose memory estimate exceeds `memory_limit`.
+pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
+    let mesh = &model.mesh;
+    let pattern = Pattern::new(mesh);
+    let dofs = DofMap::new(mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+    let system = EffectiveSystem::new(
+        &pattern,
+        dofs,
+        Backend::Faer,
+        model.analysis.ordering,
+        &mesh.coords,
+    )?;
+    let nnz_l = system.factor_nnz().unwrap_or(0);
+    let memory = crate::config::memory_estimate(model, Some(nnz_l));
+    memory.check(memory_limit, "the run")?;
+    let a = &model.analysis;
+    let steps = a.n_steps();
+    let probes = model.probes.len();
+    // A row: 12 ledger columns, 2 solver columns, 2 per probe, about 20 bytes each.
+    let row_bytes = (16 + 2 * probes) as u64 * 20;
+    let history = (steps + 1, (steps as u64 + 1) * row_bytes);
+    let vtk_files = if a.vtk_every == 0 {
+        0
+    } else {
+        steps / a.vtk_every + 1
+    };
+    // Points (3 doubles), connectivity, two vector fields, cell fields, as ASCII.
+    let vtk_file_bytes =
+        (mesh.n_nodes() as u64) * (3 + 3 + 3) * 24 + (mesh.n_elements() as u64) * (5 + 6) * 24;
+    let vtk = (vtk_files, vtk_files as u64 * vtk_file_bytes);
+    let mut warnings = Vec::new();
+    if steps >= crate::config::HUGE_STEPS {
+        warnings.push(format!(
+            "{steps} steps: is dt ({:e} s) meant? t_end / dt sets the step count",
+            a.dt
+        ));
+    }
+    if history.1 + vtk.1 >= HUGE_OUTPUT {
+        warnings.push(format!(
+            "the output will take about {} (history {}, {} VTK files {}): raise vtk_every or \
+             shorten the run",
+            human(history.1 + vtk.1),
+            human(history.1),
+            vtk.0,
+            human(vtk.1)
+        ));
+    }
+    let cfl =
+        crate::time::cfl::critical_step(model).map(|c| (c.dt, c.block, c.element, a.dt / c.dt));
+    Ok(Report {
+        bodies: model
+            .bodies
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let els: usize = mesh
+                    .blocks
+                    .iter()
+                    .filter(|bl| bl.body == i)
+                    .map(|bl| bl.elements.len())
+                    .sum();
+                (b.name.clone(), els, b.thickness, b.velocity)
+            })
+            .collect(),
+        nodes: mesh.n_nodes(),
+        elements: mesh.n_elements(),
+        dofs: (mesh.n_dofs(), system.dofs().n_free()),
+        steps: (steps, a.dt, a.t_end),
+        history,
+        vtk,
+        cfl,
+        nnz: (system.matrix().row_idx.len(), nnz_l),
+        nested_dissection: system.nested_dissection(),
+        memory,
+        available: memory_limit.or_else(crate::memory::available),
+        warnings,
+    })
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        writeln!(f, "bodies      {}", self.bodies.len())?;
+        for (name, els, t, v) in &self.bodies {
+            writeln!(
+                f,
+                "  {name:<12} {els} elements, thickness {t} m, velocity {v:?} m/s"
+            )?;
+        }
+        writeln!(f, "nodes       {}", self.nodes)?;
+        writeln!(f, "elements    {}", self.elements)?;
+        writeln!(f, "dofs        {} ({} free)", self.dofs.0, self.dofs.1)?;
+        let (steps, dt, t_end) = self.steps;
+        writeln!(f, "steps       {steps} of h = {dt:e} s to T = {t_end:e} s")?;
+        writeln!(
+            f,
+            "output      history.csv {} rows ({}), {} VTK files ({})",
+            self.history.0,
+            human(self.history.1),
+            self.vtk.0,
+            human(self.vtk.1)
+        )?;
+        if let Some((dt_c, block, element, ratio)) = self.cfl {
+            writeln!(
+                f,
+                "CFL step    {dt_c:.4e} s (explicit central differences; block {block}, element {element}); h / CFL = {ratio:.3}"
+            )?;
+        }
+        writeln!(
+            f,
+            "nnz(K_eff)  {} (lower), nnz(L) {} (faer, {})",
+            self.nnz.0,
+            self.nnz.1,
+            if self.nested_dissection {
+                "nested dissection"
+            } else {
+                "AMD"
+            }
+        )?;
+        let m = &self.memory;
+        write!(
+            f,
+            "memory      about {} (mesh {}, matrices {}, factor {}, state {})",
+            human(m.total()),
+            human(m.mesh),
+            human(m.matrices),
+            human(m.factor),
+            human(m.state)
+        )?;
+        match self.available {
+            Some(a) => writeln!(f, "; {} available", human(a))?,
+            None => writeln!(f)?,
+        }
+        for w in &self.warnings {
+            writeln!(f, "warning     {w}")?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,239 @@
+//! Body meshes and bars: generated rectangles (sized before they are built), Gmsh
+//! files, bars along lines of nodes, and the memory estimate of the whole model.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::checks::{finite, positive};
+use crate::config::{LoadOptions, MeshSpec, Scenario};
+use crate::error::{Error, Result};
+use crate::material::Material;
+use crate::memory::{factor_nnz_estimate, Estimate};
+use crate::mesh::{gmsh, structured, Block, ElementKind, Elements, Mesh, Part};
+use crate::model::Body;
+
+/// The nodes and elements of a rectangle of `nx x ny` cells, or `None` if the counts
+/// overflow.
+fn rectangle_size(nx: usize, ny: usize, element: ElementKind) -> Option<(u64, u64)> {
+    let nodes = (nx as u64)
+        .checked_add(1)?
+        .checked_mul((ny as u64).checked_add(1)?)?;
+    let cells = (nx as u64).checked_mul(ny as u64)?;
+    let elements = match element {
+        ElementKind::Tri3 => cells.checked_mul(2)?,
+        _ => cells,
+    };
+    Some((nodes, elements))
+}
+
+/// Estimates the generated meshes before building them, so that a mistyped
+/// `divisions` is refused instead of allocating what the machine does not have.
+pub(super) fn check_generated_size(
+    s: &Scenario,
+    materials: &[Material],
+    mat_index: &BTreeMap<String, usize>,
+    opts: &LoadOptions,
+) -> Result<()> {
+    let (mut nodes, mut elements, mut points, mut history) = (0u64, 0u64, 0u64, 0u64);
+    for (bi, b) in s.bodies.iter().enumerate() {
+        if let MeshSpec::Rectangle {
+            divisions, element, ..
+        } = &b.mesh
+        {
+            let field = format!("bodies[{bi}].mesh.divisions");
+            let (n, e) = rectangle_size(divisions[0], divisions[1], *element).ok_or_else(|| {
+                Error::config(
+                    &field,
+                    format!("{divisions:?} cells: the node count overflows"),
+                )
+            })?;
+            nodes = nodes.saturating_add(n);
+            elements = elements.saturating_add(e);
+            let per = if *element == ElementKind::Tri3 { 1 } else { 4 };
+            points = points.saturating_add(e.saturating_mul(per));
+            if let Some(&m) = mat_index.get(&b.material) {
+                history = history.max(materials[m].n_state() as u64);
+            }
+        }
+    }
+    if nodes == 0 {
+        return Ok(());
+    }
+    let dofs = usize::try_from(nodes.saturating_mul(2)).unwrap_or(usize::MAX);
+    let tangent = materials.iter().any(|m| !m.has_constant_tangent());
+    let est = Estimate::of(
+        nodes,
+        elements,
+        points,
+        history,
+        factor_nnz_estimate(dofs),
+        tangent,
+    );
+    est.check(
+        opts.memory_limit,
+        &format!("the generated meshes ({nodes} nodes, {elements} elements)"),
+    )
+    .map_err(|e| Error::config("bodies[..].mesh.divisions", e.to_string()))
+}
+
+/// The memory estimate of the built mesh (the factor from its size: the exact
+/// figure is checked again after the symbolic analysis, before the factorisation).
+pub(super) fn check_memory(mesh: &Mesh, materials: &[Material], opts: &LoadOptions) -> Result<()> {
+    let est = estimate(mesh, materials, None);
+    est.check(
+        opts.memory_limit,
+        &format!(
+            "the model ({} nodes, {} elements)",
+            mesh.n_nodes(),
+            mesh.n_elements()
+        ),
+    )
+}
+
+/// The memory estimate of a model, with the factor's exact nonzeros when known.
+pub fn estimate(mesh: &Mesh, materials: &[Material], factor_nnz: Option<usize>) -> Estimate {
+    let points: u64 = mesh
+        .blocks
+        .iter()
+        .map(|b| {
+            (b.elements.len() * crate::assembly::internal::points_per_element(b.elements.kind))
+                as u64
+        })
+        .sum();
+    let history = materials.iter().map(|m| m.n_state()).max().unwrap_or(0) as u64;
+    let tangent = materials.iter().any(|m| !m.has_constant_tangent());
+    Estimate::of(
+        mesh.n_nodes() as u64,
+        mesh.n_elements() as u64,
+        points,
+        history,
+        factor_nnz.map_or_else(|| factor_nnz_estimate(mesh.n_dofs()), |n| n as u64),
+        tangent,
+    )
+}
+
+/// A body's part from its mesh spec.
+pub(super) fn body_part(field: &str, spec: &MeshSpec, dir: &Path) -> Result<Part> {
+    match spec {
+        MeshSpec::Rectangle {
+            origin,
+            size,
+            divisions,
+            element,
+        } => {
+            finite(&format!("{field}.origin"), origin)?;
+            positive(&format!("{field}.size[0]"), size[0])?;
+            positive(&format!("{field}.size[1]"), size[1])?;
+            if divisions[0] == 0 || divisions[1] == 0 {
+                return Err(Error::config(
+                    format!("{field}.divisions"),
+                    format!("must be at least 1 each way, got {divisions:?}"),
+                ));
+            }
+            if *element == ElementKind::Bar2 {
+                return Err(Error::config(
+                    format!("{field}.element"),
+                    "a rectangle is meshed with quad4 or tri3",
+                ));
+            }
+            Ok(structured::rectangle(
+                *origin,
+                *size,
+                divisions[0],
+                divisions[1],
+                *element,
+            ))
+        }
+        MeshSpec::Gmsh { file } => {
+            if file.trim().is_empty() {
+                return Err(Error::config(
+                    format!("{field}.file"),
+                    "the mesh file name is empty",
+                ));
+            }
+            let path = dir.join(file);
+            if !path.is_file() {
+                return Err(Error::config(
+                    format!("{field}.file"),
+                    format!("mesh file {} does not exist", path.display()),
+                ));
+            }
+            gmsh::read(&path).map_err(|e| Error::config(format!("{field}.file"), e.to_string()))
+        }
+    }
+}
+
+/// Adds the bar blocks: 2-node bars through the body's nodes on each line. A bar's
+/// name becomes a node set (`body.name`) and must not shadow an existing set.
+pub(super) fn add_bars(
+    s: &Scenario,
+    mesh: &mut Mesh,
+    bodies: &[Body],
+    materials: &[Material],
+    find_material: &dyn Fn(String, &str) -> Result<usize>,
+) -> Result<()> {
+    for (i, bar) in s.bars.iter().enumerate() {
+        let field = format!("bars[{i}]");
+        if bar.name.is_empty() || bar.name.contains('.') {
+            return Err(Error::config(
+                format!("{field}.name"),
+                "must be non-empty and contain no `.`",
+            ));
+        }
+        positive(&format!("{field}.area"), bar.area)?;
+        finite(&format!("{field}.from"), &bar.from)?;
+        finite(&format!("{field}.to"), &bar.to)?;
+        let mat = find_material(format!("{field}.material"), &bar.material)?;
+        if !materials[mat].is_linear_elastic() {
+            return Err(Error::config(
+                format!("{field}.material"),
+                "bars take an elastic material",
+            ));
+        }
+        let body = bodies
+            .iter()
+            .position(|b| b.name == bar.body)
+            .ok_or_else(|| {
+                Error::config(
+                    format!("{field}.body"),
+                    format!("unknown body `{}`", bar.body),
+                )
+            })?;
+        let set = format!("{}.{}", bar.body, bar.name);
+        if mesh.node_sets.contains_key(&set) || mesh.edge_sets.contains_key(&set) {
+            return Err(Error::config(
+                format!("{field}.name"),
+                format!("`{set}` is already a set of the mesh; give the bar another name"),
+            ));
+        }
+        let len = ((bar.to[0] - bar.from[0]).powi(2) + (bar.to[1] - bar.from[1]).powi(2)).sqrt();
+        if !(len > 0.0 && len.is_finite()) {
+            return Err(Error::config(
+                format!("{field}.to"),
+                format!(
+                    "the bar line from {:?} to {:?} has no length",
+                    bar.from, bar.to
+                ),
+            ));
+        }
+        let nodes = mesh.nodes_on_segment(body, bar.from, bar.to, 1e-9 * len.max(1.0));
+        if nodes.len() < 2 {
+            return Err(Error::config(
+                field,
+                format!(
+                    "the line from {:?} to {:?} passes through fewer than two nodes of `{}`",
+                    bar.from, bar.to, bar.body
+                ),
+            ));
+        }
+        let conn = nodes.windows(2).flat_map(|w| [w[0], w[1]]).collect();
+        mesh.blocks.push(Block {
+            elements: Elements::new(ElementKind::Bar2, conn),
+            body,
+            material: mat,
+            section: bar.area,
+        });
+        mesh.node_sets.insert(set, nodes);
+    }
+    Ok(())
+}

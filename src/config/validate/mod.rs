@@ -1,0 +1,181 @@
+//! Scenario → model: range checks that name the field, set resolution, mesh building,
+//! model consistency, and the memory estimate before anything large is allocated.
+//!
+//! The order matters: the analysis and the materials are checked first, the size of
+//! every generated mesh is estimated before it is built (a mistyped `divisions`
+//! must not allocate terabytes), then the meshes are built and checked, then the bars,
+//! supports, loads and probes that refer to their sets.
+
+mod checks;
+mod constraints;
+mod materials;
+mod meshes;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+pub use checks::HUGE_STEPS;
+pub(crate) use checks::{check_function, finite, positive};
+pub use materials::material;
+pub use meshes::estimate;
+
+use super::{LoadOptions, Scenario};
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::model::{Analysis, Body, Model};
+
+/// Builds the model of `s`; relative file names resolve against `dir`.
+pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
+    let a = &s.analysis;
+    analysis(a)?;
+    if s.materials.is_empty() {
+        return Err(Error::config(
+            "materials",
+            "at least one material is needed",
+        ));
+    }
+    let mut materials = Vec::new();
+    let mut mat_index = BTreeMap::new();
+    for (name, spec) in &s.materials {
+        mat_index.insert(name.clone(), materials.len());
+        materials.push(material(name, &format!("materials.{name}"), spec)?);
+    }
+    for m in &materials {
+        if matches!(m.model, crate::material::Model::RankineHill(_))
+            && a.plane == crate::fe::Plane::Strain
+        {
+            return Err(Error::config(format!("materials.{}", m.name), "Rankine-Hill plasticity is formulated in plane stress; set analysis.plane = \"stress\""));
+        }
+    }
+    let find_material = |field: String, name: &str| -> Result<usize> {
+        mat_index.get(name).copied().ok_or_else(|| {
+            Error::config(
+                field,
+                format!(
+                    "unknown material `{name}` (known: {})",
+                    mat_index.keys().cloned().collect::<Vec<_>>().join(", ")
+                ),
+            )
+        })
+    };
+
+    if s.bodies.is_empty() {
+        return Err(Error::config("bodies", "at least one body is needed"));
+    }
+    meshes::check_generated_size(s, &materials, &mat_index, opts)?;
+    let mut mesh = Mesh::default();
+    let mut bodies = Vec::new();
+    for (bi, b) in s.bodies.iter().enumerate() {
+        let field = format!("bodies[{bi}]");
+        if b.name.is_empty() || b.name.contains('.') {
+            return Err(Error::config(
+                format!("{field}.name"),
+                "must be non-empty and contain no `.`",
+            ));
+        }
+        if s.bodies[..bi].iter().any(|o| o.name == b.name) {
+            return Err(Error::config(
+                format!("{field}.name"),
+                format!("duplicate body name `{}`", b.name),
+            ));
+        }
+        positive(&format!("{field}.thickness"), b.thickness)?;
+        finite(&format!("{field}.velocity"), &b.velocity)?;
+        let mat = find_material(format!("{field}.material"), &b.material)?;
+        let part = meshes::body_part(&format!("{field}.mesh"), &b.mesh, dir)?;
+        mesh.add_part(&part, bi, &b.name, mat, b.thickness);
+        bodies.push(Body {
+            name: b.name.clone(),
+            velocity: b.velocity,
+            thickness: b.thickness,
+        });
+    }
+    meshes::add_bars(s, &mut mesh, &bodies, &materials, &find_material)?;
+    let names: Vec<String> = bodies.iter().map(|b| b.name.clone()).collect();
+    mesh.check_elements(&names)?;
+    materials::check_crack_band(&mesh, &materials)?;
+    meshes::check_memory(&mesh, &materials, opts)?;
+
+    let constraints = constraints::constraints(s, &mesh)?;
+    let loads = constraints::loads(s, &mesh, &bodies)?;
+    let probes = constraints::probes(s, &mesh)?;
+
+    Ok(Model {
+        mesh,
+        materials,
+        plane: a.plane,
+        bodies,
+        constraints,
+        loads,
+        gravity: a.gravity,
+        probes,
+        analysis: Analysis {
+            kind: a.kind,
+            dt: a.dt,
+            t_end: a.t_end,
+            lumped_mass: a.mass == super::MassKind::Lumped,
+            zeta: a.zeta,
+            rayleigh: a.rayleigh,
+            vtk_every: a.vtk_every,
+            tolerance: a.tolerance,
+            max_iterations: a.max_iterations,
+            displacement_tolerance: a.displacement_tolerance,
+            iteration: a.iteration,
+            max_cuts: a.max_cuts,
+            ordering: a.ordering,
+        },
+    })
+}
+
+/// The `[analysis]` table.
+fn analysis(a: &super::AnalysisSpec) -> Result<()> {
+    positive("analysis.dt", a.dt)?;
+    positive("analysis.t_end", a.t_end)?;
+    if a.dt > a.t_end {
+        return Err(Error::config(
+            "analysis.dt",
+            format!("step {} exceeds t_end {}", a.dt, a.t_end),
+        ));
+    }
+    let steps = (a.t_end / a.dt).round();
+    if !(steps <= checks::MAX_STEPS) {
+        return Err(Error::config(
+            "analysis.dt",
+            format!(
+                "t_end / dt = {steps:e} steps does not fit a step counter (at most 2^53); \
+                 is dt in seconds?"
+            ),
+        ));
+    }
+    checks::non_negative("analysis.zeta", a.zeta)?;
+    positive("analysis.tolerance", a.tolerance)?;
+    positive("analysis.displacement_tolerance", a.displacement_tolerance)?;
+    checks::count_in(
+        "analysis.max_iterations",
+        a.max_iterations,
+        1,
+        MAX_ITERATIONS,
+        "corrections per step",
+    )?;
+    checks::count_in(
+        "analysis.max_cuts",
+        a.max_cuts,
+        0,
+        MAX_CUTS,
+        "each halves the step",
+    )?;
+    for (i, c) in a.rayleigh.iter().enumerate() {
+        checks::non_negative(&format!("analysis.rayleigh[{i}]"), *c)?;
+    }
+    if let Some(g) = a.gravity {
+        finite("analysis.gravity", &g)?;
+    }
+    Ok(())
+}
+
+/// More corrections per step than any converging iteration needs; the residual
+/// history of a step is kept for its report.
+const MAX_ITERATIONS: usize = 10_000;
+
+/// Halvings in a row: 2⁻⁵⁰ of the step is far below any useful step size.
+const MAX_CUTS: usize = 50;
