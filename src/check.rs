@@ -71,11 +71,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
     // A row: 12 ledger columns, 2 solver columns, 2 per probe, about 20 bytes each.
     let row_bytes = (16 + 2 * probes) as u64 * 20;
     let history = (steps + 1, (steps as u64 + 1) * row_bytes);
-    let vtk_files = if a.vtk_every == 0 {
-        0
-    } else {
-        steps / a.vtk_every + 1
-    };
+    let vtk_files = steps.checked_div(a.vtk_every).map_or(0, |k| k + 1);
     // Points (3 doubles), connectivity, two vector fields, cell fields, as ASCII.
     let vtk_file_bytes =
         (mesh.n_nodes() as u64) * (3 + 3 + 3) * 24 + (mesh.n_elements() as u64) * (5 + 6) * 24;

@@ -57,14 +57,14 @@ pub enum Error {
         message: String,
     },
     /// A quantity of the state stopped being a finite number.
-    #[error("non-finite value at t = {t:.6e}: {quantity} is {value} at {location}")]
+    #[error("non-finite value at t = {t:.6e}: {quantity} is {value}{}", .location.as_ref().map(|l| format!(" at {l}")).unwrap_or_default())]
     NonFinite {
         /// Which quantity (`u`, `f_int`, a ledger line, ...).
         quantity: String,
         /// Its value (NaN or an infinity).
         value: f64,
-        /// Where: dof (node, coordinates, body, element) or "the whole model".
-        location: String,
+        /// Where: the dof (node, coordinates, body, element), when it is one dof.
+        location: Option<String>,
         /// Time of the step.
         t: f64,
     },

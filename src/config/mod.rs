@@ -501,7 +501,12 @@ pub fn load_with(path: &Path, opts: &LoadOptions) -> Result<Model> {
 pub fn parse(text: &str) -> Result<Scenario> {
     toml::from_str(text).map_err(|e| {
         let span = e.span().map(|s| {
-            let line = text[..s.start.min(text.len())].matches('\n').count() + 1;
+            let end = s.start.min(text.len());
+            let line = text.as_bytes()[..end]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1;
             format!("line {line}")
         });
         Error::config(
@@ -513,7 +518,12 @@ pub fn parse(text: &str) -> Result<Scenario> {
 
 /// Parses and validates scenario text; relative mesh paths resolve against `dir`.
 pub fn from_str(text: &str, dir: &Path) -> Result<Model> {
-    validate::build(&parse(text)?, dir, &LoadOptions::default())
+    from_str_with(text, dir, &LoadOptions::default())
+}
+
+/// [`from_str`] with options.
+pub fn from_str_with(text: &str, dir: &Path, opts: &LoadOptions) -> Result<Model> {
+    validate::build(&parse(text)?, dir, opts)
 }
 
 /// The memory estimate of a model (the factor's exact nonzeros when known).

@@ -153,7 +153,7 @@ fn check(p: &PathSpec) -> Result<()> {
     crate::config::positive_pub("path.t_end", p.t_end)?;
     crate::config::positive_pub("path.length", p.length)?;
     let steps = (p.t_end / p.dt).round();
-    if !(steps <= MAX_POINT_STEPS) {
+    if steps.is_nan() || steps > MAX_POINT_STEPS {
         return Err(Error::config(
             "path.dt",
             format!("t_end / dt = {steps:e} steps; at most {MAX_POINT_STEPS:e} are taken"),
@@ -325,7 +325,7 @@ where
             return Err(Error::NonFinite {
                 quantity: "material point stress, strain or dissipation".into(),
                 value: *bad,
-                location: "the material point".into(),
+                location: None,
                 t,
             });
         }

@@ -96,7 +96,7 @@ impl Shape {
                     x[a][0] * x[b][1] - x[b][0] * x[a][1]
                 })
                 .sum::<f64>();
-        if !(area.abs() > 1e-12 * size * size) {
+        if area.is_nan() || area.abs() <= 1e-12 * size * size {
             return Shape::Degenerate;
         }
         let (lo, hi) = crate::fe::jacobian_range(kind, x);

@@ -729,7 +729,17 @@ pub(crate) fn step(
                 ("M v", &w.mv_np1),
                 ("residual", &w.r),
             ]);
-            let (quantity, dof, value) = found.unwrap_or(("residual", dof, value));
+            // Every entry finite, yet a sum over them is not: the forces are too large
+            // for their squares (beyond about 1e154).
+            let (quantity, dof, value) = found.unwrap_or((
+                if dof.is_some() {
+                    "residual"
+                } else {
+                    "the sum of the squared forces (forces beyond 1e154 overflow their squares)"
+                },
+                dof,
+                value,
+            ));
             let outcome = Outcome::NonFinite {
                 quantity,
                 dof,
@@ -751,7 +761,7 @@ pub(crate) fn step(
         return Err(Error::NonFinite {
             quantity: format!("the ledger line {quantity}"),
             value,
-            location: "the whole model".into(),
+            location: None,
             t: t1,
         });
     }
@@ -867,6 +877,77 @@ fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> String {
     }
 }
 
+/// Why the initial effective matrix is not positive definite, as far as can be told:
+/// a step size that takes the mass term out of the floating-point range, a free dof
+/// with nothing on its diagonal (a node of no element), or, in statics, a body whose
+/// supports do not stop its rigid motion.
+fn likely_cause(
+    model: &Model,
+    ops: &Operators,
+    k_eff: &crate::linsolve::LowerCsc,
+    dofs: &DofMap,
+) -> String {
+    let (c_m, _, _) = ops.coefficients();
+    if let Scheme::BackwardEuler { h, .. } = ops.scheme {
+        if !c_m.is_finite() || c_m == 0.0 {
+            return format!(
+                "the step h = {h:e} s puts 1/h² = {:e} outside the floating-point range",
+                1.0 / (h * h)
+            );
+        }
+    }
+    if let Some(eq) = (0..k_eff.n).find(|&j| k_eff.diagonal(j).is_nan() || k_eff.diagonal(j) <= 0.0)
+    {
+        return format!(
+            "{} has a zero or negative diagonal entry: a node that no element holds, or a \
+             material with no stiffness",
+            model.describe_dof(dofs.free[eq])
+        );
+    }
+    match ops.scheme {
+        Scheme::Static { .. } => {
+            let mut free_bodies = Vec::new();
+            for (b, body) in model.bodies.iter().enumerate() {
+                let mut held = [0usize; 2];
+                let mut nodes = std::collections::BTreeSet::new();
+                for c in &model.constraints {
+                    if model.mesh.node_body[c.dof / 2] == b {
+                        held[c.dof % 2] += 1;
+                        nodes.insert(c.dof / 2);
+                    }
+                }
+                let why = if held == [0, 0] {
+                    Some("has no supports".to_string())
+                } else if held[0] == 0 {
+                    Some("is free to move in x".to_string())
+                } else if held[1] == 0 {
+                    Some("is free to move in y".to_string())
+                } else if nodes.len() < 2 {
+                    Some("is held at one node only and free to rotate".to_string())
+                } else {
+                    None
+                };
+                if let Some(why) = why {
+                    free_bodies.push(format!("body `{}` {why}", body.name));
+                }
+            }
+            if free_bodies.is_empty() {
+                "in a static analysis every body needs supports that stop its rigid motion".into()
+            } else {
+                format!(
+                    "in a static analysis every body needs supports that stop its rigid motion, \
+                     and {}",
+                    free_bodies.join(", ")
+                )
+            }
+        }
+        Scheme::BackwardEuler { h, .. } => format!(
+            "with h = {h:e} s the mass term 1/h² M is too small against the stiffness of an \
+             unsupported body; use a smaller step or supports"
+        ),
+    }
+}
+
 /// The integrator parts every implicit scheme holds.
 pub(crate) struct Core<'m> {
     pub model: &'m Model,
@@ -897,16 +978,10 @@ impl<'m> Core<'m> {
             return Err(Error::Solver {
                 backend: sys.backend(),
                 message: format!(
-                    "the initial effective matrix is not positive definite{} ({message}); \
-                     {}",
+                    "the initial effective matrix is not positive definite{} ({message}); {}",
                     dof.map(|d| format!(" at {}", model.describe_dof(d)))
                         .unwrap_or_default(),
-                    match scheme {
-                        Scheme::Static { .. } =>
-                            "in a static analysis every body needs supports that stop its rigid motion",
-                        Scheme::BackwardEuler { .. } =>
-                            "check the material constants and the step size",
-                    }
+                    likely_cause(model, &ops, sys.matrix(), sys.dofs())
                 ),
             });
         }

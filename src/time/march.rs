@@ -98,10 +98,7 @@ where
                 return Err(Error::NonFinite {
                     quantity: quantity.to_string(),
                     value,
-                    location: match dof {
-                        Some(d) => integrator.model().describe_dof(d),
-                        None => "the whole model".into(),
-                    },
+                    location: dof.map(|d| integrator.model().describe_dof(d)),
                     t: s.t + integrator.h(),
                 });
             }

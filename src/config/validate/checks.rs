@@ -10,7 +10,7 @@ pub(crate) fn positive(field: &str, v: f64) -> Result<()> {
     } else {
         Err(Error::config(
             field,
-            format!("must be positive and finite, got {v}"),
+            format!("must be positive and finite, got {v:?}"),
         ))
     }
 }
@@ -21,11 +21,11 @@ pub(crate) fn finite(field: &str, v: &[f64]) -> Result<()> {
         None => Ok(()),
         Some(i) if v.len() == 1 => Err(Error::config(
             field,
-            format!("must be finite, got {}", v[i]),
+            format!("must be finite, got {:?}", v[i]),
         )),
         Some(i) => Err(Error::config(
             format!("{field}[{i}]"),
-            format!("must be finite, got {}", v[i]),
+            format!("must be finite, got {:?}", v[i]),
         )),
     }
 }
@@ -37,7 +37,7 @@ pub(crate) fn non_negative(field: &str, v: f64) -> Result<()> {
     } else {
         Err(Error::config(
             field,
-            format!("must be non-negative and finite, got {v}"),
+            format!("must be non-negative and finite, got {v:?}"),
         ))
     }
 }
@@ -61,7 +61,7 @@ pub(crate) fn check_elastic(field: &str, e: f64, nu: f64, rho: f64) -> Result<()
     if !(nu > -1.0 && nu < 0.5) {
         return Err(Error::config(
             format!("{field}.nu"),
-            format!("Poisson's ratio must lie in (-1, 0.5), got {nu}"),
+            format!("Poisson's ratio must lie in (-1, 0.5), got {nu:?}"),
         ));
     }
     Ok(())

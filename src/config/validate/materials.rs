@@ -23,7 +23,7 @@ fn hardening(
             if !post_yield_modulus.is_finite() || post_yield_modulus.abs() >= e {
                 return Err(Error::config(
                     format!("{field}.post_yield_modulus"),
-                    format!("must lie in (-E, E), got {post_yield_modulus}"),
+                    format!("must lie in (-E, E), got {post_yield_modulus:?}"),
                 ));
             }
             H::Bilinear {
@@ -41,7 +41,7 @@ fn hardening(
             if eps_cu1.is_nan() || eps_cu1 <= eps_c1 {
                 return Err(Error::config(
                     format!("{field}.eps_cu1"),
-                    format!("must exceed eps_c1 = {eps_c1}, got {eps_cu1}"),
+                    format!("must exceed eps_c1 = {eps_c1}, got {eps_cu1:?}"),
                 ));
             }
             let k = 1.05 * e * eps_c1 / f_cm;
@@ -223,7 +223,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                 if !(0.0..=2.0).contains(&v) {
                     return Err(Error::config(
                         format!("{field}.{k}"),
-                        format!("must lie in [0, 2], got {v}"),
+                        format!("must lie in [0, 2], got {v:?}"),
                     ));
                 }
             }
@@ -233,7 +233,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             if !(d_max > 0.0 && d_max < 1.0) {
                 return Err(Error::config(
                     format!("{field}.d_max"),
-                    format!("must lie in (0, 1), got {d_max}"),
+                    format!("must lie in (0, 1), got {d_max:?}"),
                 ));
             }
             with(

@@ -138,7 +138,7 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
         ));
     }
     let steps = (a.t_end / a.dt).round();
-    if !(steps <= checks::MAX_STEPS) {
+    if steps.is_nan() || steps > checks::MAX_STEPS {
         return Err(Error::config(
             "analysis.dt",
             format!(

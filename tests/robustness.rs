@@ -1,0 +1,393 @@
+//! No silent wrong result, no panic, bounded memory: one representative of each class
+//! of bad input and runaway run, as a user meets it through the `rothe` command (or
+//! the library where the command cannot reach the case).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+fn rothe(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_rothe"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn good() -> String {
+    rothe::workload::cantilever_scenario(
+        [8, 2],
+        1e-5,
+        1e-4,
+        "model = \"elastic\"\nE = 30e9\nnu = 0.2\nrho = 2400.0",
+        "vtk_every = 5",
+    )
+}
+
+/// `check` fails on `text` with a message holding every one of `words`, and no panic.
+fn refused(text: &str, words: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(dir.path(), "s.toml", text);
+    let (ok, out, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(!ok, "accepted: {out}");
+    assert!(!err.contains("panicked"), "{err}");
+    for w in words {
+        assert!(err.contains(w), "`{w}` not in: {err}");
+    }
+}
+
+fn summary(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn every_number_of_a_scenario_must_be_finite() {
+    // Time functions of every kind, loads, probes, gravity: NaN and infinities are
+    // refused with the field named.
+    let cases: [(&str, &str, &[&str]); 7] = [
+        (
+            "function = { kind = \"step\", at = 0.0 }",
+            "function = { kind = \"step\", at = nan }",
+            &["loads[0].function.at", "finite"],
+        ),
+        (
+            "function = { kind = \"step\", at = 0.0 }",
+            "function = { kind = \"ramp\", t0 = 0.0, t1 = inf }",
+            &["loads[0].function.t1", "finite"],
+        ),
+        (
+            "function = { kind = \"step\", at = 0.0 }",
+            "function = { kind = \"table\", points = [[0.0, 1.0], [nan, 2.0]] }",
+            &["loads[0].function.points[1][0]", "finite"],
+        ),
+        (
+            "function = { kind = \"step\", at = 0.0 }",
+            "function = { kind = \"harmonic\", frequency = 10.0, phase = -inf }",
+            &["loads[0].function.phase"],
+        ),
+        (
+            "value = [0.0, -1.0e6]",
+            "value = [nan, -1.0e6]",
+            &["loads[0].value[0]", "finite"],
+        ),
+        (
+            "at = [2.0, 0.25]",
+            "at = [2.0, inf]",
+            &["probes[0].at[1]", "finite"],
+        ),
+        (
+            "vtk_every = 5",
+            "vtk_every = 5\ngravity = [0.0, nan]",
+            &["analysis.gravity[1]"],
+        ),
+    ];
+    for (from, to, words) in cases {
+        assert!(good().contains(from), "{from}");
+        refused(&good().replace(from, to), words);
+    }
+    // A table function that does not increase, and an empty one.
+    refused(
+        &good().replace(
+            "function = { kind = \"step\", at = 0.0 }",
+            "function = { kind = \"table\", points = [[0.0, 1.0], [0.0, 2.0]] }",
+        ),
+        &["loads[0].function.points", "increase strictly"],
+    );
+    refused(
+        &good().replace(
+            "function = { kind = \"step\", at = 0.0 }",
+            "function = { kind = \"table\", points = [] }",
+        ),
+        &["loads[0].function.points", "at least one"],
+    );
+}
+
+#[test]
+fn a_run_whose_state_stops_being_finite_fails_naming_the_quantity() {
+    // A load of 1e300 N is finite, but the stored energy it puts in overflows: the
+    // first non-finite value stops the run with the quantity and the time, and
+    // summary.json says failed; the rows written before stay.
+    let dir = tempfile::tempdir().unwrap();
+    let text = good().replace("value = [0.0, -1.0e6]", "value = [0.0, -1.0e300]");
+    let sc = scenario(dir.path(), "s.toml", &text);
+    let out = dir.path().join("out");
+    let (ok, _, err) = rothe(&[
+        "run",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("non-finite value at t = "), "{err}");
+    assert!(err.contains("is inf") || err.contains("is NaN"), "{err}");
+    let s = summary(&out);
+    assert_eq!(s["status"], "failed");
+    assert!(s["error"].as_str().unwrap().contains("non-finite"));
+    let rows = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert!(rows.lines().count() >= 2, "the initial row is kept");
+}
+
+#[test]
+fn a_panic_inside_a_run_is_an_internal_error_and_a_failed_summary() {
+    // A model built in code with a block whose material does not exist: the run
+    // panics deep inside the assembly; `run` reports it as an internal error and
+    // writes summary.json with status failed (the command does the same for panics
+    // outside a run, with the input file named).
+    let mut model = rothe::config::from_str(&good(), Path::new(".")).unwrap();
+    model.mesh.blocks[0].material = 7;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let e = rothe::run::run(
+        &model,
+        &rothe::run::RunOptions::new(&out, rothe::linsolve::Backend::Faer),
+    )
+    .unwrap_err();
+    assert!(matches!(e, rothe::Error::Internal(_)), "{e:?}");
+    assert!(e.to_string().contains("internal error"), "{e}");
+    assert_eq!(summary(&out)["status"], "failed");
+}
+
+#[test]
+fn memory_is_estimated_before_it_is_taken() {
+    // A mistyped division count: refused before the mesh is built, with the estimate
+    // and the memory available.
+    refused(
+        &good().replace("divisions = [8, 2]", "divisions = [200000, 100000]"),
+        &["bodies[..].mesh.divisions", "needs about", "available"],
+    );
+    // Counts whose product overflows.
+    refused(
+        &good().replace(
+            "divisions = [8, 2]",
+            "divisions = [9223372036854775807, 9223372036854775807]",
+        ),
+        &["divisions", "overflows"],
+    );
+    // Through the library with a small limit: the model is refused naming the parts.
+    let e = rothe::config::from_str_with(
+        &good(),
+        Path::new("."),
+        &rothe::config::LoadOptions {
+            memory_limit: Some(10_000),
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("factor") && e.contains("only 10.0 kB is available"),
+        "{e}"
+    );
+}
+
+#[test]
+fn check_reports_steps_and_output_and_refuses_absurd_step_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let huge = good().replace("dt = 1.0e-5", "dt = 1.0e-12");
+    let sc = scenario(dir.path(), "huge.toml", &huge);
+    let (ok, out, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.contains("steps       100000000 of h"), "{out}");
+    assert!(out.contains("history.csv 100000001 rows"), "{out}");
+    assert!(out.contains("VTK files"), "{out}");
+    assert!(
+        out.contains("warning") && out.contains("100000000 steps"),
+        "{out}"
+    );
+    refused(
+        &good().replace("dt = 1.0e-5", "dt = 1.0e-300"),
+        &["analysis.dt", "does not fit a step counter"],
+    );
+}
+
+#[test]
+fn a_killed_run_is_marked_running() {
+    // summary.json exists from the first step on with status "running": a run killed
+    // part way is never taken for a complete one.
+    let dir = tempfile::tempdir().unwrap();
+    let text = rothe::workload::cantilever_scenario(
+        [40, 10],
+        1e-6,
+        1.0,
+        "model = \"elastic\"\nE = 30e9\nnu = 0.2\nrho = 2400.0",
+        "vtk_every = 0",
+    );
+    let sc = scenario(dir.path(), "long.toml", &text);
+    let out = dir.path().join("out");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rothe"))
+        .args([
+            "run",
+            sc.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let rows = || {
+        std::fs::read_to_string(out.join("history.csv"))
+            .map(|s| s.lines().count())
+            .unwrap_or(0)
+    };
+    while rows() < 20 && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(rows() >= 20, "the run wrote its rows as it went");
+    let s = summary(&out);
+    assert_eq!(s["status"], "running", "{s}");
+}
+
+#[test]
+fn the_model_must_be_consistent() {
+    // A bar whose name is an existing set of its body.
+    refused(
+        &(good()
+            + "[materials.steel]\nmodel = \"elastic\"\nE = 200e9\nnu = 0.3\nrho = 7850.0\n[[bars]]\nname = \"top\"\nbody = \"beam\"\nmaterial = \"steel\"\narea = 1e-4\nfrom = [0.0, 0.5]\nto = [2.0, 0.5]\n"),
+        &["bars[0].name", "`beam.top` is already a set"],
+    );
+    // Two probes of one name.
+    refused(
+        &(good() + "[[probes]]\nname = \"tip\"\nat = [1.0, 0.25]\n"),
+        &["probes[1].name", "duplicate probe name `tip`"],
+    );
+    // A support and a prescribed displacement on the same dof: both are named.
+    refused(
+        &(good() + "[[prescribed]]\nset = \"beam.left\"\ncomponent = \"y\"\nvalue = 1e-4\n"),
+        &["prescribed[0]", "supports[0]", "already holds"],
+    );
+    // Overlapping supports are fine (both hold the dof at zero).
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(
+        dir.path(),
+        "ok.toml",
+        &(good() + "[[supports]]\nset = \"beam.bottom_left\"\nfix = [\"x\"]\n"),
+    );
+    assert!(rothe(&["check", sc.to_str().unwrap()]).0);
+    // A probe far from every body.
+    refused(
+        &good().replace("at = [2.0, 0.25]", "at = [5.0, 0.25]"),
+        &["probes[0].at", "lies on no body", "from the nearest node"],
+    );
+}
+
+/// The square of `tests/data/square.msh` (two triangles, physical curves `bottom`
+/// and `top`, surface `body`) with an empty physical group `empty` added.
+fn gmsh() -> String {
+    let square = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square.msh"),
+    )
+    .unwrap();
+    square
+        .replace("$PhysicalNames\n3\n", "$PhysicalNames\n4\n")
+        .replace("$EndPhysicalNames", "1 9 \"empty\"\n$EndPhysicalNames")
+}
+
+#[test]
+fn mesh_errors_name_the_file_the_body_and_the_element() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("sq.msh"), gmsh()).unwrap();
+    let text = good().replace(
+        "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
+        "mesh = { kind = \"gmsh\", file = \"sq.msh\" }",
+    );
+    // An empty group is reported as empty, not unknown.
+    let with_empty = text
+        .replace("set = \"beam.left\"", "set = \"beam.empty\"")
+        .replace("set = \"beam.top\"", "set = \"beam.bottom\"")
+        .replace("at = [2.0, 0.25]", "at = [1.0, 0.0]");
+    let sc = scenario(dir.path(), "e.toml", &with_empty);
+    let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        err.contains("supports[0].set") && err.contains("node set `beam.empty` is empty"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_gmsh_node_of_no_element_is_refused_with_its_tag() {
+    let part = rothe::mesh::gmsh::parse(gmsh().as_bytes()).unwrap();
+    assert!(part.check().is_ok());
+    // A fifth node (tag 5, on a point entity) that no element uses.
+    let patched = gmsh()
+        .replace("$Nodes\n3 4 1 4\n", "$Nodes\n4 5 1 5\n")
+        .replace("$EndNodes", "0 1 0 1\n5\n0.5 0.5 0\n$EndNodes");
+    let err = rothe::mesh::gmsh::parse(patched.as_bytes())
+        .and_then(|p| p.check())
+        .unwrap_err();
+    assert!(err.contains("node with Gmsh tag 5 at [0.5, 0.5]"), "{err}");
+    assert!(err.contains("belongs to no element"), "{err}");
+}
+
+#[test]
+fn a_singular_static_model_is_traced_to_its_unsupported_body() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = good()
+        .replace("vtk_every = 5", "vtk_every = 5\nkind = \"static\"")
+        .replace(
+            "[[supports]]\nset = \"beam.left\"\nfix = [\"x\", \"y\"]\n",
+            "",
+        );
+    let sc = scenario(dir.path(), "free.toml", &text);
+    let out = dir.path().join("out");
+    let (ok, _, err) = rothe(&[
+        "run",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!ok);
+    assert!(err.contains("not positive definite"), "{err}");
+    assert!(err.contains("body `beam` has no supports"), "{err}");
+    assert_eq!(summary(&out)["status"], "failed");
+}
+
+#[test]
+fn a_material_path_with_bad_numbers_is_refused_and_a_good_one_streams() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/materials/mazars_tension.toml");
+    let text = std::fs::read_to_string(&file).unwrap();
+    for (bad, words) in [
+        (
+            text.replace("amplitude = 1.0", "amplitude = nan"),
+            vec!["path.amplitude", "finite"],
+        ),
+        (
+            text.replace("[1.0, 1.0e-3]", "[1.0, inf]"),
+            vec!["path.function.points[1][1]", "finite"],
+        ),
+        (
+            text.replace("dt = 1.0e-3", "dt = 1.0e-300"),
+            vec!["path.dt", "steps"],
+        ),
+    ] {
+        let f = dir.path().join("bad.toml");
+        std::fs::write(&f, bad).unwrap();
+        let out = dir.path().join("m");
+        let (ok, _, err) = rothe(&[
+            "material",
+            f.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!ok);
+        assert!(!err.contains("panicked"), "{err}");
+        for w in words {
+            assert!(err.contains(w), "`{w}` not in {err}");
+        }
+    }
+}
