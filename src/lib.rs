@@ -28,6 +28,7 @@
 pub mod assembly;
 pub mod check;
 pub mod config;
+pub mod contact;
 pub mod energy;
 pub mod error;
 pub mod fe;

@@ -178,6 +178,10 @@ pub struct Analysis {
     pub max_cuts: usize,
     /// Fill-reducing ordering for the faer backend.
     pub ordering: Ordering,
+    /// Largest penetration a contact step accepts (m).
+    pub contact_tolerance: f64,
+    /// How the contact QP is solved.
+    pub contact_qp: ContactQp,
 }
 
 /// Fill-reducing ordering of the effective matrix. Nested dissection is handed to
@@ -251,8 +255,59 @@ pub struct Model {
     pub gravity: Option<[f64; 2]>,
     /// Output probes.
     pub probes: Vec<Probe>,
+    /// Contact pairs and unilateral supports.
+    pub contacts: Vec<ContactPair>,
     /// Analysis settings.
     pub analysis: Analysis,
+}
+
+/// The master side of one direction of a contact pair.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Master {
+    /// Segments (node pairs) of a deformable body, oriented with the body on their
+    /// left, so `n = (Δy, −Δx)/L` points out of it.
+    Segments(Vec<[usize; 2]>),
+    /// A rigid line from `a` to `b` with unit normal `n` towards the slave body.
+    Rigid {
+        /// First end.
+        a: [f64; 2],
+        /// Second end.
+        b: [f64; 2],
+        /// Unit normal pointing to the side the slave body lies on.
+        n: [f64; 2],
+    },
+}
+
+/// One direction of a contact pair: slave nodes that may not cross the master.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactSide {
+    /// Slave nodes.
+    pub slaves: Vec<usize>,
+    /// The master surface.
+    pub master: Master,
+}
+
+/// A named contact pair: one side, or two (both ways), or a unilateral support.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactPair {
+    /// Name for output.
+    pub name: String,
+    /// Its directions.
+    pub sides: Vec<ContactSide>,
+    /// Search radius of the detection (m): the largest master segment or slave
+    /// element edge.
+    pub radius: f64,
+}
+
+/// How the implicit contact QP is solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactQp {
+    /// The dual QP on the contact forces with `W = G K_eff⁻¹ Gᵀ` from the factor.
+    #[default]
+    Condensed,
+    /// The primal QP over all free dofs (reference).
+    Full,
 }
 
 impl Model {

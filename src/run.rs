@@ -75,6 +75,7 @@ fn snapshot(s: &State, iterations: usize, nl_residual: f64) -> Snapshot<'_> {
         v: &s.v,
         ledger: &s.ledger,
         points: &s.points,
+        contact: &s.contact,
         iterations,
         nl_residual,
     }
@@ -103,6 +104,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         t_end: 0.0,
         dt: a.dt,
         probes: Default::default(),
+        contact: Default::default(),
         energy: EnergySummary::from(&Ledger::default()),
         timing: TimingSummary::zero(),
         solver: SolverSummary {
@@ -149,6 +151,7 @@ fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I
     summary.t_end = s.t;
     summary.energy = EnergySummary::from(&s.ledger);
     summary.probes = rec.probes().clone();
+    summary.contact = rec.contact().clone();
     summary.timing.assembly_s = timing.assembly_s;
     summary.timing.factorization_s = timing.factorization_s;
     summary.timing.solve_s = timing.solve_s;

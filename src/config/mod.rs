@@ -81,6 +81,32 @@ pub struct Scenario {
     /// Output probes.
     #[serde(default)]
     pub probes: Vec<ProbeSpec>,
+    /// Contact pairs and unilateral supports.
+    #[serde(default)]
+    pub contact: Vec<ContactSpec>,
+}
+
+/// `[[contact]]`: a slave node or edge set against a master edge set of another body
+/// (frictionless node-to-segment contact), or against a rigid line (a unilateral
+/// support: it resists motion into it and lets the body lift off).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Name (column prefix `<name>_force`, `<name>_active` in `history.csv`).
+    pub name: String,
+    /// The slave side: a node set or an edge set (its nodes) of one body.
+    pub slave: String,
+    /// The master side: an edge set of another body. Give this or `rigid_line`.
+    #[serde(default)]
+    pub master: Option<String>,
+    /// A rigid line `[[x0, y0], [x1, y1]]` the slave nodes may not cross (a unilateral
+    /// support). Its side is the one the slave body lies on.
+    #[serde(default)]
+    pub rigid_line: Option<[[f64; 2]; 2]>,
+    /// Also check the master's nodes against the slave's edges (the slave must be an
+    /// edge set). Default false: slave nodes against master segments only.
+    #[serde(default)]
+    pub both_ways: bool,
 }
 
 fn default_vtk_every() -> usize {
@@ -139,6 +165,15 @@ pub struct AnalysisSpec {
     /// free dofs), `amd` or `nested_dissection`.
     #[serde(default)]
     pub ordering: crate::model::Ordering,
+    /// Largest penetration a contact step accepts (m). Default: 1e-4 of the shortest
+    /// master segment, far below the deformations contact produces.
+    #[serde(default)]
+    pub contact_tolerance: Option<f64>,
+    /// How the contact QP is solved: `condensed` (default: the dual QP on the contact
+    /// forces, `W = G K_eff⁻¹ Gᵀ` from the factor) or `full` (the primal QP over all
+    /// free dofs, the reference).
+    #[serde(default)]
+    pub contact_qp: crate::model::ContactQp,
 }
 
 fn default_displacement_tolerance() -> f64 {

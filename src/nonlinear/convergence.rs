@@ -5,7 +5,8 @@
 pub struct ConstraintStatus {
     /// Largest penetration (negative gap magnitude) at the iterate (m).
     pub penetration: f64,
-    /// Largest `|λ_i g_i|` at the iterate (J).
+    /// Complementarity: the largest gap (m) across which a force still acts (zero
+    /// when every force acts on a closed gap).
     pub complementarity: f64,
     /// Whether the active set differs from the previous iterate's.
     pub active_set_changed: bool,
@@ -38,7 +39,7 @@ pub struct Convergence {
     pub max_iterations: usize,
     /// Largest penetration accepted (m).
     pub penetration_tolerance: f64,
-    /// Largest `|λ g|` accepted (J).
+    /// Largest open gap under a force accepted (m).
     pub complementarity_tolerance: f64,
 }
 

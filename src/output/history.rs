@@ -31,8 +31,9 @@ pub struct History {
 
 impl History {
     /// Creates the file and writes the header (ledger columns, solver columns, then
-    /// `<probe>_ux, <probe>_uy` per probe).
-    pub fn create(path: &Path, probes: &[String]) -> Result<Self> {
+    /// `<probe>_ux, <probe>_uy` per probe, then `<pair>_force, <pair>_active` per
+    /// contact pair).
+    pub fn create(path: &Path, probes: &[String], pairs: &[String]) -> Result<Self> {
         let file = File::create(path).map_err(|e| Error::io(path, e))?;
         let mut h = History {
             path: path.into(),
@@ -44,6 +45,10 @@ impl History {
         for p in probes {
             cols.push(format!("{p}_ux"));
             cols.push(format!("{p}_uy"));
+        }
+        for p in pairs {
+            cols.push(format!("{p}_force"));
+            cols.push(format!("{p}_active"));
         }
         writeln!(h.out, "{}", cols.join(",")).map_err(|e| Error::io(&h.path, e))?;
         h.flush()?;
@@ -58,6 +63,7 @@ impl History {
         iterations: usize,
         nl_residual: f64,
         probes: &[[f64; 2]],
+        pairs: &[crate::contact::PairRecord],
     ) -> Result<()> {
         let d = l.dissipated();
         let mut line = format!(
@@ -67,6 +73,9 @@ impl History {
         );
         for p in probes {
             line.push_str(&format!(",{:.12e},{:.12e}", p[0], p[1]));
+        }
+        for p in pairs {
+            line.push_str(&format!(",{:.12e},{}", p.force, p.active));
         }
         writeln!(self.out, "{line}").map_err(|e| Error::io(&self.path, e))?;
         self.flush()

@@ -8,8 +8,9 @@ use std::path::Path;
 
 use super::history::History;
 use super::post::{cell_history_fields, cell_stress};
-use super::summary::ProbeSummary;
+use super::summary::{ContactSummary, ProbeSummary};
 use super::vtk::VtkSeries;
+use crate::contact::{ContactState, PairRecord};
 use crate::energy::Ledger;
 use crate::error::{Error, Result};
 use crate::material::store::StateStore;
@@ -30,6 +31,8 @@ pub struct Snapshot<'a> {
     pub ledger: &'a Ledger,
     /// Committed Gauss-point states (empty for elastic-only models).
     pub points: &'a [StateStore],
+    /// The contact state.
+    pub contact: &'a ContactState,
     /// Corrections of the step.
     pub iterations: usize,
     /// Final relative residual of the step.
@@ -43,6 +46,10 @@ pub struct Recorder {
     vtk_every: usize,
     probes: BTreeMap<String, ProbeSummary>,
     samples: Vec<[f64; 2]>,
+    contact: BTreeMap<String, ContactSummary>,
+    pair_names: Vec<String>,
+    last_t: f64,
+    empty_pairs: Vec<PairRecord>,
 }
 
 impl Recorder {
@@ -50,7 +57,8 @@ impl Recorder {
     pub fn new(model: &Model, out: &Path) -> Result<Self> {
         std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
         let names: Vec<String> = model.probes.iter().map(|p| p.name.clone()).collect();
-        let history = History::create(&out.join("history.csv"), &names)?;
+        let pair_names: Vec<String> = model.contacts.iter().map(|p| p.name.clone()).collect();
+        let history = History::create(&out.join("history.csv"), &names, &pair_names)?;
         let vtk = if model.analysis.vtk_every > 0 {
             Some(VtkSeries::new(out, &model.mesh)?)
         } else {
@@ -66,6 +74,13 @@ impl Recorder {
             vtk_every: model.analysis.vtk_every,
             probes,
             samples: Vec::with_capacity(model.probes.len()),
+            contact: pair_names
+                .iter()
+                .map(|n| (n.clone(), ContactSummary::default()))
+                .collect(),
+            empty_pairs: vec![PairRecord::default(); pair_names.len()],
+            pair_names,
+            last_t: 0.0,
         })
     }
 
@@ -80,8 +95,26 @@ impl Recorder {
             }
             self.samples.push(x);
         }
-        self.history
-            .row(s.t, s.ledger, s.iterations, s.nl_residual, &self.samples)?;
+        let pairs = if s.contact.pairs.len() == self.pair_names.len() {
+            &s.contact.pairs
+        } else {
+            &self.empty_pairs
+        };
+        let dt = s.t - self.last_t;
+        for (name, p) in self.pair_names.iter().zip(pairs) {
+            if let Some(c) = self.contact.get_mut(name) {
+                c.sample(p, dt);
+            }
+        }
+        self.last_t = s.t;
+        self.history.row(
+            s.t,
+            s.ledger,
+            s.iterations,
+            s.nl_residual,
+            &self.samples,
+            pairs,
+        )?;
         if let Some(vtk) = &mut self.vtk {
             if s.step % self.vtk_every == 0 {
                 let extra = if s.points.is_empty() {
@@ -89,11 +122,21 @@ impl Recorder {
                 } else {
                     cell_history_fields(model, s.points)
                 };
+                let point_extra: Vec<(&str, &[f64])> =
+                    if model.contacts.is_empty() || s.contact.gap.len() != model.mesh.n_nodes() {
+                        Vec::new()
+                    } else {
+                        vec![
+                            ("contact_gap", &s.contact.gap[..]),
+                            ("contact_pressure", &s.contact.pressure[..]),
+                        ]
+                    };
                 vtk.write(
                     s.step,
                     s.t,
                     s.u,
                     s.v,
+                    &point_extra,
                     &cell_stress(model, s.u, s.points),
                     &extra,
                 )?;
@@ -105,5 +148,10 @@ impl Recorder {
     /// The probes' extremes so far.
     pub fn probes(&self) -> &BTreeMap<String, ProbeSummary> {
         &self.probes
+    }
+
+    /// The contact pairs' extremes and impulses so far.
+    pub fn contact(&self) -> &BTreeMap<String, ContactSummary> {
+        &self.contact
     }
 }

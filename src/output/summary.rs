@@ -47,6 +47,38 @@ impl ProbeSummary {
     }
 }
 
+/// One contact pair over a run.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct ContactSummary {
+    /// Largest total normal force (N).
+    pub max_force: f64,
+    /// Largest penetration (m).
+    pub max_penetration: f64,
+    /// Largest number of active constraints.
+    pub max_active: usize,
+    /// Impulse `∫ F dt` (N s), the force of each step times its length.
+    pub impulse: f64,
+}
+
+impl ContactSummary {
+    /// Takes one step's record of length `dt`.
+    pub fn sample(&mut self, p: &crate::contact::PairRecord, dt: f64) {
+        let nan = p.force.is_nan() || p.penetration.is_nan();
+        self.max_force = if nan {
+            f64::NAN
+        } else {
+            self.max_force.max(p.force)
+        };
+        self.max_penetration = if nan {
+            f64::NAN
+        } else {
+            self.max_penetration.max(p.penetration)
+        };
+        self.max_active = self.max_active.max(p.active);
+        self.impulse += p.force * dt;
+    }
+}
+
 /// Energy totals.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct EnergySummary {
@@ -143,6 +175,9 @@ pub struct Summary {
     pub dt: f64,
     /// Probe extremes.
     pub probes: BTreeMap<String, ProbeSummary>,
+    /// Contact pairs: forces, penetration, active constraints, impulse.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub contact: BTreeMap<String, ContactSummary>,
     /// Energies.
     pub energy: EnergySummary,
     /// Timings.

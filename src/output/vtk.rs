@@ -52,14 +52,16 @@ impl VtkSeries {
         })
     }
 
-    /// Writes step `step` at time `t` with nodal `u`, `v`, cell `stress` and further
-    /// scalar cell fields `extra`.
+    /// Writes step `step` at time `t` with nodal `u`, `v`, further scalar point fields
+    /// `point_extra`, cell `stress` and further scalar cell fields `extra`.
+    #[allow(clippy::too_many_arguments)]
     pub fn write(
         &mut self,
         step: usize,
         t: f64,
         u: &[f64],
         v: &[f64],
+        point_extra: &[(&str, &[f64])],
         stress: &[[f64; 3]],
         extra: &[(&str, Vec<f64>)],
     ) -> Result<()> {
@@ -79,7 +81,7 @@ impl VtkSeries {
                 types: self.types.clone(),
             },
             data: Attributes {
-                point: vec![
+                point: [
                     Attribute::DataArray(DataArray {
                         name: "displacement".into(),
                         elem: ElementType::Vectors,
@@ -90,7 +92,19 @@ impl VtkSeries {
                         elem: ElementType::Vectors,
                         data: vec3(v),
                     }),
-                ],
+                ]
+                .into_iter()
+                .chain(point_extra.iter().map(|(name, values)| {
+                    Attribute::DataArray(DataArray {
+                        name: (*name).into(),
+                        elem: ElementType::Scalars {
+                            num_comp: 1,
+                            lookup_table: None,
+                        },
+                        data: values.to_vec().into(),
+                    })
+                }))
+                .collect(),
                 cell: std::iter::once(Attribute::DataArray(DataArray {
                     name: "stress".into(),
                     elem: ElementType::Generic(3),

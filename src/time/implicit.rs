@@ -20,6 +20,7 @@ use super::forces::{external_force, gravity_force};
 use super::{Rejection, State, StepOutcome, StepReport};
 use crate::assembly::internal::{new_stores, PointPass, PointTotals};
 use crate::assembly::{Assembler, Mass};
+use crate::contact::ContactCorrection;
 use crate::energy::{work_integrands, Dissipation, Ledger, StepIncrements, StepWork};
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;
@@ -110,8 +111,8 @@ impl Operators {
                 tolerance: a.tolerance,
                 displacement_tolerance: a.displacement_tolerance,
                 max_iterations: a.max_iterations,
-                penetration_tolerance: f64::INFINITY,
-                complementarity_tolerance: f64::INFINITY,
+                penetration_tolerance: a.contact_tolerance,
+                complementarity_tolerance: a.contact_tolerance,
             },
         };
         ops.update_constant_tangent(model);
@@ -292,6 +293,7 @@ impl Operators {
             (totals.psi, points)
         };
         let e_kin0 = 0.5 * super::dot(&v, &mv);
+        let contact = crate::contact::ContactState::initial(model, &u);
         State {
             t: 0.0,
             step: 0,
@@ -304,6 +306,7 @@ impl Operators {
             points,
             f_pred,
             f_pred_h: self.h(),
+            contact,
         }
     }
 }
@@ -669,6 +672,52 @@ fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
     acc
 }
 
+/// How an implicit step corrects its iterates: one solve, or the contact QP.
+pub(crate) enum Corrector<'m> {
+    /// No constraints: one solve on the factor.
+    Linear(LinearCorrection),
+    /// Contact pairs and unilateral supports.
+    Contact(Box<ContactCorrection<'m>>),
+}
+
+impl Corrector<'_> {
+    fn begin_step(&mut self, s: &State) {
+        if let Corrector::Contact(c) = self {
+            c.begin_step(&s.contact);
+        }
+    }
+
+    /// The energy the constraints took in the accepted step (`−Δu·f_c`), with their
+    /// state written into `s.contact`.
+    fn finish(&mut self, du: &[f64], s: &mut State) -> f64 {
+        match self {
+            Corrector::Linear(_) => 0.0,
+            Corrector::Contact(c) => -c.finish(du, &mut s.contact),
+        }
+    }
+}
+
+impl Correction for Corrector<'_> {
+    fn constrain(&mut self, u: &[f64], r: &mut [f64]) -> nonlinear::ConstraintStatus {
+        match self {
+            Corrector::Linear(c) => c.constrain(u, r),
+            Corrector::Contact(c) => c.constrain(u, r),
+        }
+    }
+
+    fn correct(
+        &mut self,
+        sys: &mut EffectiveSystem,
+        u: &[f64],
+        rhs: &mut [f64],
+    ) -> Result<nonlinear::Corrected> {
+        match self {
+            Corrector::Linear(c) => c.correct(sys, u, rhs),
+            Corrector::Contact(c) => c.correct(sys, u, rhs),
+        }
+    }
+}
+
 /// Runs one implicit step from `s` to `t + h` with `correction`; on acceptance `s`
 /// holds the new state and its ledger line, on rejection `s` is unchanged.
 pub(crate) fn step(
@@ -676,9 +725,10 @@ pub(crate) fn step(
     ops: &Operators,
     sys: &mut EffectiveSystem,
     w: &mut Scratch,
-    correction: &mut dyn Correction,
+    correction: &mut Corrector,
     s: &mut State,
 ) -> Result<StepOutcome> {
+    correction.begin_step(s);
     let h = ops.h();
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
@@ -756,7 +806,8 @@ pub(crate) fn step(
             }));
         }
     };
-    finish(ops, sys.dofs(), w, s, t1);
+    let contact = correction.finish(&w.du, s);
+    finish(ops, sys.dofs(), w, s, t1, contact);
     if let Some((quantity, value)) = s.ledger.first_non_finite() {
         return Err(Error::NonFinite {
             quantity: format!("the ledger line {quantity}"),
@@ -782,7 +833,7 @@ fn first_non_finite(
 /// Books the converged step and makes it the state. The last evaluation summed the
 /// step's ledger terms with the applied loads; the reactions (the residual on the
 /// constrained dofs) are added here, with their part of the work terms.
-fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f64) {
+fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f64, contact: f64) {
     let mut sums = w.ledger_sums;
     for &d in &dofs.constrained {
         let reaction = w.r[d];
@@ -809,7 +860,7 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
         work,
         material,
         scheme_loss: sums[5],
-        contact: 0.0,
+        contact,
     });
     std::mem::swap(&mut s.u, &mut w.u_np1);
     std::mem::swap(&mut s.f_int, &mut w.f_int_np1);
@@ -954,7 +1005,7 @@ pub(crate) struct Core<'m> {
     pub ops: Operators,
     pub sys: EffectiveSystem,
     pub scratch: Scratch,
-    pub correction: Box<dyn Correction + Send>,
+    pub correction: Corrector<'m>,
     pub assembly_s: f64,
     /// Time inside steps besides solves and refactorisations.
     pub step_other_s: f64,
@@ -991,7 +1042,11 @@ impl<'m> Core<'m> {
             ops,
             sys,
             scratch,
-            correction: Box::new(LinearCorrection),
+            correction: if model.contacts.is_empty() {
+                Corrector::Linear(LinearCorrection)
+            } else {
+                Corrector::Contact(Box::new(ContactCorrection::new(model)))
+            },
             assembly_s,
             step_other_s: 0.0,
         })
@@ -1006,7 +1061,7 @@ impl<'m> Core<'m> {
             &self.ops,
             &mut self.sys,
             &mut self.scratch,
-            self.correction.as_mut(),
+            &mut self.correction,
             s,
         );
         let after = self.sys.timing();

@@ -49,6 +49,8 @@ pub struct State {
     pub f_pred: Vec<f64>,
     /// The step size `f_pred` was predicted for.
     pub f_pred_h: f64,
+    /// The contact state (multipliers, per-pair forces, gaps and pressures).
+    pub contact: crate::contact::ContactState,
 }
 
 /// What an accepted step reports besides the new state.

@@ -23,6 +23,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
         loads: Vec::new(),
         gravity: None,
         probes: Vec::new(),
+        contacts: Vec::new(),
         analysis: Analysis {
             kind: AnalysisKind::Static,
             dt: 1.0,
@@ -37,6 +38,8 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
             iteration: rothe::model::IterationMethod::Newton,
             max_cuts: 8,
             ordering: rothe::model::Ordering::Auto,
+            contact_tolerance: 1e-6,
+            contact_qp: rothe::model::ContactQp::Condensed,
         },
     }
 }

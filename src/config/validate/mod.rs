@@ -8,6 +8,7 @@
 
 mod checks;
 mod constraints;
+mod contacts;
 mod materials;
 mod meshes;
 
@@ -82,15 +83,14 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         positive(&format!("{field}.thickness"), b.thickness)?;
         finite(&format!("{field}.velocity"), &b.velocity)?;
         let mat = find_material(format!("{field}.material"), &b.material)?;
-        let part = meshes::body_part(&format!("{field}.mesh"), &b.mesh, dir).map_err(|e| {
-            match e {
+        let part =
+            meshes::body_part(&format!("{field}.mesh"), &b.mesh, dir).map_err(|e| match e {
                 Error::Config { field, message } => Error::Config {
                     field,
                     message: format!("body `{}`: {message}", b.name),
                 },
                 e => e,
-            }
-        })?;
+            })?;
         mesh.add_part(&part, bi, &b.name, mat, b.thickness);
         bodies.push(Body {
             name: b.name.clone(),
@@ -107,6 +107,15 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let constraints = constraints::constraints(s, &mesh)?;
     let loads = constraints::loads(s, &mesh, &bodies)?;
     let probes = constraints::probes(s, &mesh)?;
+    let (contacts, shortest) = contacts::contacts(s, &mesh)?;
+    let contact_tolerance = match a.contact_tolerance {
+        Some(t) => {
+            positive("analysis.contact_tolerance", t)?;
+            t
+        }
+        None if shortest.is_finite() => 1e-4 * shortest,
+        None => 1e-6,
+    };
 
     Ok(Model {
         mesh,
@@ -117,6 +126,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         loads,
         gravity: a.gravity,
         probes,
+        contacts,
         analysis: Analysis {
             kind: a.kind,
             dt: a.dt,
@@ -131,6 +141,8 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             iteration: a.iteration,
             max_cuts: a.max_cuts,
             ordering: a.ordering,
+            contact_tolerance,
+            contact_qp: a.contact_qp,
         },
     })
 }

@@ -1,0 +1,218 @@
+//! Contact pairs and unilateral supports: sets resolved, sides oriented, the search
+//! radius and the default penetration tolerance from the geometry.
+
+use super::checks::{finite, positive};
+use crate::config::{ContactSpec, Scenario};
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::model::{ContactPair, ContactSide, Master};
+
+fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+}
+
+/// The nodes of a node set or of an edge set.
+fn slave_nodes(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<usize>> {
+    if let Some(nodes) = mesh.node_sets.get(name) {
+        if nodes.is_empty() {
+            return Err(Error::config(field, format!("node set `{name}` is empty")));
+        }
+        return Ok(nodes.clone());
+    }
+    if let Some(edges) = mesh.edge_sets.get(name) {
+        if edges.is_empty() {
+            return Err(Error::config(field, format!("edge set `{name}` is empty")));
+        }
+        let mut nodes: Vec<usize> = edges.iter().flatten().copied().collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        return Ok(nodes);
+    }
+    Err(Error::config(
+        field,
+        format!(
+            "unknown set `{name}` (known node sets: {}; edge sets: {})",
+            mesh.node_sets
+                .keys()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", "),
+            mesh.edge_sets
+                .keys()
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    ))
+}
+
+/// The segments of an edge set.
+fn master_edges(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<[usize; 2]>> {
+    match mesh.edge_sets.get(name) {
+        Some(e) if !e.is_empty() => Ok(e.clone()),
+        Some(_) => Err(Error::config(field, format!("edge set `{name}` is empty"))),
+        None if mesh.node_sets.contains_key(name) => Err(Error::config(
+            field,
+            format!("`{name}` is a node set; the master of a contact pair is an edge set"),
+        )),
+        None => Err(Error::config(
+            field,
+            format!(
+                "unknown edge set `{name}` (known: {})",
+                mesh.edge_sets
+                    .keys()
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )),
+    }
+}
+
+/// The body of a set of nodes, if they all belong to one.
+fn body_of(mesh: &Mesh, nodes: &[usize]) -> Option<usize> {
+    let b = mesh.node_body[*nodes.first()?];
+    nodes.iter().all(|&n| mesh.node_body[n] == b).then_some(b)
+}
+
+/// The pairs, and the smallest master segment (or slave element) length for the
+/// default tolerance.
+pub(super) fn contacts(s: &Scenario, mesh: &Mesh) -> Result<(Vec<ContactPair>, f64)> {
+    let mut pairs = Vec::new();
+    let mut shortest = f64::INFINITY;
+    for (i, c) in s.contact.iter().enumerate() {
+        let field = format!("contact[{i}]");
+        let ContactSpec {
+            name,
+            slave,
+            master,
+            rigid_line,
+            both_ways,
+        } = c;
+        if name.is_empty() || name.contains(',') || name.contains('\n') {
+            return Err(Error::config(
+                format!("{field}.name"),
+                "must be non-empty and contain no comma or line break",
+            ));
+        }
+        if let Some(j) = s.contact[..i].iter().position(|o| &o.name == name) {
+            return Err(Error::config(
+                format!("{field}.name"),
+                format!("duplicate contact name `{name}` (also contact[{j}])"),
+            ));
+        }
+        if s.probes.iter().any(|p| &p.name == name) {
+            return Err(Error::config(
+                format!("{field}.name"),
+                format!("`{name}` is a probe name too: the history columns would clash"),
+            ));
+        }
+        let slaves = slave_nodes(mesh, &format!("{field}.slave"), slave)?;
+        let slave_size = slaves
+            .iter()
+            .map(|&n| mesh.element_size_at(n))
+            .fold(0.0, f64::max);
+        let mut sides = Vec::new();
+        let mut radius = slave_size;
+        match (master, rigid_line) {
+            (Some(m), None) => {
+                if m == slave {
+                    return Err(Error::config(
+                        format!("{field}.master"),
+                        format!("the master `{m}` is the slave set too"),
+                    ));
+                }
+                let edges = master_edges(mesh, &format!("{field}.master"), m)?;
+                let master_nodes: Vec<usize> = edges.iter().flatten().copied().collect();
+                if let (Some(a), Some(b)) = (body_of(mesh, &slaves), body_of(mesh, &master_nodes)) {
+                    if a == b {
+                        return Err(Error::config(
+                            format!("{field}.master"),
+                            "slave and master belong to one body: self-contact is not supported",
+                        ));
+                    }
+                }
+                for e in &edges {
+                    let l = dist(mesh.coords[e[0]], mesh.coords[e[1]]);
+                    radius = radius.max(l);
+                    shortest = shortest.min(l);
+                }
+                sides.push(ContactSide {
+                    slaves: slaves.clone(),
+                    master: Master::Segments(edges.clone()),
+                });
+                if *both_ways {
+                    let back =
+                        master_edges(mesh, &format!("{field}.slave"), slave).map_err(|_| {
+                            Error::config(
+                                format!("{field}.both_ways"),
+                                format!("both ways needs the slave `{slave}` to be an edge set"),
+                            )
+                        })?;
+                    let mut nodes = master_nodes;
+                    nodes.sort_unstable();
+                    nodes.dedup();
+                    for e in &back {
+                        let l = dist(mesh.coords[e[0]], mesh.coords[e[1]]);
+                        radius = radius.max(l);
+                        shortest = shortest.min(l);
+                    }
+                    sides.push(ContactSide {
+                        slaves: nodes,
+                        master: Master::Segments(back),
+                    });
+                }
+            }
+            (None, Some([a, b])) => {
+                finite(&format!("{field}.rigid_line[0]"), a)?;
+                finite(&format!("{field}.rigid_line[1]"), b)?;
+                let l = dist(*a, *b);
+                positive(&format!("{field}.rigid_line"), l).map_err(|_| {
+                    Error::config(
+                        format!("{field}.rigid_line"),
+                        format!("the rigid line from {a:?} to {b:?} has zero length"),
+                    )
+                })?;
+                if *both_ways {
+                    return Err(Error::config(
+                        format!("{field}.both_ways"),
+                        "a rigid line is a master only",
+                    ));
+                }
+                // The normal points to the side of the slave body's centroid.
+                let body = mesh.node_body[slaves[0]];
+                let (mut cx, mut cy, mut k) = (0.0, 0.0, 0.0);
+                for (n, &bn) in mesh.node_body.iter().enumerate() {
+                    if bn == body {
+                        cx += mesh.coords[n][0];
+                        cy += mesh.coords[n][1];
+                        k += 1.0;
+                    }
+                }
+                let (cx, cy) = (cx / k, cy / k);
+                let t = [(b[0] - a[0]) / l, (b[1] - a[1]) / l];
+                let mut n = [-t[1], t[0]];
+                if (cx - a[0]) * n[0] + (cy - a[1]) * n[1] < 0.0 {
+                    n = [-n[0], -n[1]];
+                }
+                shortest = shortest.min(slave_size);
+                sides.push(ContactSide {
+                    slaves,
+                    master: Master::Rigid { a: *a, b: *b, n },
+                });
+            }
+            _ => {
+                return Err(Error::config(
+                    field,
+                    "give exactly one of `master` (an edge set) or `rigid_line`",
+                ))
+            }
+        }
+        pairs.push(ContactPair {
+            name: name.clone(),
+            sides,
+            radius,
+        });
+    }
+    Ok((pairs, shortest))
+}

@@ -1,0 +1,452 @@
+//! Impenetrability in the implicit schemes: the constrained correction of the
+//! equilibrium loop.
+//!
+//! At an iterate `u` with residual `r` (without contact forces) and effective matrix
+//! `A`, the correction solves the convex QP
+//!
+//! `min ½ δᵀAδ + rᵀδ   subject to   g + Gδ ≥ 0`,
+//!
+//! `g` the gaps and `G` their linearisation at `u` (from [`super::detect`]); its
+//! multipliers `λ ≥ 0` are the contact forces, `f_c = Gᵀλ`. Condensed (the default):
+//! `δ₀ = −A⁻¹r`, `Y = A⁻¹Gᵀ` (one blocked solve on the factor the loop already has),
+//! `W = G Y`, the dual `min ½ λᵀWλ + λᵀ(g + Gδ₀)`, `λ ≥ 0`, and `δ = δ₀ + Yλ`. Full
+//! (the reference): the primal QP over all free dofs.
+//!
+//! Rows: the candidates whose predicted gap `g + Gδ₀` closes to within the
+//! tolerance, and those active at the last QP (or the last step). At every evaluated
+//! iterate the geometry is detected again (new normals, closest segments,
+//! candidates: re-linearisation), the forces `Gᵀλ` of the current multipliers enter
+//! the residual, and the loop converges when the residual, the penetration, the
+//! complementarity (no force across an open gap) and the active set all settle
+//! (`theory/contact.md`).
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use super::detect::{detect, Candidate};
+use super::qp::{primal_qp, DualQp};
+use crate::error::Result;
+use crate::model::{ContactPair, ContactQp, Model};
+use crate::nonlinear::{ConstraintStatus, Corrected, Correction};
+use crate::system::EffectiveSystem;
+
+/// Key of a constraint across re-linearisations: pair, side, slave node.
+type Key = (usize, usize, usize);
+
+/// One pair's contact at the end of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PairRecord {
+    /// Total normal force `Σ λ` (N).
+    pub force: f64,
+    /// Active constraints (nodes pressed against the master).
+    pub active: usize,
+    /// Largest penetration (m), zero when none.
+    pub penetration: f64,
+}
+
+/// The contact state a step leaves: kept in `time::State`, so a cut-back restores
+/// it with the rest.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ContactState {
+    /// Multipliers of the active constraints (N), by key.
+    pub active: Vec<(Key, f64)>,
+    /// Per pair.
+    pub pairs: Vec<PairRecord>,
+    /// Gap at each node (m); NaN where the node is no candidate.
+    pub gap: Vec<f64>,
+    /// Contact pressure at each node (Pa): its force over its tributary area.
+    pub pressure: Vec<f64>,
+}
+
+/// Time spent in the contact correction.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactStats {
+    /// QPs solved.
+    pub qps: usize,
+    /// Rows (constraints) summed over the QPs.
+    pub rows: usize,
+    /// Forming `W` (the blocked solve and the products), s.
+    pub w_s: f64,
+    /// Clarabel, s.
+    pub qp_s: f64,
+    /// Detection, s.
+    pub detect_s: f64,
+}
+
+/// The constrained correction for the contact pairs of a model.
+pub struct ContactCorrection<'m> {
+    model: &'m Model,
+    pairs: &'m [ContactPair],
+    tol: f64,
+    qp: ContactQp,
+    /// Tributary area (length × thickness) of each node as a slave, for pressures.
+    area: Vec<f64>,
+    /// The free-dof numbering (the system's).
+    dofs: crate::system::DofMap,
+    /// Candidates at the current iterate.
+    cands: Vec<Candidate>,
+    /// Current multipliers by key (positive ones only).
+    lambda: BTreeMap<Key, f64>,
+    /// Active keys of the previous QP (or of the last step) and of the last one.
+    previous: Vec<Key>,
+    current: Vec<Key>,
+    /// Contact forces `Gᵀλ` at the current iterate (all dofs), and whether the loop's
+    /// residual includes them.
+    f_c: Vec<f64>,
+    added: bool,
+    // Workspace.
+    x: Vec<f64>,
+    delta0: Vec<f64>,
+    rows: Vec<usize>,
+    row_free: Vec<Vec<(usize, f64)>>,
+    y: Vec<f64>,
+    w: Vec<f64>,
+    c: Vec<f64>,
+    lambda_rows: Vec<f64>,
+    dual: DualQp,
+    stats: ContactStats,
+}
+
+impl<'m> ContactCorrection<'m> {
+    /// The correction for the contact pairs of `model`.
+    pub fn new(model: &'m Model) -> Self {
+        let mesh = &model.mesh;
+        let n = mesh.n_dofs();
+        // Tributary lengths: half of every element edge joining two slave nodes.
+        let mut area = vec![0.0; mesh.n_nodes()];
+        for pair in &model.contacts {
+            for side in &pair.sides {
+                let mut is_slave = vec![false; mesh.n_nodes()];
+                for &s in &side.slaves {
+                    is_slave[s] = true;
+                }
+                let mut seen = std::collections::BTreeSet::new();
+                for b in &mesh.blocks {
+                    let t = model.bodies[b.body].thickness;
+                    for e in 0..b.elements.len() {
+                        let nodes = b.elements.element(e);
+                        for k in 0..nodes.len() {
+                            let (p, q) = (nodes[k], nodes[(k + 1) % nodes.len()]);
+                            if is_slave[p] && is_slave[q] && seen.insert((p.min(q), p.max(q))) {
+                                let (xp, xq) = (mesh.coords[p], mesh.coords[q]);
+                                let l = ((xp[0] - xq[0]).powi(2) + (xp[1] - xq[1]).powi(2)).sqrt();
+                                area[p] += 0.5 * l * t;
+                                area[q] += 0.5 * l * t;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        ContactCorrection {
+            model,
+            pairs: &model.contacts,
+            tol: model.analysis.contact_tolerance,
+            qp: model.analysis.contact_qp,
+            area,
+            dofs: crate::system::DofMap::new(n, model.constraints.iter().map(|c| c.dof)),
+            cands: Vec::new(),
+            lambda: BTreeMap::new(),
+            previous: Vec::new(),
+            current: Vec::new(),
+            f_c: vec![0.0; n],
+            added: false,
+            x: vec![0.0; n],
+            delta0: Vec::new(),
+            rows: Vec::new(),
+            row_free: Vec::new(),
+            y: Vec::new(),
+            w: Vec::new(),
+            c: Vec::new(),
+            lambda_rows: Vec::new(),
+            dual: DualQp::default(),
+            stats: ContactStats::default(),
+        }
+    }
+
+    /// Starts a step from the contact state of the last one: its multipliers are the
+    /// first guess of the forces, its active set the reference of the first QP.
+    pub fn begin_step(&mut self, committed: &ContactState) {
+        self.lambda = committed.active.iter().copied().collect();
+        self.current = committed.active.iter().map(|(k, _)| *k).collect();
+        self.previous = self.current.clone();
+        self.added = false;
+    }
+
+    /// Ends an accepted step with increment `du`: writes the contact state and returns
+    /// the work `Δu·f_c` of the contact forces of the step (the ledger books its
+    /// negative as `D_contact`).
+    pub fn finish(&mut self, du: &[f64], out: &mut ContactState) -> f64 {
+        let work: f64 = du.iter().zip(&self.f_c).map(|(d, f)| d * f).sum();
+        out.active = self.lambda.iter().map(|(k, l)| (*k, *l)).collect();
+        out.pairs.clear();
+        out.pairs.resize(self.pairs.len(), PairRecord::default());
+        let n_nodes = self.model.mesh.n_nodes();
+        out.gap.clear();
+        out.gap.resize(n_nodes, f64::NAN);
+        out.pressure.clear();
+        out.pressure.resize(n_nodes, 0.0);
+        for c in &self.cands {
+            let rec = &mut out.pairs[c.pair];
+            rec.penetration = rec.penetration.max(-c.gap);
+            let g = &mut out.gap[c.slave];
+            *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
+            if let Some(&l) = self.lambda.get(&c.key()) {
+                rec.force += l;
+                rec.active += 1;
+                if self.area[c.slave] > 0.0 {
+                    out.pressure[c.slave] += l / self.area[c.slave];
+                }
+            }
+        }
+        work
+    }
+
+    /// Time and counts so far.
+    pub fn stats(&self) -> ContactStats {
+        self.stats
+    }
+
+    /// Candidates at `u` into `self.cands`.
+    fn detect_at(&mut self, u: &[f64]) {
+        let t = Instant::now();
+        let coords = &self.model.mesh.coords;
+        for (n, c) in coords.iter().enumerate() {
+            self.x[2 * n] = c[0] + u[2 * n];
+            self.x[2 * n + 1] = c[1] + u[2 * n + 1];
+        }
+        let x = &self.x;
+        detect(self.pairs, |n| [x[2 * n], x[2 * n + 1]], &mut self.cands);
+        self.stats.detect_s += t.elapsed().as_secs_f64();
+    }
+
+    /// `Gᵀλ` of the current multipliers at the current candidates, into `f_c`.
+    fn forces(&mut self) {
+        self.f_c.fill(0.0);
+        for c in &self.cands {
+            if let Some(&l) = self.lambda.get(&c.key()) {
+                let (row, k) = c.row();
+                for &(d, v) in &row[..k] {
+                    self.f_c[d] += l * v;
+                }
+            }
+        }
+    }
+
+    /// The threshold below which a multiplier counts as zero.
+    fn active_threshold(&self, lambda: &[f64]) -> f64 {
+        1e-9 * lambda.iter().fold(0.0f64, |a, x| a.max(*x)) + f64::MIN_POSITIVE
+    }
+}
+
+impl Correction for ContactCorrection<'_> {
+    fn constrain(&mut self, u: &[f64], r: &mut [f64]) -> ConstraintStatus {
+        self.detect_at(u);
+        self.forces();
+        for (ri, f) in r.iter_mut().zip(&self.f_c) {
+            *ri -= f;
+        }
+        self.added = true;
+        let mut penetration: f64 = 0.0;
+        let mut open_under_force: f64 = 0.0;
+        for c in &self.cands {
+            penetration = penetration.max(-c.gap);
+            if self.lambda.contains_key(&c.key()) {
+                open_under_force = open_under_force.max(c.gap);
+            }
+        }
+        // A multiplier whose constraint is no candidate any more pushes nothing: it
+        // is dropped, and that is an active-set change.
+        let before = self.lambda.len();
+        let cands = &self.cands;
+        self.lambda
+            .retain(|k, _| cands.iter().any(|c| c.key() == *k));
+        ConstraintStatus {
+            penetration,
+            complementarity: open_under_force,
+            active_set_changed: self.previous != self.current || self.lambda.len() != before,
+        }
+    }
+
+    fn correct(
+        &mut self,
+        sys: &mut EffectiveSystem,
+        u: &[f64],
+        rhs: &mut [f64],
+    ) -> Result<Corrected> {
+        if !self.added {
+            // A predicted start: no evaluation, no forces in the right-hand side yet.
+            self.detect_at(u);
+            self.f_c.fill(0.0);
+        }
+        self.added = false;
+        let (free, eq) = (&self.dofs.free, &self.dofs.eq);
+        debug_assert_eq!(free.len(), sys.dofs().n_free());
+        // −r = rhs − f_c on the free dofs; δ₀ = A⁻¹(−r).
+        self.delta0.clear();
+        self.delta0
+            .extend(free.iter().zip(rhs.iter()).map(|(&d, &b)| b - self.f_c[d]));
+        let minus_r = self.delta0.clone();
+        sys.solve(&mut self.delta0)?;
+        // The rows: predicted to close, or active before; rows the free dofs cannot
+        // move are left out (nothing can enforce them).
+        self.rows.clear();
+        self.row_free.clear();
+        self.c.clear();
+        for (i, c) in self.cands.iter().enumerate() {
+            let (row, k) = c.row();
+            let entries: Vec<(usize, f64)> = row[..k]
+                .iter()
+                .filter(|(d, _)| eq[*d] != crate::system::CONSTRAINED)
+                .map(|&(d, v)| (eq[d], v))
+                .collect();
+            if entries.is_empty() {
+                continue;
+            }
+            let predicted = c.gap
+                + entries
+                    .iter()
+                    .map(|&(e, v)| v * self.delta0[e])
+                    .sum::<f64>();
+            if predicted < self.tol || self.current.contains(&c.key()) {
+                self.rows.push(i);
+                self.row_free.push(entries);
+                self.c.push(predicted);
+            }
+        }
+        let m = self.rows.len();
+        self.previous = std::mem::take(&mut self.current);
+        self.lambda.clear();
+        if m == 0 {
+            rhs.copy_from_slice(&self.delta0);
+            return Ok(Corrected::Ok);
+        }
+        self.stats.qps += 1;
+        self.stats.rows += m;
+        let nf = free.len();
+        let status = match self.qp {
+            ContactQp::Condensed => {
+                let t = Instant::now();
+                self.y.clear();
+                self.y.resize(nf * m, 0.0);
+                for (j, entries) in self.row_free.iter().enumerate() {
+                    for &(e, v) in entries {
+                        self.y[j * nf + e] += v;
+                    }
+                }
+                sys.solve_block(&mut self.y, m)?;
+                self.w.clear();
+                self.w.resize(m * m, 0.0);
+                for j in 0..m {
+                    let yj = &self.y[j * nf..(j + 1) * nf];
+                    for (i, entries) in self.row_free.iter().enumerate() {
+                        self.w[i + j * m] = entries.iter().map(|&(e, v)| v * yj[e]).sum();
+                    }
+                }
+                self.stats.w_s += t.elapsed().as_secs_f64();
+                let t = Instant::now();
+                let r = self.dual.solve(&self.w, &self.c, &mut self.lambda_rows);
+                self.stats.qp_s += t.elapsed().as_secs_f64();
+                if r.is_ok() {
+                    for (j, &l) in self.lambda_rows.iter().enumerate() {
+                        if l != 0.0 {
+                            let yj = &self.y[j * nf..(j + 1) * nf];
+                            for (d, y) in self.delta0.iter_mut().zip(yj) {
+                                *d += l * y;
+                            }
+                        }
+                    }
+                }
+                r.map(|_| ())
+            }
+            ContactQp::Full => {
+                let t = Instant::now();
+                let r_free: Vec<f64> = minus_r.iter().map(|x| -x).collect();
+                let gaps: Vec<f64> = self.rows.iter().map(|&i| self.cands[i].gap).collect();
+                let mut delta = Vec::new();
+                let sigma = self.delta0.iter().fold(self.tol, |a, x| a.max(x.abs()));
+                let r = primal_qp(
+                    sys.matrix(),
+                    &r_free,
+                    &gaps,
+                    &self.row_free,
+                    sigma,
+                    &mut delta,
+                    &mut self.lambda_rows,
+                );
+                self.stats.qp_s += t.elapsed().as_secs_f64();
+                if r.is_ok() {
+                    self.delta0.copy_from_slice(&delta);
+                }
+                r.map(|_| ())
+            }
+        };
+        if let Err(status) = status {
+            let worst = self
+                .cands
+                .iter()
+                .min_by(|a, b| a.gap.total_cmp(&b.gap))
+                .map(|c| {
+                    format!(
+                        "; worst gap {:.3e} m at {} of pair `{}`",
+                        c.gap,
+                        self.model.describe_dof(2 * c.slave),
+                        self.pairs[c.pair].name
+                    )
+                })
+                .unwrap_or_default();
+            let pairs: Vec<&str> = {
+                let mut p: Vec<usize> = self.rows.iter().map(|&i| self.cands[i].pair).collect();
+                p.sort_unstable();
+                p.dedup();
+                p.iter().map(|&i| self.pairs[i].name.as_str()).collect()
+            };
+            return Ok(Corrected::Failed(format!(
+                "contact QP of pair(s) {}: {status}{worst}",
+                pairs.join(", ")
+            )));
+        }
+        let threshold = self.active_threshold(&self.lambda_rows);
+        for (j, &i) in self.rows.iter().enumerate() {
+            let l = self.lambda_rows[j];
+            if l > threshold {
+                let key = self.cands[i].key();
+                self.lambda.insert(key, l);
+                self.current.push(key);
+            }
+        }
+        self.current.sort_unstable();
+        rhs.copy_from_slice(&self.delta0);
+        Ok(Corrected::Ok)
+    }
+}
+
+impl ContactState {
+    /// The state at the start of a run: no forces, the gaps of the initial geometry
+    /// (displacements `u`).
+    pub fn initial(model: &Model, u: &[f64]) -> ContactState {
+        let mut out = ContactState {
+            pairs: vec![PairRecord::default(); model.contacts.len()],
+            ..Default::default()
+        };
+        if model.contacts.is_empty() {
+            return out;
+        }
+        let coords = &model.mesh.coords;
+        let mut cands = Vec::new();
+        detect(
+            &model.contacts,
+            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+            &mut cands,
+        );
+        out.gap = vec![f64::NAN; model.mesh.n_nodes()];
+        out.pressure = vec![0.0; model.mesh.n_nodes()];
+        for c in &cands {
+            let g = &mut out.gap[c.slave];
+            *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
+            let rec = &mut out.pairs[c.pair];
+            rec.penetration = rec.penetration.max(-c.gap);
+        }
+        out
+    }
+}
