@@ -184,3 +184,83 @@ impl fmt::Display for Report {
         Ok(())
     }
 }
+
+/// Writes the matrices of the model's first step in Matrix Market format (through
+/// nalgebra-sparse's I/O) into `dir`, for study in SciPy or MATLAB:
+/// `K.mtx` and `M.mtx` (all dofs, dof `2n + c` for node `n`, component `c`),
+/// `K_eff.mtx` (the effective matrix of the first step on the free dofs, both
+/// triangles), `free_dofs.txt` (the dof of each free equation), and `G.mtx` (the
+/// linearised gap rows of every contact candidate at the initial geometry, all dofs)
+/// when the model has contact. Returns the files written.
+pub fn write_matrices(model: &Model, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>> {
+    use nalgebra_sparse::io::save_to_matrix_market_file;
+    use nalgebra_sparse::{CooMatrix, CscMatrix};
+    std::fs::create_dir_all(dir).map_err(|e| crate::Error::io(dir, e))?;
+    let (asm, k, mass, sys) = crate::time::first_matrices(model)?;
+    let p = &asm.pattern;
+    let n = p.n_dofs();
+    let on_pattern = |values: &[f64]| {
+        let mut coo = CooMatrix::new(n, n);
+        for node in 0..p.n_nodes {
+            let nbrs = &p.adj[p.adj_ptr[node]..p.adj_ptr[node + 1]];
+            for j in 0..2 {
+                let c0 = p.col_start(node, j);
+                for (kk, &m) in nbrs.iter().enumerate() {
+                    for i in 0..2 {
+                        let v = values[c0 + 2 * kk + i];
+                        if v != 0.0 {
+                            coo.push(2 * m as usize + i, 2 * node + j, v);
+                        }
+                    }
+                }
+            }
+        }
+        CscMatrix::from(&coo)
+    };
+    let mut written = Vec::new();
+    let save = |name: &str, m: &CscMatrix<f64>, written: &mut Vec<std::path::PathBuf>| -> Result<()> {
+        let path = dir.join(name);
+        save_to_matrix_market_file(m, &path).map_err(|e| crate::Error::io(&path, e))?;
+        written.push(path);
+        Ok(())
+    };
+    save("K.mtx", &on_pattern(&k), &mut written)?;
+    let m_values = match &mass {
+        crate::assembly::Mass::Consistent(v) => on_pattern(v),
+        crate::assembly::Mass::Lumped(d) => {
+            let mut coo = CooMatrix::new(n, n);
+            for (i, &v) in d.iter().enumerate() {
+                coo.push(i, i, v);
+            }
+            CscMatrix::from(&coo)
+        }
+    };
+    save("M.mtx", &m_values, &mut written)?;
+    let a = sys.matrix();
+    let mut coo = CooMatrix::new(a.n, a.n);
+    for j in 0..a.n {
+        for q in a.col_ptr[j]..a.col_ptr[j + 1] {
+            let i = a.row_idx[q];
+            coo.push(i, j, a.values[q]);
+            if i != j {
+                coo.push(j, i, a.values[q]);
+            }
+        }
+    }
+    save("K_eff.mtx", &CscMatrix::from(&coo), &mut written)?;
+    let path = dir.join("free_dofs.txt");
+    let text: String = sys.dofs().free.iter().map(|d| format!("{d}\n")).collect();
+    std::fs::write(&path, text).map_err(|e| crate::Error::io(&path, e))?;
+    written.push(path);
+    if !model.contacts.is_empty() {
+        let mut cands = Vec::new();
+        let coords = &model.mesh.coords;
+        crate::contact::detect::detect(&model.contacts, |nd| coords[nd], &mut cands);
+        let all: Vec<usize> = (0..n).collect();
+        let g = crate::contact::gap_matrix(&cands, &all, n);
+        let path = dir.join("G.mtx");
+        save_to_matrix_market_file(&g, &path).map_err(|e| crate::Error::io(&path, e))?;
+        written.push(path);
+    }
+    Ok(written)
+}

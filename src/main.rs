@@ -58,6 +58,10 @@ enum Command {
         /// Report even when the memory estimate exceeds the memory available.
         #[arg(long)]
         ignore_memory: bool,
+        /// Also write K, M, the first step's effective matrix and the contact gap
+        /// rows G in Matrix Market format into this directory.
+        #[arg(long)]
+        matrices: Option<PathBuf>,
     },
 }
 
@@ -129,11 +133,19 @@ fn main() -> ExitCode {
         Command::Check {
             scenario,
             ignore_memory,
+            matrices,
         } => {
             let opts = load_options(ignore_memory);
-            rothe::config::load_with(&scenario, &opts)
-                .and_then(|model| rothe::check::report(&model, opts.memory_limit))
-                .map(|report| print!("{report}"))
+            rothe::config::load_with(&scenario, &opts).and_then(|model| {
+                let report = rothe::check::report(&model, opts.memory_limit)?;
+                print!("{report}");
+                if let Some(dir) = matrices {
+                    for f in rothe::check::write_matrices(&model, &dir)? {
+                        println!("wrote       {}", f.display());
+                    }
+                }
+                Ok(())
+            })
         }
     });
     let result = result.unwrap_or_else(|p| {

@@ -281,7 +281,7 @@ pub enum Master {
 /// One direction of a contact pair: slave nodes that may not cross the master.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactSide {
-    /// Slave nodes.
+    /// Slave nodes, sorted and distinct (detection looks them up by number).
     pub slaves: Vec<usize>,
     /// The master surface.
     pub master: Master,

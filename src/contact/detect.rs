@@ -7,7 +7,19 @@
 //! at hand, queried with the pair's search radius, so the search grows as
 //! `s log s` with the number of segments, not as their square. Narrow phase: the
 //! closest point of each segment in reach; the segment with the smallest distance
-//! wins (an interior projection over an end point on a tie).
+//! wins (an interior projection over an end point on a tie). The normal is the
+//! segment's own, so the force of a frictionless contact is normal to the surface
+//! and does no work on sliding; where the closest point is a convex vertex (a slave
+//! beyond both segments' ends), it is the vertex normal (the normalised sum of the
+//! normals of the segments meeting there).
+//!
+//! A piecewise-linear surface has a kink at every vertex. Where the kink is concave
+//! (the next segment rises out of the plane of the first: a notch), a slave node
+//! sitting in it is held by both segments, and picking one of them would make it
+//! flip between the two normals from one iteration to the next, so the equilibrium
+//! loop never settles. A slave within [`NEAR_VERTEX`] of a concave vertex therefore
+//! gives two candidates, one per segment, each the half-plane of its segment's line:
+//! the QP finds the force in the cone of the two normals that balances the node.
 
 use rstar::primitives::{GeomWithData, Line};
 use rstar::RTree;
@@ -17,8 +29,13 @@ use crate::model::{ContactPair, Master};
 /// What a slave node is in contact with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Contactee {
-    /// A segment of a deformable body, nodes `[a, b]`.
-    Segment([usize; 2]),
+    /// Segment `index` of the side's master, nodes `[a, b]`.
+    Segment {
+        /// Index among the side's master segments.
+        index: usize,
+        /// End nodes.
+        nodes: [usize; 2],
+    },
     /// The rigid line of the pair's side.
     Rigid,
 }
@@ -44,9 +61,18 @@ pub struct Candidate {
 }
 
 impl Candidate {
-    /// The key that follows a constraint across re-linearisations (its segment may
-    /// change).
-    pub fn key(&self) -> (usize, usize, usize) {
+    /// The key of the constraint: pair, side, slave node and master segment (the
+    /// segment's index in the side, `usize::MAX` for a rigid line).
+    pub fn key(&self) -> (usize, usize, usize, usize) {
+        let master = match self.master {
+            Contactee::Segment { index, .. } => index,
+            Contactee::Rigid => usize::MAX,
+        };
+        (self.pair, self.side, self.slave, master)
+    }
+
+    /// The slave's key: pair, side, slave node.
+    pub fn slave_key(&self) -> (usize, usize, usize) {
         (self.pair, self.side, self.slave)
     }
 
@@ -58,7 +84,7 @@ impl Candidate {
         r[0] = (2 * s, nx);
         r[1] = (2 * s + 1, ny);
         match self.master {
-            Contactee::Segment([a, b]) => {
+            Contactee::Segment { nodes: [a, b], .. } => {
                 let (wa, wb) = (1.0 - self.xi, self.xi);
                 r[2] = (2 * a, -wa * nx);
                 r[3] = (2 * a + 1, -wa * ny);
@@ -71,16 +97,69 @@ impl Candidate {
     }
 }
 
-/// Closest point of `p` on the segment `a`-`b`: `(ξ, distance²)`.
+/// How close (relative to the segment's length) to a concave vertex a slave's
+/// closest point must be for the segment on the other side of the vertex to hold it
+/// too: a thousandth, far more than a node moves about a vertex within the
+/// iterations of a step, far less than a segment.
+pub const NEAR_VERTEX: f64 = 1e-3;
+
+/// How far (relative to its length) beyond its ends a rigid line still holds a node:
+/// a node at the very end of a support moves sideways by micrometres (Poisson's
+/// effect) and must not drop in and out of contact with it. A thousandth of the line
+/// changes where the support ends far less than the node spacing does.
+pub const RIGID_END_MARGIN: f64 = 1e-3;
+
+/// The linearised gap rows `G` of `cands` as a CSR matrix: one row per candidate,
+/// columns the dofs numbered by `columns` (`columns[d]` the column of dof `d`, or
+/// `usize::MAX` to leave the dof out: a constrained one), `ncols` columns.
+pub fn gap_matrix(
+    cands: &[Candidate],
+    columns: &[usize],
+    ncols: usize,
+) -> nalgebra_sparse::CsrMatrix<f64> {
+    let mut offsets = Vec::with_capacity(cands.len() + 1);
+    let mut cols = Vec::with_capacity(6 * cands.len());
+    let mut values = Vec::with_capacity(6 * cands.len());
+    offsets.push(0);
+    for c in cands {
+        let (row, k) = c.row();
+        let start = cols.len();
+        for &(d, v) in &row[..k] {
+            let j = columns[d];
+            if j != usize::MAX {
+                match cols[start..].iter().position(|&x| x == j) {
+                    Some(p) => values[start + p] += v,
+                    None => {
+                        cols.push(j);
+                        values.push(v);
+                    }
+                }
+            }
+        }
+        offsets.push(cols.len());
+    }
+    nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(
+        cands.len(),
+        ncols,
+        offsets,
+        cols,
+        values,
+    )
+    .expect("distinct in-range columns per row")
+}
+
+/// Projection of `p` on the line of the segment `a`-`b`: the unclamped `ξ` and the
+/// distance² to the closest point of the segment (`ξ` clamped to `[0, 1]`).
 fn closest(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
     let d = [b[0] - a[0], b[1] - a[1]];
     let l2 = d[0] * d[0] + d[1] * d[1];
     let xi = if l2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+        ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2
     } else {
         0.0
     };
-    let q = [a[0] + xi * d[0], a[1] + xi * d[1]];
+    let c = xi.clamp(0.0, 1.0);
+    let q = [a[0] + c * d[0], a[1] + c * d[1]];
     (xi, (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2))
 }
 
@@ -95,8 +174,77 @@ fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     }
 }
 
+/// The topology of a master's segments at the current geometry: each segment's
+/// outward normal and its neighbours along the surface (the segment ending where it
+/// starts, the one starting where it ends).
+struct Chain {
+    normal: Vec<[f64; 2]>,
+    prev: Vec<Option<usize>>,
+    next: Vec<Option<usize>>,
+    /// Sum of the normals of the segments meeting at a node.
+    at_node: std::collections::HashMap<usize, [f64; 2]>,
+}
+
+impl Chain {
+    fn new<X: Fn(usize) -> [f64; 2]>(segments: &[[usize; 2]], x: &X) -> Chain {
+        let m = segments.len();
+        let mut starting = std::collections::HashMap::with_capacity(m);
+        let mut at_node: std::collections::HashMap<usize, [f64; 2]> =
+            std::collections::HashMap::with_capacity(m + 1);
+        let mut normal = Vec::with_capacity(m);
+        for (k, &[a, b]) in segments.iter().enumerate() {
+            starting.insert(a, k);
+            let n = outward(x(a), x(b));
+            normal.push(n);
+            for v in [a, b] {
+                let e = at_node.entry(v).or_insert([0.0, 0.0]);
+                e[0] += n[0];
+                e[1] += n[1];
+            }
+        }
+        let next: Vec<Option<usize>> = segments
+            .iter()
+            .map(|&[_, b]| starting.get(&b).copied())
+            .collect();
+        let mut prev = vec![None; m];
+        for (k, n) in next.iter().enumerate() {
+            if let Some(&k2) = n.as_ref() {
+                prev[k2] = Some(k);
+            }
+        }
+        Chain {
+            normal,
+            prev,
+            next,
+            at_node,
+        }
+    }
+
+    /// Whether the kink from segment `k` into the next one `k2` is concave: the far
+    /// end of `k2` lies outside the line of `k`.
+    fn concave<X: Fn(usize) -> [f64; 2]>(
+        &self,
+        k: usize,
+        k2: usize,
+        segments: &[[usize; 2]],
+        x: &X,
+    ) -> bool {
+        let (v, c) = (x(segments[k][1]), x(segments[k2][1]));
+        let n = self.normal[k];
+        (c[0] - v[0]) * n[0] + (c[1] - v[1]) * n[1] > 0.0
+    }
+
+    /// The unit vertex normal at node `v`, if the normals there do not cancel.
+    fn vertex_normal(&self, v: usize) -> Option<[f64; 2]> {
+        let [nx, ny] = *self.at_node.get(&v)?;
+        let l = (nx * nx + ny * ny).sqrt();
+        (l > 0.0).then(|| [nx / l, ny / l])
+    }
+}
+
 /// Candidates of every pair at the geometry `x(node)`, appended to `out` (cleared
-/// first), ordered by pair, side and slave node.
+/// first), ordered by pair, side and slave node (a slave in a notch gives two, by
+/// segment).
 pub fn detect<X>(pairs: &[ContactPair], x: X, out: &mut Vec<Candidate>)
 where
     X: Fn(usize) -> [f64; 2],
@@ -107,6 +255,7 @@ where
         for (si, side) in pair.sides.iter().enumerate() {
             match &side.master {
                 Master::Segments(segments) => {
+                    let chain = Chain::new(segments, &x);
                     let tree = RTree::bulk_load(
                         segments
                             .iter()
@@ -116,6 +265,7 @@ where
                     );
                     for &s in &side.slaves {
                         let p = x(s);
+                        // (distance², interior, segment, ξ unclamped)
                         let mut best: Option<(f64, bool, usize, f64)> = None;
                         for hit in tree.locate_within_distance(p, r2) {
                             let [a, b] = segments[hit.data];
@@ -134,20 +284,60 @@ where
                                 best = Some((d2, interior, hit.data, xi));
                             }
                         }
-                        if let Some((_, _, k, xi)) = best {
+                        let Some((_, _, k, xi)) = best else {
+                            continue;
+                        };
+                        let [a, b] = segments[k];
+                        // The vertex near the closest point, and the segment beyond it
+                        // when the kink there is concave.
+                        let notch = if xi >= 1.0 - NEAR_VERTEX {
+                            chain.next[k].filter(|&k2| chain.concave(k, k2, segments, &x))
+                        } else if xi <= NEAR_VERTEX {
+                            chain.prev[k].filter(|&k2| chain.concave(k2, k, segments, &x))
+                        } else {
+                            None
+                        };
+                        let candidate = |k: usize, xi: f64, n: [f64; 2]| {
                             let [a, b] = segments[k];
                             let (xa, xb) = (x(a), x(b));
-                            let n = outward(xa, xb);
                             let q = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
-                            out.push(Candidate {
+                            Candidate {
                                 pair: pi,
                                 side: si,
                                 slave: s,
-                                master: Contactee::Segment([a, b]),
+                                master: Contactee::Segment {
+                                    index: k,
+                                    nodes: [a, b],
+                                },
                                 xi,
                                 gap: (p[0] - q[0]) * n[0] + (p[1] - q[1]) * n[1],
                                 normal: n,
-                            });
+                            }
+                        };
+                        let xi = xi.clamp(0.0, 1.0);
+                        match notch {
+                            Some(k2) => {
+                                // Two half-planes, each along its segment's normal.
+                                let [a2, b2] = segments[k2];
+                                let (xi2, _) = closest(p, x(a2), x(b2));
+                                let mut pair_of = [
+                                    candidate(k, xi, chain.normal[k]),
+                                    candidate(k2, xi2.clamp(0.0, 1.0), chain.normal[k2]),
+                                ];
+                                pair_of.sort_by_key(|c| c.key());
+                                out.extend(pair_of);
+                            }
+                            None => {
+                                let vertex = match () {
+                                    _ if xi <= 0.0 => Some(a),
+                                    _ if xi >= 1.0 => Some(b),
+                                    _ => None,
+                                };
+                                let n = vertex
+                                    .and_then(|v| chain.vertex_normal(v))
+                                    .unwrap_or(chain.normal[k]);
+                                out.push(candidate(k, xi, n));
+                            }
                         }
                     }
                 }
@@ -158,8 +348,9 @@ where
                         let p = x(s);
                         let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
                         let gap = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
-                        let tol = 1e-9;
-                        if (-tol..=1.0 + tol).contains(&xi) && gap * gap <= r2 {
+                        if (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi)
+                            && gap * gap <= r2
+                        {
                             out.push(Candidate {
                                 pair: pi,
                                 side: si,
@@ -206,11 +397,11 @@ mod tests {
         detect(&[pair], |n| coords[n], &mut out);
         assert_eq!(out.len(), 2, "node 5 is out of reach: {out:?}");
         let c3 = out.iter().find(|c| c.slave == 3).unwrap();
-        assert_eq!(c3.master, Contactee::Segment([1, 2]));
+        assert_eq!(c3.master, Contactee::Segment { index: 1, nodes: [1, 2] });
         assert!((c3.xi - 0.5).abs() < 1e-14 && (c3.gap - 0.3).abs() < 1e-14);
         assert_eq!(c3.normal, [0.0, 1.0]);
         let c4 = out.iter().find(|c| c.slave == 4).unwrap();
-        assert_eq!(c4.master, Contactee::Segment([0, 1]));
+        assert_eq!(c4.master, Contactee::Segment { index: 0, nodes: [0, 1] });
         assert!((c4.gap + 0.01).abs() < 1e-14, "penetrating: {}", c4.gap);
         // The linearised row: +n on the slave, −(1−ξ)n and −ξn on the segment.
         let (row, k) = c3.row();
@@ -218,6 +409,61 @@ mod tests {
         assert_eq!(row[1], (7, 1.0));
         assert_eq!(row[3], (3, -0.5));
         assert_eq!(row[5], (5, -0.5));
+    }
+
+    #[test]
+    fn a_slave_in_a_notch_is_held_by_both_segments() {
+        // Master top edge (body below, oriented right to left) with a concave kink at
+        // node 1 (a notch: both neighbours higher) and a convex one at node 2 (the
+        // surface turns flat there, below the line of the segment before).
+        let coords = [
+            [2.0, 0.1],  // 0
+            [1.0, 0.0],  // 1: notch
+            [0.0, 0.1],  // 2: convex
+            [-1.0, 0.1], // 3
+            [1.0, 1e-9], // 4: slave just above the notch
+            [0.0, 0.15], // 5: slave above the convex vertex
+        ];
+        let pair = |slaves: Vec<usize>, segments: Vec<[usize; 2]>| ContactPair {
+            name: "p".into(),
+            sides: vec![ContactSide {
+                slaves,
+                master: Master::Segments(segments),
+            }],
+            radius: 1.0,
+        };
+        let mut out = Vec::new();
+        detect(
+            &[pair(vec![4, 5], vec![[0, 1], [1, 2], [2, 3]])],
+            |n| coords[n],
+            &mut out,
+        );
+        let at4: Vec<_> = out.iter().filter(|c| c.slave == 4).collect();
+        assert_eq!(at4.len(), 2, "{out:?}");
+        assert_eq!(at4[0].key().3, 0);
+        assert_eq!(at4[1].key().3, 1);
+        for c in &at4 {
+            // Each along its own segment's normal, the gap that of its line.
+            let n = c.normal;
+            assert!((n[0] * n[0] + n[1] * n[1] - 1.0).abs() < 1e-14);
+            assert!(c.gap > 0.0 && c.gap < 1e-9, "{c:?}");
+        }
+        // Segment 0 rises to the right (its normal leans left), segment 1 to the left.
+        assert!(at4[0].normal[0] < 0.0 && at4[1].normal[0] > 0.0, "{at4:?}");
+        // Vertex 2 is convex (node 3 lies below the line of segment [1, 2]): one
+        // candidate.
+        assert_eq!(out.iter().filter(|c| c.slave == 5).count(), 1, "{out:?}");
+
+        // A convex corner: a slave beyond both segments' ends gets the vertex normal.
+        let corner = [[1.0, 0.0], [0.0, 0.0], [0.0, -1.0], [-0.1, 0.1]];
+        detect(
+            &[pair(vec![3], vec![[0, 1], [1, 2]])],
+            |n| corner[n],
+            &mut out,
+        );
+        assert_eq!(out.len(), 1);
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((out[0].normal[0] + h).abs() < 1e-14 && (out[0].normal[1] - h).abs() < 1e-14);
     }
 
     #[test]

@@ -30,8 +30,21 @@ use crate::model::{ContactPair, ContactQp, Model};
 use crate::nonlinear::{ConstraintStatus, Corrected, Correction};
 use crate::system::EffectiveSystem;
 
-/// Key of a constraint across re-linearisations: pair, side, slave node.
-type Key = (usize, usize, usize);
+/// Key of a constraint across re-linearisations: pair, side, slave node, master
+/// segment (`Candidate::key`).
+type Key = (usize, usize, usize, usize);
+
+/// The slaves (pair, side, node) of a sorted list of constraint keys, distinct.
+fn slaves(keys: &[Key]) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+    let mut last = None;
+    keys.iter().filter_map(move |k| {
+        let s = (k.0, k.1, k.2);
+        (last.replace(s) != Some(s)).then_some(s)
+    })
+}
+
+/// Multipliers below this fraction of the largest count as inactive.
+const ACTIVE_FRACTION: f64 = 1e-6;
 
 /// One pair's contact at the end of a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -48,7 +61,8 @@ pub struct PairRecord {
 /// it with the rest.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ContactState {
-    /// Multipliers of the active constraints (N), by key.
+    /// The positive multipliers (N), by key (the active constraints are those above
+    /// a millionth of the largest).
     pub active: Vec<(Key, f64)>,
     /// Per pair.
     pub pairs: Vec<PairRecord>,
@@ -87,7 +101,10 @@ pub struct ContactCorrection<'m> {
     cands: Vec<Candidate>,
     /// Current multipliers by key (positive ones only).
     lambda: BTreeMap<Key, f64>,
-    /// Active keys of the previous QP (or of the last step) and of the last one.
+    /// Active constraints (multipliers above the threshold) of the previous QP (or of
+    /// the last step) and of the last one, sorted. The active set has settled when
+    /// the same slaves are held (a slave in a notch may share its force between
+    /// two segments differently from one QP to the next).
     previous: Vec<Key>,
     current: Vec<Key>,
     /// Contact forces `Gᵀλ` at the current iterate (all dofs), and whether the loop's
@@ -98,7 +115,6 @@ pub struct ContactCorrection<'m> {
     x: Vec<f64>,
     delta0: Vec<f64>,
     rows: Vec<usize>,
-    row_free: Vec<Vec<(usize, f64)>>,
     y: Vec<f64>,
     w: Vec<f64>,
     c: Vec<f64>,
@@ -154,7 +170,6 @@ impl<'m> ContactCorrection<'m> {
             x: vec![0.0; n],
             delta0: Vec::new(),
             rows: Vec::new(),
-            row_free: Vec::new(),
             y: Vec::new(),
             w: Vec::new(),
             c: Vec::new(),
@@ -168,7 +183,14 @@ impl<'m> ContactCorrection<'m> {
     /// first guess of the forces, its active set the reference of the first QP.
     pub fn begin_step(&mut self, committed: &ContactState) {
         self.lambda = committed.active.iter().copied().collect();
-        self.current = committed.active.iter().map(|(k, _)| *k).collect();
+        let values: Vec<f64> = committed.active.iter().map(|(_, l)| *l).collect();
+        let threshold = self.active_threshold(&values);
+        self.current = committed
+            .active
+            .iter()
+            .filter(|(_, l)| *l > threshold)
+            .map(|(k, _)| *k)
+            .collect();
         self.previous = self.current.clone();
         self.added = false;
     }
@@ -193,11 +215,13 @@ impl<'m> ContactCorrection<'m> {
             *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
             if let Some(&l) = self.lambda.get(&c.key()) {
                 rec.force += l;
-                rec.active += 1;
                 if self.area[c.slave] > 0.0 {
                     out.pressure[c.slave] += l / self.area[c.slave];
                 }
             }
+        }
+        for (pair, _, _) in slaves(&self.current) {
+            out.pairs[pair].active += 1;
         }
         work
     }
@@ -233,9 +257,13 @@ impl<'m> ContactCorrection<'m> {
         }
     }
 
-    /// The threshold below which a multiplier counts as zero.
+    /// The threshold below which a multiplier counts as zero: a millionth of the
+    /// largest. A constraint that is only weakly active (its gap and its force both
+    /// about zero, as at the instant of a release) would otherwise flip in and out of
+    /// the active set from one QP to the next while the step is already in
+    /// equilibrium.
     fn active_threshold(&self, lambda: &[f64]) -> f64 {
-        1e-9 * lambda.iter().fold(0.0f64, |a, x| a.max(*x)) + f64::MIN_POSITIVE
+        ACTIVE_FRACTION * lambda.iter().fold(0.0f64, |a, x| a.max(*x)) + f64::MIN_POSITIVE
     }
 }
 
@@ -251,7 +279,7 @@ impl Correction for ContactCorrection<'_> {
         let mut open_under_force: f64 = 0.0;
         for c in &self.cands {
             penetration = penetration.max(-c.gap);
-            if self.lambda.contains_key(&c.key()) {
+            if self.current.contains(&c.key()) {
                 open_under_force = open_under_force.max(c.gap);
             }
         }
@@ -264,7 +292,8 @@ impl Correction for ContactCorrection<'_> {
         ConstraintStatus {
             penetration,
             complementarity: open_under_force,
-            active_set_changed: self.previous != self.current || self.lambda.len() != before,
+            active_set_changed: !slaves(&self.previous).eq(slaves(&self.current))
+                || self.lambda.len() != before,
         }
     }
 
@@ -288,29 +317,26 @@ impl Correction for ContactCorrection<'_> {
             .extend(free.iter().zip(rhs.iter()).map(|(&d, &b)| b - self.f_c[d]));
         let minus_r = self.delta0.clone();
         sys.solve(&mut self.delta0)?;
-        // The rows: predicted to close, or active before; rows the free dofs cannot
-        // move are left out (nothing can enforce them).
+        // G over the free dofs (nalgebra-sparse CSR). The rows: predicted to close, or
+        // active before; rows the free dofs cannot move are left out (nothing can
+        // enforce them).
+        let g = super::detect::gap_matrix(&self.cands, eq, free.len());
         self.rows.clear();
-        self.row_free.clear();
         self.c.clear();
         for (i, c) in self.cands.iter().enumerate() {
-            let (row, k) = c.row();
-            let entries: Vec<(usize, f64)> = row[..k]
-                .iter()
-                .filter(|(d, _)| eq[*d] != crate::system::CONSTRAINED)
-                .map(|&(d, v)| (eq[d], v))
-                .collect();
-            if entries.is_empty() {
+            let row = g.row(i);
+            if row.nnz() == 0 {
                 continue;
             }
             let predicted = c.gap
-                + entries
+                + row
+                    .col_indices()
                     .iter()
-                    .map(|&(e, v)| v * self.delta0[e])
+                    .zip(row.values())
+                    .map(|(&e, v)| v * self.delta0[e])
                     .sum::<f64>();
             if predicted < self.tol || self.current.contains(&c.key()) {
                 self.rows.push(i);
-                self.row_free.push(entries);
                 self.c.push(predicted);
             }
         }
@@ -329,8 +355,9 @@ impl Correction for ContactCorrection<'_> {
                 let t = Instant::now();
                 self.y.clear();
                 self.y.resize(nf * m, 0.0);
-                for (j, entries) in self.row_free.iter().enumerate() {
-                    for &(e, v) in entries {
+                for (j, &i) in self.rows.iter().enumerate() {
+                    let row = g.row(i);
+                    for (&e, v) in row.col_indices().iter().zip(row.values()) {
                         self.y[j * nf + e] += v;
                     }
                 }
@@ -339,8 +366,14 @@ impl Correction for ContactCorrection<'_> {
                 self.w.resize(m * m, 0.0);
                 for j in 0..m {
                     let yj = &self.y[j * nf..(j + 1) * nf];
-                    for (i, entries) in self.row_free.iter().enumerate() {
-                        self.w[i + j * m] = entries.iter().map(|&(e, v)| v * yj[e]).sum();
+                    for (k, &i) in self.rows.iter().enumerate() {
+                        let row = g.row(i);
+                        self.w[k + j * m] = row
+                            .col_indices()
+                            .iter()
+                            .zip(row.values())
+                            .map(|(&e, v)| v * yj[e])
+                            .sum();
                     }
                 }
                 self.stats.w_s += t.elapsed().as_secs_f64();
@@ -363,13 +396,25 @@ impl Correction for ContactCorrection<'_> {
                 let t = Instant::now();
                 let r_free: Vec<f64> = minus_r.iter().map(|x| -x).collect();
                 let gaps: Vec<f64> = self.rows.iter().map(|&i| self.cands[i].gap).collect();
+                let row_entries: Vec<Vec<(usize, f64)>> = self
+                    .rows
+                    .iter()
+                    .map(|&i| {
+                        let row = g.row(i);
+                        row.col_indices()
+                            .iter()
+                            .copied()
+                            .zip(row.values().iter().copied())
+                            .collect()
+                    })
+                    .collect();
                 let mut delta = Vec::new();
                 let sigma = self.delta0.iter().fold(self.tol, |a, x| a.max(x.abs()));
                 let r = primal_qp(
                     sys.matrix(),
                     &r_free,
                     &gaps,
-                    &self.row_free,
+                    &row_entries,
                     sigma,
                     &mut delta,
                     &mut self.lambda_rows,
@@ -406,12 +451,17 @@ impl Correction for ContactCorrection<'_> {
                 pairs.join(", ")
             )));
         }
+        // Every positive multiplier acts as a force (dropping small ones would leave
+        // their force out of the balance); the active set, for the test that it has
+        // settled and for complementarity, holds the significant ones.
         let threshold = self.active_threshold(&self.lambda_rows);
         for (j, &i) in self.rows.iter().enumerate() {
             let l = self.lambda_rows[j];
-            if l > threshold {
-                let key = self.cands[i].key();
+            let key = self.cands[i].key();
+            if l > 0.0 {
                 self.lambda.insert(key, l);
+            }
+            if l > threshold {
                 self.current.push(key);
             }
         }

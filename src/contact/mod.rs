@@ -15,5 +15,5 @@ pub mod detect;
 pub mod implicit;
 mod qp;
 
-pub use detect::{Candidate, Contactee};
+pub use detect::{gap_matrix, Candidate, Contactee};
 pub use implicit::{ContactCorrection, ContactState, PairRecord};

@@ -97,6 +97,14 @@ impl<'m> BackwardEuler<'m> {
         self.core.scratch.history()
     }
 
+    /// Time and counts of the contact correction, when the model has contact.
+    pub fn contact_stats(&self) -> Option<crate::contact::implicit::ContactStats> {
+        match &self.core.correction {
+            super::implicit::Corrector::Contact(c) => Some(c.stats()),
+            super::implicit::Corrector::Linear(_) => None,
+        }
+    }
+
     /// The effective system (matrix, factor, solves).
     pub fn system(&mut self) -> &mut EffectiveSystem {
         &mut self.core.sys

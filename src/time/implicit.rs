@@ -175,8 +175,8 @@ impl Operators {
     }
 
     /// Refills the effective matrix with the tangent `kt` (ignored for elastic
-    /// models) and refactorises it.
-    pub fn refactor(&self, sys: &mut EffectiveSystem, kt: &[f64]) -> Result<Factored> {
+    /// models).
+    pub fn refill(&self, sys: &mut EffectiveSystem, kt: &[f64]) {
         let (c_m, c_k, c_t) = self.coefficients();
         if c_t == 0.0 {
             sys.refill(c_m, &self.mass, &[(c_k, &self.k)]);
@@ -185,6 +185,11 @@ impl Operators {
         } else {
             sys.refill(c_m, &self.mass, &[(c_k, &self.k), (c_t, kt)]);
         }
+    }
+
+    /// Refills the effective matrix with the tangent `kt` and refactorises it.
+    pub fn refactor(&self, sys: &mut EffectiveSystem, kt: &[f64]) -> Result<Factored> {
+        self.refill(sys, kt);
         sys.factorize()
     }
 
@@ -997,6 +1002,41 @@ fn likely_cause(
              unsupported body; use a smaller step or supports"
         ),
     }
+}
+
+/// The matrices of a model's first step, for export: `K` and `M` on the shared
+/// pattern (with the assembler), and the effective matrix on the free dofs, analysed
+/// but not factorised (the tangent at rest for materials with history).
+pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, EffectiveSystem)> {
+    let a = &model.analysis;
+    let scheme = match a.kind {
+        crate::model::AnalysisKind::Dynamic => Scheme::BackwardEuler {
+            h: a.dt,
+            damp_m: a.zeta + a.rayleigh[0],
+            damp_k: a.rayleigh[1],
+        },
+        crate::model::AnalysisKind::Static => Scheme::Static { dt: a.dt },
+    };
+    let ops = Operators::new(model, scheme);
+    let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+    let mut sys = EffectiveSystem::new(
+        &ops.asm.pattern,
+        dofs,
+        Backend::Faer,
+        a.ordering,
+        &model.mesh.coords,
+    )?;
+    let kt = match ops.response {
+        Response::StateDependent(_) => {
+            let stores = new_stores(&model.mesh, &model.materials);
+            let u0 = vec![0.0; model.mesh.n_dofs()];
+            ops.asm
+                .tangent(&model.mesh, &model.materials, model.plane, &u0, ops.h(), &stores)
+        }
+        _ => ops.kt.clone(),
+    };
+    ops.refill(&mut sys, &kt);
+    Ok((ops.asm, ops.k, ops.mass, sys))
 }
 
 /// The integrator parts every implicit scheme holds.

@@ -13,6 +13,7 @@ pub mod cfl;
 pub mod forces;
 mod implicit;
 pub mod march;
+pub use implicit::first_matrices;
 pub mod statics;
 
 use crate::energy::Ledger;

@@ -17,7 +17,10 @@ fn slave_nodes(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<usize>> {
         if nodes.is_empty() {
             return Err(Error::config(field, format!("node set `{name}` is empty")));
         }
-        return Ok(nodes.clone());
+        let mut nodes = nodes.clone();
+        nodes.sort_unstable();
+        nodes.dedup();
+        return Ok(nodes);
     }
     if let Some(edges) = mesh.edge_sets.get(name) {
         if edges.is_empty() {
