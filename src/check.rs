@@ -218,12 +218,13 @@ pub fn write_matrices(model: &Model, dir: &std::path::Path) -> Result<Vec<std::p
         CscMatrix::from(&coo)
     };
     let mut written = Vec::new();
-    let save = |name: &str, m: &CscMatrix<f64>, written: &mut Vec<std::path::PathBuf>| -> Result<()> {
-        let path = dir.join(name);
-        save_to_matrix_market_file(m, &path).map_err(|e| crate::Error::io(&path, e))?;
-        written.push(path);
-        Ok(())
-    };
+    let save =
+        |name: &str, m: &CscMatrix<f64>, written: &mut Vec<std::path::PathBuf>| -> Result<()> {
+            let path = dir.join(name);
+            save_to_matrix_market_file(m, &path).map_err(|e| crate::Error::io(&path, e))?;
+            written.push(path);
+            Ok(())
+        };
     save("K.mtx", &on_pattern(&k), &mut written)?;
     let m_values = match &mass {
         crate::assembly::Mass::Consistent(v) => on_pattern(v),

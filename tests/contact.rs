@@ -281,7 +281,10 @@ fix = ["x"]
     for _ in 0..m.analysis.n_steps() {
         be.step_accepted(&mut s).unwrap();
         let f = s.contact.pairs[0].force + s.contact.pairs[1].force;
-        assert!(s.contact.pairs.iter().all(|p| p.force >= 0.0), "a support pulls");
+        assert!(
+            s.contact.pairs.iter().all(|p| p.force >= 0.0),
+            "a support pulls"
+        );
         for p in &s.contact.pairs {
             assert!(p.penetration <= m.analysis.contact_tolerance);
         }
@@ -292,7 +295,10 @@ fix = ["x"]
             lifted = true;
         }
     }
-    assert!(pushed && lifted, "the beam bounces off: pushed {pushed}, lifted {lifted}");
+    assert!(
+        pushed && lifted,
+        "the beam bounces off: pushed {pushed}, lifted {lifted}"
+    );
 }
 
 fn drop_on(material: &str) -> String {
@@ -426,10 +432,26 @@ fn contact_ledgers_close_with_every_material_model() {
 fn contact_pairs_are_validated() {
     let base = drop_on("model = \"elastic\"");
     let cases: [(&str, &str, &str); 6] = [
-        ("master = \"base.top\"", "master = \"block.bottom\"", "is the slave set too"),
-        ("master = \"base.top\"", "master = \"base.roof\"", "unknown edge set `base.roof`"),
-        ("master = \"base.top\"", "master = \"base.all\"", "is a node set"),
-        ("slave = \"block.bottom\"", "slave = \"block.nothing\"", "unknown set `block.nothing`"),
+        (
+            "master = \"base.top\"",
+            "master = \"block.bottom\"",
+            "is the slave set too",
+        ),
+        (
+            "master = \"base.top\"",
+            "master = \"base.roof\"",
+            "unknown edge set `base.roof`",
+        ),
+        (
+            "master = \"base.top\"",
+            "master = \"base.all\"",
+            "is a node set",
+        ),
+        (
+            "slave = \"block.bottom\"",
+            "slave = \"block.nothing\"",
+            "unknown set `block.nothing`",
+        ),
         (
             "master = \"base.top\"",
             "rigid_line = [[0.0, 0.0], [0.0, 0.0]]",
@@ -447,10 +469,17 @@ fn contact_pairs_are_validated() {
             .to_string();
         assert!(e.contains("contact[0]") && e.contains(words), "{e}");
     }
-    let e = rothe::config::from_str(&(base.clone() + "[[contact]]\nname = \"impact\"\nslave = \"base.top\"\nmaster = \"block.bottom\"\n"), Path::new("."))
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("contact[1].name") && e.contains("duplicate"), "{e}");
+    let e = rothe::config::from_str(
+        &(base.clone()
+            + "[[contact]]\nname = \"impact\"\nslave = \"base.top\"\nmaster = \"block.bottom\"\n"),
+        Path::new("."),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("contact[1].name") && e.contains("duplicate"),
+        "{e}"
+    );
     let e = rothe::config::from_str(
         &base.replace("master = \"base.top\"", "master = \"block.top\""),
         Path::new("."),

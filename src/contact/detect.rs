@@ -221,7 +221,10 @@ impl Chain {
     }
 
     /// Whether the kink from segment `k` into the next one `k2` is concave: the far
-    /// end of `k2` lies outside the line of `k`.
+    /// end of `k2` lies outside the line of `k`. No threshold: at a flat kink the two
+    /// rows coincide, so a slave passes continuously from one row to two; any
+    /// threshold would make that a jump (and a vertex whose kink hovers at it would
+    /// switch from one iteration to the next).
     fn concave<X: Fn(usize) -> [f64; 2]>(
         &self,
         k: usize,
@@ -397,11 +400,23 @@ mod tests {
         detect(&[pair], |n| coords[n], &mut out);
         assert_eq!(out.len(), 2, "node 5 is out of reach: {out:?}");
         let c3 = out.iter().find(|c| c.slave == 3).unwrap();
-        assert_eq!(c3.master, Contactee::Segment { index: 1, nodes: [1, 2] });
+        assert_eq!(
+            c3.master,
+            Contactee::Segment {
+                index: 1,
+                nodes: [1, 2]
+            }
+        );
         assert!((c3.xi - 0.5).abs() < 1e-14 && (c3.gap - 0.3).abs() < 1e-14);
         assert_eq!(c3.normal, [0.0, 1.0]);
         let c4 = out.iter().find(|c| c.slave == 4).unwrap();
-        assert_eq!(c4.master, Contactee::Segment { index: 0, nodes: [0, 1] });
+        assert_eq!(
+            c4.master,
+            Contactee::Segment {
+                index: 0,
+                nodes: [0, 1]
+            }
+        );
         assert!((c4.gap + 0.01).abs() < 1e-14, "penetrating: {}", c4.gap);
         // The linearised row: +n on the slave, −(1−ξ)n and −ξn on the segment.
         let (row, k) = c3.row();

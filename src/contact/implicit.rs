@@ -23,8 +23,9 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+use super::compliance::Compliance;
 use super::detect::{detect, Candidate};
-use super::qp::{primal_qp, DualQp};
+use super::qp::{primal_qp, solve_by_active_set, DualQp, QpStats};
 use crate::error::Result;
 use crate::model::{ContactPair, ContactQp, Model};
 use crate::nonlinear::{ConstraintStatus, Corrected, Correction};
@@ -42,6 +43,10 @@ fn slaves(keys: &[Key]) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
         (last.replace(s) != Some(s)).then_some(s)
     })
 }
+
+/// How far (relative to the largest predicted gap) a row left out of an active-set
+/// guess may end up penetrating for the guess to stand: Clarabel's own tolerance.
+const GUESS_GAP_TOLERANCE: f64 = 1e-9;
 
 /// Multipliers below this fraction of the largest count as inactive.
 const ACTIVE_FRACTION: f64 = 1e-6;
@@ -85,6 +90,10 @@ pub struct ContactStats {
     pub qp_s: f64,
     /// Detection, s.
     pub detect_s: f64,
+    /// QPs whose `W` came from the kept compliance of the contact dofs.
+    pub compliant: usize,
+    /// QPs solved by the previous active set (its KKT conditions held).
+    pub guessed: usize,
 }
 
 /// The constrained correction for the contact pairs of a model.
@@ -119,6 +128,20 @@ pub struct ContactCorrection<'m> {
     w: Vec<f64>,
     c: Vec<f64>,
     lambda_rows: Vec<f64>,
+    needed: Vec<usize>,
+    push: Vec<f64>,
+    /// The step's lead `h v` on the free dofs and on all dofs, and `u + h v`.
+    lead: Vec<f64>,
+    lead_all: Vec<f64>,
+    x_lead: Vec<f64>,
+    /// The gap of each candidate at the iterate (shifted back by the lead).
+    gaps: Vec<f64>,
+    guess: Vec<usize>,
+    guess_work: Vec<f64>,
+    moved: Vec<(Key, f64)>,
+    /// The compliance of the contact dofs, and the factorisation of the last QP.
+    compliance: Compliance,
+    qp_generation: usize,
     dual: DualQp,
     stats: ContactStats,
 }
@@ -174,6 +197,17 @@ impl<'m> ContactCorrection<'m> {
             w: Vec::new(),
             c: Vec::new(),
             lambda_rows: Vec::new(),
+            needed: Vec::new(),
+            push: Vec::new(),
+            lead: Vec::new(),
+            lead_all: Vec::new(),
+            x_lead: Vec::new(),
+            gaps: Vec::new(),
+            guess: Vec::new(),
+            guess_work: Vec::new(),
+            moved: Vec::new(),
+            compliance: Compliance::default(),
+            qp_generation: usize::MAX,
             dual: DualQp::default(),
             stats: ContactStats::default(),
         }
@@ -181,7 +215,21 @@ impl<'m> ContactCorrection<'m> {
 
     /// Starts a step from the contact state of the last one: its multipliers are the
     /// first guess of the forces, its active set the reference of the first QP.
-    pub fn begin_step(&mut self, committed: &ContactState) {
+    pub fn begin_step(&mut self, committed: &ContactState, lead: Option<(f64, &[f64])>) {
+        // The displacement h v the step is expected to make, by which the first
+        // correction is linearised ahead (zero on the constrained dofs).
+        self.lead.clear();
+        self.lead_all.clear();
+        if let Some((h, v)) = lead {
+            self.lead_all.extend(v.iter().map(|x| h * x));
+            for (d, &e) in self.dofs.eq.iter().enumerate() {
+                if e == crate::system::CONSTRAINED {
+                    self.lead_all[d] = 0.0;
+                }
+            }
+            self.lead
+                .extend(self.dofs.free.iter().map(|&d| self.lead_all[d]));
+        }
         self.lambda = committed.active.iter().copied().collect();
         let values: Vec<f64> = committed.active.iter().map(|(_, l)| *l).collect();
         let threshold = self.active_threshold(&values);
@@ -270,6 +318,39 @@ impl<'m> ContactCorrection<'m> {
 impl Correction for ContactCorrection<'_> {
     fn constrain(&mut self, u: &[f64], r: &mut [f64]) -> ConstraintStatus {
         self.detect_at(u);
+        // A multiplier whose row is no candidate any more (its slave left a notch,
+        // or moved on to the next segment) passes to the slave's row that remains:
+        // a node's force does not vanish because its linearisation changed. With no
+        // row left for the slave (it left the master), it is dropped, and that is
+        // an active-set change.
+        let mut dropped = false;
+        self.moved.clear();
+        let cands = &self.cands;
+        let found = |k: &Key| cands.binary_search_by_key(k, Candidate::key).is_ok();
+        let moved = &mut self.moved;
+        self.lambda.retain(|k, l| {
+            let keep = found(k);
+            if !keep {
+                moved.push((*k, *l));
+            }
+            keep
+        });
+        for &(k, l) in &self.moved {
+            let slave = (k.0, k.1, k.2);
+            let at = self.cands.partition_point(|c| c.slave_key() < slave);
+            match self.cands.get(at).filter(|c| c.slave_key() == slave) {
+                Some(c) => {
+                    *self.lambda.entry(c.key()).or_insert(0.0) += l;
+                    if let Ok(p) = self.current.binary_search(&k) {
+                        self.current.remove(p);
+                        if let Err(q) = self.current.binary_search(&c.key()) {
+                            self.current.insert(q, c.key());
+                        }
+                    }
+                }
+                None => dropped = true,
+            }
+        }
         self.forces();
         for (ri, f) in r.iter_mut().zip(&self.f_c) {
             *ri -= f;
@@ -279,21 +360,14 @@ impl Correction for ContactCorrection<'_> {
         let mut open_under_force: f64 = 0.0;
         for c in &self.cands {
             penetration = penetration.max(-c.gap);
-            if self.current.contains(&c.key()) {
+            if self.current.binary_search(&c.key()).is_ok() {
                 open_under_force = open_under_force.max(c.gap);
             }
         }
-        // A multiplier whose constraint is no candidate any more pushes nothing: it
-        // is dropped, and that is an active-set change.
-        let before = self.lambda.len();
-        let cands = &self.cands;
-        self.lambda
-            .retain(|k, _| cands.iter().any(|c| c.key() == *k));
         ConstraintStatus {
             penetration,
             complementarity: open_under_force,
-            active_set_changed: !slaves(&self.previous).eq(slaves(&self.current))
-                || self.lambda.len() != before,
+            active_set_changed: !slaves(&self.previous).eq(slaves(&self.current)) || dropped,
         }
     }
 
@@ -305,9 +379,20 @@ impl Correction for ContactCorrection<'_> {
     ) -> Result<Corrected> {
         if !self.added {
             // A predicted start: no evaluation, no forces in the right-hand side yet.
-            self.detect_at(u);
+            // Linearised about the predicted geometry u + h v (theory/contact.md).
+            if self.lead.is_empty() {
+                self.detect_at(u);
+            } else {
+                self.x_lead.clear();
+                self.x_lead
+                    .extend(u.iter().zip(&self.lead_all).map(|(a, b)| a + b));
+                let x_lead = std::mem::take(&mut self.x_lead);
+                self.detect_at(&x_lead);
+                self.x_lead = x_lead;
+            }
             self.f_c.fill(0.0);
         }
+        let leading = !self.added && !self.lead.is_empty();
         self.added = false;
         let (free, eq) = (&self.dofs.free, &self.dofs.eq);
         debug_assert_eq!(free.len(), sys.dofs().n_free());
@@ -315,7 +400,6 @@ impl Correction for ContactCorrection<'_> {
         self.delta0.clear();
         self.delta0
             .extend(free.iter().zip(rhs.iter()).map(|(&d, &b)| b - self.f_c[d]));
-        let minus_r = self.delta0.clone();
         sys.solve(&mut self.delta0)?;
         // G over the free dofs (nalgebra-sparse CSR). The rows: predicted to close, or
         // active before; rows the free dofs cannot move are left out (nothing can
@@ -323,18 +407,27 @@ impl Correction for ContactCorrection<'_> {
         let g = super::detect::gap_matrix(&self.cands, eq, free.len());
         self.rows.clear();
         self.c.clear();
+        self.gaps.clear();
         for (i, c) in self.cands.iter().enumerate() {
             let row = g.row(i);
+            let dot = |x: &[f64]| {
+                row.col_indices()
+                    .iter()
+                    .zip(row.values())
+                    .map(|(&e, v)| v * x[e])
+                    .sum::<f64>()
+            };
+            // The gap at u: at u + hv less its linearised change over hv.
+            let gap = if leading {
+                c.gap - dot(&self.lead)
+            } else {
+                c.gap
+            };
+            self.gaps.push(gap);
             if row.nnz() == 0 {
                 continue;
             }
-            let predicted = c.gap
-                + row
-                    .col_indices()
-                    .iter()
-                    .zip(row.values())
-                    .map(|(&e, v)| v * self.delta0[e])
-                    .sum::<f64>();
+            let predicted = gap + dot(&self.delta0);
             if predicted < self.tol || self.current.contains(&c.key()) {
                 self.rows.push(i);
                 self.c.push(predicted);
@@ -353,39 +446,107 @@ impl Correction for ContactCorrection<'_> {
         let status = match self.qp {
             ContactQp::Condensed => {
                 let t = Instant::now();
-                self.y.clear();
-                self.y.resize(nf * m, 0.0);
-                for (j, &i) in self.rows.iter().enumerate() {
-                    let row = g.row(i);
-                    for (&e, v) in row.col_indices().iter().zip(row.values()) {
-                        self.y[j * nf + e] += v;
+                // S pays once the factor has outlived a QP (theory/contact.md).
+                let generation = sys.factorizations();
+                let compliant = self.compliance.is_current(sys) || self.qp_generation == generation;
+                self.qp_generation = generation;
+                if compliant {
+                    self.needed.clear();
+                    for &i in &self.rows {
+                        self.needed.extend_from_slice(g.row(i).col_indices());
                     }
-                }
-                sys.solve_block(&mut self.y, m)?;
-                self.w.clear();
-                self.w.resize(m * m, 0.0);
-                for j in 0..m {
-                    let yj = &self.y[j * nf..(j + 1) * nf];
-                    for (k, &i) in self.rows.iter().enumerate() {
+                    self.compliance.cover(sys, &self.needed)?;
+                    self.stats.compliant += 1;
+                    self.w.clear();
+                    self.w.resize(m * m, 0.0);
+                    for (j, &ij) in self.rows.iter().enumerate() {
+                        let rj = g.row(ij);
+                        for (k, &ik) in self.rows.iter().enumerate().skip(j) {
+                            let rk = g.row(ik);
+                            let mut w = 0.0;
+                            for (&e, v) in rk.col_indices().iter().zip(rk.values()) {
+                                for (&f, u) in rj.col_indices().iter().zip(rj.values()) {
+                                    w += v * u * self.compliance.at(e, f);
+                                }
+                            }
+                            self.w[k + j * m] = w;
+                            self.w[j + k * m] = w;
+                        }
+                    }
+                } else {
+                    self.y.clear();
+                    self.y.resize(nf * m, 0.0);
+                    for (j, &i) in self.rows.iter().enumerate() {
                         let row = g.row(i);
-                        self.w[k + j * m] = row
-                            .col_indices()
-                            .iter()
-                            .zip(row.values())
-                            .map(|(&e, v)| v * yj[e])
-                            .sum();
+                        for (&e, v) in row.col_indices().iter().zip(row.values()) {
+                            self.y[j * nf + e] += v;
+                        }
+                    }
+                    sys.solve_block(&mut self.y, m)?;
+                    self.w.clear();
+                    self.w.resize(m * m, 0.0);
+                    for j in 0..m {
+                        let yj = &self.y[j * nf..(j + 1) * nf];
+                        for (k, &i) in self.rows.iter().enumerate() {
+                            let row = g.row(i);
+                            self.w[k + j * m] = row
+                                .col_indices()
+                                .iter()
+                                .zip(row.values())
+                                .map(|(&e, v)| v * yj[e])
+                                .sum();
+                        }
                     }
                 }
                 self.stats.w_s += t.elapsed().as_secs_f64();
                 let t = Instant::now();
-                let r = self.dual.solve(&self.w, &self.c, &mut self.lambda_rows);
+                // The previous active set first: accepted only if it satisfies the
+                // KKT conditions, so the QP's solution either way.
+                self.guess.clear();
+                for (j, &i) in self.rows.iter().enumerate() {
+                    if self.previous.binary_search(&self.cands[i].key()).is_ok() {
+                        self.guess.push(j);
+                    }
+                }
+                let gap_tol =
+                    GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                let r = if !self.guess.is_empty()
+                    && solve_by_active_set(
+                        &self.w,
+                        &self.c,
+                        &mut self.guess,
+                        gap_tol,
+                        &mut self.lambda_rows,
+                        &mut self.guess_work,
+                    ) {
+                    self.stats.guessed += 1;
+                    Ok(QpStats::default())
+                } else {
+                    self.dual.solve(&self.w, &self.c, &mut self.lambda_rows)
+                };
                 self.stats.qp_s += t.elapsed().as_secs_f64();
                 if r.is_ok() {
-                    for (j, &l) in self.lambda_rows.iter().enumerate() {
-                        if l != 0.0 {
-                            let yj = &self.y[j * nf..(j + 1) * nf];
-                            for (d, y) in self.delta0.iter_mut().zip(yj) {
-                                *d += l * y;
+                    if compliant {
+                        // δ = δ₀ + A⁻¹Gᵀλ: one solve.
+                        self.push.clear();
+                        self.push.resize(nf, 0.0);
+                        for (j, &i) in self.rows.iter().enumerate() {
+                            let row = g.row(i);
+                            for (&e, v) in row.col_indices().iter().zip(row.values()) {
+                                self.push[e] += self.lambda_rows[j] * v;
+                            }
+                        }
+                        sys.solve(&mut self.push)?;
+                        for (d, p) in self.delta0.iter_mut().zip(&self.push) {
+                            *d += p;
+                        }
+                    } else {
+                        for (j, &l) in self.lambda_rows.iter().enumerate() {
+                            if l != 0.0 {
+                                let yj = &self.y[j * nf..(j + 1) * nf];
+                                for (d, y) in self.delta0.iter_mut().zip(yj) {
+                                    *d += l * y;
+                                }
                             }
                         }
                     }
@@ -394,8 +555,12 @@ impl Correction for ContactCorrection<'_> {
             }
             ContactQp::Full => {
                 let t = Instant::now();
-                let r_free: Vec<f64> = minus_r.iter().map(|x| -x).collect();
-                let gaps: Vec<f64> = self.rows.iter().map(|&i| self.cands[i].gap).collect();
+                let r_free: Vec<f64> = free
+                    .iter()
+                    .zip(rhs.iter())
+                    .map(|(&d, &b)| self.f_c[d] - b)
+                    .collect();
+                let gaps: Vec<f64> = self.rows.iter().map(|&i| self.gaps[i]).collect();
                 let row_entries: Vec<Vec<(usize, f64)>> = self
                     .rows
                     .iter()

@@ -11,6 +11,7 @@
 //! The theory (the QP and its KKT conditions, the condensed dual, the
 //! re-linearisation, the energy of an implicit impact) is in `theory/contact.md`.
 
+mod compliance;
 pub mod detect;
 pub mod implicit;
 mod qp;

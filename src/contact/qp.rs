@@ -67,6 +67,138 @@ pub(crate) struct QpStats {
     pub solve_s: f64,
 }
 
+/// Rounds of changes to the active set [`solve_by_active_set`] tries before it gives
+/// up.
+const MAX_SWAPS: usize = 8;
+
+/// Solves the dual QP by a primal active-set method started from the guess `active`
+/// (sorted row indices, the previous QP's active set): on the current set,
+/// `W_AA λ_A = −c_A` by a dense Cholesky factorisation and `λ = 0` elsewhere; the
+/// rows of negative multipliers leave the set, else the penetrating rows join it, for
+/// up to [`MAX_SWAPS`] rounds. Returns whether the result satisfies the QP's KKT conditions
+/// (`λ ≥ 0`, and every row's gap `c + Wλ` nonnegative to `gap_tol`): then it is the
+/// QP's solution, and `lambda` holds it. `active` ends as the set tried last.
+pub(crate) fn solve_by_active_set(
+    w: &[f64],
+    c: &[f64],
+    active: &mut Vec<usize>,
+    gap_tol: f64,
+    lambda: &mut Vec<f64>,
+    work: &mut Vec<f64>,
+) -> bool {
+    let m = c.len();
+    for _ in 0..=MAX_SWAPS {
+        if !on_active_set(w, c, active, lambda, work) {
+            return false;
+        }
+        // The negative multipliers leave.
+        let before = active.len();
+        active.retain(|&a| lambda[a] >= 0.0);
+        if active.len() < before {
+            continue;
+        }
+        // Else the penetrating rows join.
+        let mut joined = false;
+        let mut stuck = false;
+        for r in 0..m {
+            let gap = c[r]
+                + active
+                    .iter()
+                    .map(|&a| w[r + a * m] * lambda[a])
+                    .sum::<f64>();
+            if gap < -gap_tol {
+                match active.binary_search(&r) {
+                    Err(p) => {
+                        active.insert(p, r);
+                        joined = true;
+                    }
+                    // A row of the set penetrates: it was dropped as dependent.
+                    Ok(_) => stuck = true,
+                }
+            }
+        }
+        if !joined {
+            return !stuck;
+        }
+    }
+    false
+}
+
+/// `W_AA λ_A = −c_A` by a dense Cholesky factorisation into `lambda` (zero off the
+/// set). A row that depends on those before it (a pivot below 1e-13 of its
+/// diagonal: two rows of one slave in an all but flat notch) is dropped, its
+/// multiplier left zero. False when `W_AA` has a non-positive diagonal.
+fn on_active_set(
+    w: &[f64],
+    c: &[f64],
+    active: &[usize],
+    lambda: &mut Vec<f64>,
+    work: &mut Vec<f64>,
+) -> bool {
+    let m = c.len();
+    let k = active.len();
+    lambda.clear();
+    lambda.resize(m, 0.0);
+    work.clear();
+    work.resize(k * k + k, 0.0);
+    let (l, x) = work.split_at_mut(k * k);
+    for (j, &aj) in active.iter().enumerate() {
+        for (i, &ai) in active.iter().enumerate().skip(j) {
+            l[i + j * k] = w[ai + aj * m];
+        }
+    }
+    for j in 0..k {
+        let diag = l[j + j * k];
+        let mut d = diag;
+        for p in 0..j {
+            d -= l[j + p * k] * l[j + p * k];
+        }
+        if !d.is_finite() || !(diag > 0.0) {
+            return false;
+        }
+        if d <= 1e-13 * diag {
+            for i in j..k {
+                l[i + j * k] = 0.0;
+            }
+            continue;
+        }
+        let d = d.sqrt();
+        l[j + j * k] = d;
+        for i in j + 1..k {
+            let mut v = l[i + j * k];
+            for p in 0..j {
+                v -= l[i + p * k] * l[j + p * k];
+            }
+            l[i + j * k] = v / d;
+        }
+    }
+    for (i, &ai) in active.iter().enumerate() {
+        if l[i + i * k] == 0.0 {
+            x[i] = 0.0;
+            continue;
+        }
+        let mut v = -c[ai];
+        for p in 0..i {
+            v -= l[i + p * k] * x[p];
+        }
+        x[i] = v / l[i + i * k];
+    }
+    for i in (0..k).rev() {
+        if l[i + i * k] == 0.0 {
+            continue;
+        }
+        let mut v = x[i];
+        for p in i + 1..k {
+            v -= l[p + i * k] * x[p];
+        }
+        x[i] = v / l[i + i * k];
+    }
+    for (i, &ai) in active.iter().enumerate() {
+        lambda[ai] = x[i];
+    }
+    true
+}
+
 /// The condensed dual QP with a solver kept between solves of the same size.
 #[derive(Default)]
 pub(crate) struct DualQp {
@@ -245,6 +377,42 @@ mod tests {
         // No gap closes: no force, no QP.
         qp.solve(&w, &[1e-6, 2e-6], &mut l).unwrap();
         assert_eq!(l, vec![0.0, 0.0]);
+    }
+
+    #[test]
+    fn the_active_set_method_finds_the_solution_from_any_guess() {
+        let s = 1e-10;
+        let w = [2.0 * s, 1.0 * s, 1.0 * s, 2.0 * s];
+        let c = [-3e-6, 1e-6];
+        let (mut l, mut work) = (Vec::new(), Vec::new());
+        // From every guess: only the first row is active, λ₁ = 1.5e4.
+        for guess in [vec![0], vec![0, 1], vec![], vec![1]] {
+            let mut active = guess.clone();
+            assert!(
+                solve_by_active_set(&w, &c, &mut active, 1e-15, &mut l, &mut work),
+                "from {guess:?}"
+            );
+            assert_eq!(active, vec![0], "from {guess:?}");
+            assert!((l[0] - 1.5e4).abs() < 1e-9 * 1.5e4 && l[1] == 0.0, "{l:?}");
+        }
+        // Clarabel agrees.
+        let mut qp = DualQp::default();
+        let mut lc = Vec::new();
+        qp.solve(&w, &c, &mut lc).unwrap();
+        assert!((lc[0] - l[0]).abs() < 1e-6 * l[0]);
+        // Two identical rows (a flat notch): one carries the force, the KKT test
+        // holds for the other.
+        let w2 = [s, s, s, s];
+        let mut active = vec![0, 1];
+        assert!(solve_by_active_set(
+            &w2,
+            &[-1e-6, -1e-6],
+            &mut active,
+            1e-15,
+            &mut l,
+            &mut work
+        ));
+        assert!((l[0] + l[1] - 1e4).abs() < 1e-9 * 1e4, "{l:?}");
     }
 
     #[test]

@@ -83,6 +83,8 @@ pub struct SystemTiming {
     pub factorization_s: f64,
     /// Triangular solves.
     pub solve_s: f64,
+    /// Right-hand sides solved (a block of `k` counts `k`).
+    pub solves: usize,
 }
 
 /// What a numeric factorisation gave.
@@ -170,6 +172,7 @@ impl EffectiveSystem {
         let t = Instant::now();
         let r = self.solver.solve_in_place(rhs);
         self.timing.solve_s += t.elapsed().as_secs_f64();
+        self.timing.solves += 1;
         r
     }
 
@@ -179,6 +182,7 @@ impl EffectiveSystem {
         let t = Instant::now();
         let r = self.solver.solve_block_in_place(rhs, ncols);
         self.timing.solve_s += t.elapsed().as_secs_f64();
+        self.timing.solves += ncols;
         r
     }
 

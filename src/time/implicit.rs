@@ -686,9 +686,9 @@ pub(crate) enum Corrector<'m> {
 }
 
 impl Corrector<'_> {
-    fn begin_step(&mut self, s: &State) {
+    fn begin_step(&mut self, s: &State, h: Option<f64>) {
         if let Corrector::Contact(c) = self {
-            c.begin_step(&s.contact);
+            c.begin_step(&s.contact, h.map(|h| (h, s.v.as_slice())));
         }
     }
 
@@ -733,7 +733,7 @@ pub(crate) fn step(
     correction: &mut Corrector,
     s: &mut State,
 ) -> Result<StepOutcome> {
-    correction.begin_step(s);
+    correction.begin_step(s, ops.dynamic().map(|(h, _, _)| h));
     let h = ops.h();
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
@@ -1030,8 +1030,14 @@ pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, Effec
         Response::StateDependent(_) => {
             let stores = new_stores(&model.mesh, &model.materials);
             let u0 = vec![0.0; model.mesh.n_dofs()];
-            ops.asm
-                .tangent(&model.mesh, &model.materials, model.plane, &u0, ops.h(), &stores)
+            ops.asm.tangent(
+                &model.mesh,
+                &model.materials,
+                model.plane,
+                &u0,
+                ops.h(),
+                &stores,
+            )
         }
         _ => ops.kt.clone(),
     };

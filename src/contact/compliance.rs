@@ -1,0 +1,103 @@
+//! The compliance of the contact dofs, `S = (A⁻¹)_DD`, kept while the factor of `A`
+//! does not change.
+//!
+//! The condensed QP needs `W = G A⁻¹ Gᵀ`. Its rows touch only the dofs `D` of the
+//! slave nodes and of the master segments they face, so `W = G_D S G_Dᵀ` with `S` the
+//! block of `A⁻¹` on `D`. While the factor stays (a linear material at a fixed step:
+//! the matrix is factorised once for the whole run), `S` is worth keeping: a QP then
+//! costs the products with `S` and one solve for the correction `A⁻¹Gᵀλ`, instead of
+//! `m` solves for `Y = A⁻¹Gᵀ`. New dofs (a slave sliding onto a new segment) add
+//! their columns (one blocked solve for all of them); a new factor clears it.
+
+use crate::error::Result;
+use crate::system::EffectiveSystem;
+
+/// Marks a free equation that is no contact dof yet.
+const NONE: usize = usize::MAX;
+
+/// `S = (A⁻¹)_DD` for the contact dofs met so far.
+#[derive(Default)]
+pub(crate) struct Compliance {
+    /// The factorisation `S` belongs to (`EffectiveSystem::factorizations`).
+    generation: usize,
+    /// The free equations in `D`, in the order of `S`'s rows and columns.
+    eqs: Vec<usize>,
+    /// Position of each free equation in `eqs` (`NONE` when not in `D`).
+    slot: Vec<usize>,
+    /// `S`, column-major `k x k`, `k = eqs.len()`.
+    s: Vec<f64>,
+    // Workspace: new equations and their columns of `A⁻¹`.
+    fresh: Vec<usize>,
+    cols: Vec<f64>,
+}
+
+impl Compliance {
+    /// Whether `S` belongs to the current factor of `sys`.
+    pub fn is_current(&self, sys: &EffectiveSystem) -> bool {
+        !self.eqs.is_empty() && self.generation == sys.factorizations()
+    }
+
+    /// Makes `S` hold every free equation of `needed` for the current factor of `sys`
+    /// (clearing it first when the factor changed).
+    pub fn cover(&mut self, sys: &mut EffectiveSystem, needed: &[usize]) -> Result<()> {
+        let n = sys.dofs().n_free();
+        if self.generation != sys.factorizations() || self.slot.len() != n {
+            self.generation = sys.factorizations();
+            self.eqs.clear();
+            self.s.clear();
+            self.slot.clear();
+            self.slot.resize(n, NONE);
+        }
+        self.fresh.clear();
+        for &e in needed {
+            if self.slot[e] == NONE {
+                self.slot[e] = self.eqs.len() + self.fresh.len();
+                self.fresh.push(e);
+            }
+        }
+        let f = self.fresh.len();
+        if f == 0 {
+            return Ok(());
+        }
+        // The new columns of A⁻¹ in one blocked solve.
+        self.cols.clear();
+        self.cols.resize(n * f, 0.0);
+        for (j, &e) in self.fresh.iter().enumerate() {
+            self.cols[j * n + e] = 1.0;
+        }
+        sys.solve_block(&mut self.cols, f)?;
+        // Grow S from k x k to (k + f) x (k + f): the old block stays, the new rows
+        // and columns come from the new columns of A⁻¹ (A⁻¹ is symmetric).
+        let k = self.eqs.len();
+        let k2 = k + f;
+        let mut s = vec![0.0; k2 * k2];
+        for j in 0..k {
+            s[j * k2..j * k2 + k].copy_from_slice(&self.s[j * k..(j + 1) * k]);
+        }
+        self.eqs.extend_from_slice(&self.fresh);
+        for jn in 0..f {
+            let col = &self.cols[jn * n..(jn + 1) * n];
+            let j = k + jn;
+            for (i, &e) in self.eqs.iter().enumerate() {
+                s[i + j * k2] = col[e];
+                s[j + i * k2] = col[e];
+            }
+        }
+        // The new-new block from the columns themselves (symmetrised).
+        for jn in 0..f {
+            for i_n in 0..f {
+                let v = 0.5
+                    * (self.cols[jn * n + self.fresh[i_n]] + self.cols[i_n * n + self.fresh[jn]]);
+                s[(k + i_n) + (k + jn) * k2] = v;
+            }
+        }
+        self.s = s;
+        Ok(())
+    }
+
+    /// `S` at the free equations `a`, `b` (both covered).
+    pub fn at(&self, a: usize, b: usize) -> f64 {
+        let k = self.eqs.len();
+        self.s[self.slot[a] + self.slot[b] * k]
+    }
+}
