@@ -329,8 +329,16 @@ impl Model {
     /// Where dof `d` sits, for messages: node, coordinates, body, one element
     /// holding it, component.
     pub fn describe_dof(&self, d: usize) -> String {
+        format!(
+            "{}, component {}",
+            self.describe_node(d / 2),
+            if d % 2 == 0 { "x" } else { "y" }
+        )
+    }
+
+    /// Where node `n` sits, for messages: coordinates, body, one element holding it.
+    pub fn describe_node(&self, n: usize) -> String {
         let mesh = &self.mesh;
-        let n = d / 2;
         let body = &self.bodies[mesh.node_body[n]].name;
         let element = mesh.blocks.iter().enumerate().find_map(|(bi, b)| {
             (0..b.elements.len())
@@ -338,11 +346,10 @@ impl Model {
                 .map(|e| format!("block {bi} element {e}"))
         });
         format!(
-            "node {n} at ({:.4}, {:.4}) of body `{body}`, {}, component {}",
+            "node {n} at ({:.4}, {:.4}) of body `{body}`, {}",
             mesh.coords[n][0],
             mesh.coords[n][1],
             element.unwrap_or_else(|| "no element".into()),
-            if d % 2 == 0 { "x" } else { "y" }
         )
     }
 

@@ -10,6 +10,14 @@ use rothe::model::{ContactQp, Model};
 use rothe::time::backward_euler::BackwardEuler;
 use rothe::time::{Integrator, State};
 
+/// The text of `examples/contact/NAME`.
+fn example(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/contact")
+        .join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 fn model(text: &str) -> Model {
     rothe::config::from_str(text, Path::new(".")).unwrap()
 }
@@ -32,40 +40,8 @@ fn a_block_resting_on_a_block_carries_its_weight() {
     // touching at t = 0, under gravity; mass damping (ζ = 2000 1/s) settles it. The
     // total contact force equals the weight ρ V g = 770.085 N to the solver's
     // tolerance, and no node penetrates beyond the contact tolerance.
-    let text = r#"
-[analysis]
-t_end = 5.0e-3
-dt = 1.0e-5
-gravity = [0.0, -9.81]
-zeta = 2000.0
-vtk_every = 0
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
-name = "base"
-material = "steel"
-thickness = 0.1
-mesh = { kind = "rectangle", size = [1.0, 0.2], divisions = [10, 2] }
-[[bodies]]
-name = "block"
-material = "steel"
-thickness = 0.1
-mesh = { kind = "rectangle", origin = [0.25, 0.2], size = [0.5, 0.2], divisions = [4, 2] }
-[[supports]]
-set = "base.bottom"
-fix = ["x", "y"]
-[[supports]]
-set = "block.left"
-fix = ["x"]
-[[contact]]
-name = "seat"
-slave = "block.bottom"
-master = "base.top"
-"#;
-    let m = model(text);
+    let text = example("block_resting.toml");
+    let m = model(&text);
     let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
     let mut s = be.initial_state();
     let tol = m.analysis.contact_tolerance;
@@ -90,36 +66,22 @@ master = "base.top"
     );
 }
 
+/// The bar impact example at step `h` with the QP form `qp`.
 fn bars(h: f64, qp: &str) -> String {
-    format!(
-        r#"
-[analysis]
-t_end = 6.0e-4
-dt = {h:e}
-vtk_every = 0
-contact_qp = "{qp}"
-[materials.steel]
-model = "elastic"
-E = 200e9
-nu = 0.0
-rho = 8000.0
-[[bodies]]
-name = "striker"
-material = "steel"
-thickness = 0.1
-velocity = [1.0, 0.0]
-mesh = {{ kind = "rectangle", origin = [-1.0, 0.0], size = [1.0, 0.05], divisions = [100, 1] }}
-[[bodies]]
-name = "target"
-material = "steel"
-thickness = 0.1
-mesh = {{ kind = "rectangle", origin = [0.0, 0.0], size = [1.0, 0.05], divisions = [100, 1] }}
-[[contact]]
-name = "impact"
-slave = "striker.right"
-master = "target.left"
-"#
-    )
+    let text = example("bars_impact.toml");
+    let with = text
+        .replace("dt = 1.0e-6", &format!("dt = {h:e}"))
+        .replace(
+            "contact_qp = \"condensed\"",
+            &format!("contact_qp = \"{qp}\""),
+        )
+        .replace("vtk_every = 20", "vtk_every = 0");
+    assert_eq!(
+        with.matches(&format!("dt = {h:e}")).count(),
+        1,
+        "the example's step changed"
+    );
+    with
 }
 
 /// Contact duration, plateau force, final striker and target velocities, and the
@@ -244,36 +206,8 @@ fn a_beam_dropped_on_unilateral_supports_bounces_off_them() {
     // 0.23 m long at its ends (benchmark 2's supports): the supports push while the
     // beam presses on them (never pull: the force is never negative), then the beam
     // lifts off, moving up, and the force is zero again.
-    let text = r#"
-[analysis]
-t_end = 3.0e-3
-dt = 1.0e-5
-gravity = [0.0, -9.81]
-vtk_every = 0
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
-name = "beam"
-material = "steel"
-thickness = 0.2
-velocity = [0.0, -1.0]
-mesh = { kind = "rectangle", size = [1.7, 0.25], divisions = [34, 5] }
-[[contact]]
-name = "left"
-slave = "beam.bottom"
-rigid_line = [[0.0, 0.0], [0.23, 0.0]]
-[[contact]]
-name = "right"
-slave = "beam.bottom"
-rigid_line = [[1.47, 0.0], [1.7, 0.0]]
-[[supports]]
-set = "beam.bottom_left"
-fix = ["x"]
-"#;
-    let m = model(text);
+    let text = example("beam_on_supports.toml");
+    let m = model(&text);
     let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
     let mass = be.mass().row_sums(&be.assembler().pattern);
     let mut s = be.initial_state();
@@ -487,4 +421,155 @@ fn contact_pairs_are_validated() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("self-contact"), "{e}");
+}
+
+#[test]
+fn an_infeasible_contact_qp_cuts_the_step_then_stops_naming_the_pair_and_status() {
+    // A block whose bottom nodes may not move vertically sits a millimetre below the
+    // apex of a V of two rigid lines: its middle bottom node penetrates both, and
+    // moving sideways cannot free it from both (the QP is infeasible). Every step
+    // cut fails the same way; the run stops naming the step, the pair, Clarabel's
+    // status and the worst gap, and keeps what it wrote.
+    let text = r#"
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-5
+vtk_every = 1
+max_cuts = 3
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "block"
+material = "steel"
+thickness = 0.1
+mesh = { kind = "rectangle", origin = [-0.05, -0.001], size = [0.1, 0.1], divisions = [2, 2] }
+[[supports]]
+set = "block.bottom"
+fix = ["y"]
+[[contact]]
+name = "vee_left"
+slave = "block.bottom"
+rigid_line = [[-1.0, 1.0], [0.0, 0.0]]
+[[contact]]
+name = "vee_right"
+slave = "block.bottom"
+rigid_line = [[0.0, 0.0], [1.0, 1.0]]
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let sc = dir.path().join("vee.toml");
+    std::fs::write(&sc, text).unwrap();
+    let out = dir.path().join("out");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_rothe"))
+        .args(["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success(), "the run went through: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    for word in [
+        "step 1",
+        "3 step cuts",
+        "vee_left",
+        "vee_right",
+        "Clarabel status",
+        "worst gap",
+    ] {
+        assert!(err.contains(word), "`{word}` not in: {err}");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "failed");
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    assert!(
+        history.lines().count() >= 2,
+        "the initial state is kept: {history}"
+    );
+    assert!(out.join("vtk").read_dir().unwrap().count() >= 1);
+}
+
+#[test]
+fn check_writes_the_matrices_and_the_gap_rows_in_matrix_market() {
+    use nalgebra_sparse::io::load_coo_from_matrix_market_file;
+    use nalgebra_sparse::CsrMatrix;
+    let dir = tempfile::tempdir().unwrap();
+    let sc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/contact/two_blocks.toml");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_rothe"))
+        .args([
+            "check",
+            sc.to_str().unwrap(),
+            "--matrices",
+            dir.path().to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let load = |name: &str| -> CsrMatrix<f64> {
+        CsrMatrix::from(&load_coo_from_matrix_market_file::<f64, _>(dir.path().join(name)).unwrap())
+    };
+    let (k, mass, k_eff, g) = (
+        load("K.mtx"),
+        load("M.mtx"),
+        load("K_eff.mtx"),
+        load("G.mtx"),
+    );
+    let m = model(&std::fs::read_to_string(&sc).unwrap());
+    let n = m.mesh.n_dofs();
+    assert_eq!((k.nrows(), k.ncols(), mass.nrows()), (n, n, n));
+    let dense = |a: &CsrMatrix<f64>| {
+        let mut d = vec![0.0; a.nrows() * a.ncols()];
+        for (i, j, v) in a.triplet_iter() {
+            d[i * a.ncols() + j] += v;
+        }
+        d
+    };
+    let (kd, md, ed) = (dense(&k), dense(&mass), dense(&k_eff));
+    // K and M symmetric.
+    let kmax = kd.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    for i in 0..n {
+        for j in 0..i {
+            assert!((kd[i * n + j] - kd[j * n + i]).abs() <= 1e-12 * kmax);
+            assert!((md[i * n + j] - md[j * n + i]).abs() <= 1e-12 * md[i * n + i].abs().max(1.0));
+        }
+    }
+    // The effective matrix of backward Euler on the free dofs: M/h² + K.
+    let free: Vec<usize> = std::fs::read_to_string(dir.path().join("free_dofs.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
+    let nf = free.len();
+    assert_eq!((k_eff.nrows(), nf), (n - m.constraints.len(), nf));
+    let h = m.analysis.dt;
+    for (a, &i) in free.iter().enumerate() {
+        for (b, &j) in free.iter().enumerate() {
+            let want = md[i * n + j] / (h * h) + kd[i * n + j];
+            assert!((ed[a * nf + b] - want).abs() <= 1e-12 * want.abs().max(kmax));
+        }
+    }
+    // G: one row per slave node of the steel block's bottom at the initial geometry,
+    // +n on the slave and −n split over the master segment's nodes: each row's x and
+    // y parts sum to zero (action and reaction), its normal is unit and vertical.
+    assert_eq!((g.nrows(), g.ncols()), (13, n));
+    for row in g.row_iter() {
+        let (mut sx, mut sy, mut slave) = (0.0, 0.0, None);
+        for (&d, &v) in row.col_indices().iter().zip(row.values()) {
+            if d % 2 == 0 {
+                sx += v
+            } else {
+                sy += v
+            }
+            if v == 1.0 && d % 2 == 1 {
+                slave = Some(d / 2);
+            }
+        }
+        assert!(sx.abs() < 1e-15 && sy.abs() < 1e-15, "{row:?}");
+        assert_eq!(m.mesh.node_body[slave.expect("a slave entry +1 in y")], 1);
+    }
 }

@@ -600,7 +600,7 @@ impl Correction for ContactCorrection<'_> {
                     format!(
                         "; worst gap {:.3e} m at {} of pair `{}`",
                         c.gap,
-                        self.model.describe_dof(2 * c.slave),
+                        self.model.describe_node(c.slave),
                         self.pairs[c.pair].name
                     )
                 })

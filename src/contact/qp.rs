@@ -153,7 +153,7 @@ fn on_active_set(
         for p in 0..j {
             d -= l[j + p * k] * l[j + p * k];
         }
-        if !d.is_finite() || !(diag > 0.0) {
+        if !d.is_finite() || diag.is_nan() || diag <= 0.0 {
             return false;
         }
         if d <= 1e-13 * diag {
