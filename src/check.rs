@@ -37,6 +37,11 @@ pub struct Report {
     pub vtk: (usize, u64),
     /// The explicit critical step, its block and element, and `h / Δt_crit`.
     pub cfl: Option<(f64, usize, usize, f64)>,
+    /// The stable step of central differences (element eigenvalue bound), its block
+    /// and element.
+    pub stable: Option<(f64, usize, usize)>,
+    /// The time scheme (for a dynamic analysis).
+    pub scheme: Option<crate::model::TimeScheme>,
     /// nnz of the effective matrix (lower) and of the factor.
     pub nnz: (usize, usize),
     /// Whether the ordering is nested dissection.
@@ -117,6 +122,8 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         history,
         vtk,
         cfl,
+        stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
+        scheme: (a.kind == crate::model::AnalysisKind::Dynamic).then_some(a.scheme),
         nnz: (system.matrix().row_idx.len(), nnz_l),
         nested_dissection: system.nested_dissection(),
         memory,
@@ -138,6 +145,17 @@ impl fmt::Display for Report {
         writeln!(f, "elements    {}", self.elements)?;
         writeln!(f, "dofs        {} ({} free)", self.dofs.0, self.dofs.1)?;
         let (steps, dt, t_end) = self.steps;
+        if let Some(scheme) = self.scheme {
+            writeln!(
+                f,
+                "scheme      {}",
+                match scheme {
+                    crate::model::TimeScheme::BackwardEuler => "backward Euler (implicit)",
+                    crate::model::TimeScheme::CentralDifference =>
+                        "central differences (explicit, lumped mass, kinematic contact)",
+                }
+            )?;
+        }
         writeln!(f, "steps       {steps} of h = {dt:e} s to T = {t_end:e} s")?;
         writeln!(
             f,
@@ -150,7 +168,14 @@ impl fmt::Display for Report {
         if let Some((dt_c, block, element, ratio)) = self.cfl {
             writeln!(
                 f,
-                "CFL step    {dt_c:.4e} s (explicit central differences; block {block}, element {element}); h / CFL = {ratio:.3}"
+                "CFL step    {dt_c:.4e} s (the paper's estimate L_e/c; block {block}, element {element}); h / CFL = {ratio:.3}"
+            )?;
+        }
+        if let Some((dt_s, block, element)) = self.stable {
+            writeln!(
+                f,
+                "stable step {dt_s:.4e} s (central differences, 2/ω_max of the elements; block {block}, element {element}); h / stable = {:.3}",
+                self.steps.1 / dt_s
             )?;
         }
         writeln!(

@@ -41,6 +41,10 @@ enum Command {
         /// Run even when the memory estimate exceeds the memory available.
         #[arg(long)]
         ignore_memory: bool,
+        /// Accept an explicit step above the critical (CFL) step, for stability
+        /// studies.
+        #[arg(long)]
+        allow_unstable: bool,
     },
     /// Drive one material point along a strain or stress path; writes material.csv.
     Material {
@@ -58,6 +62,9 @@ enum Command {
         /// Report even when the memory estimate exceeds the memory available.
         #[arg(long)]
         ignore_memory: bool,
+        /// Accept an explicit step above the critical (CFL) step.
+        #[arg(long)]
+        allow_unstable: bool,
         /// Also write K, M, the first step's effective matrix and the contact gap
         /// rows G in Matrix Market format into this directory.
         #[arg(long)]
@@ -65,12 +72,14 @@ enum Command {
     },
 }
 
-fn load_options(ignore_memory: bool) -> LoadOptions {
-    if ignore_memory {
+fn load_options(ignore_memory: bool, allow_unstable: bool) -> LoadOptions {
+    let mut opts = if ignore_memory {
         LoadOptions::unlimited()
     } else {
         LoadOptions::default()
-    }
+    };
+    opts.allow_unstable = allow_unstable;
+    opts
 }
 
 fn run_command(
@@ -79,8 +88,9 @@ fn run_command(
     backend: Backend,
     quiet: bool,
     ignore_memory: bool,
+    allow_unstable: bool,
 ) -> rothe::Result<()> {
-    let opts = load_options(ignore_memory);
+    let opts = load_options(ignore_memory, allow_unstable);
     let model = rothe::config::load_with(scenario, &opts)?;
     let summary = run(
         &model,
@@ -122,7 +132,8 @@ fn main() -> ExitCode {
             backend,
             quiet,
             ignore_memory,
-        } => run_command(&scenario, &out, backend, quiet, ignore_memory),
+            allow_unstable,
+        } => run_command(&scenario, &out, backend, quiet, ignore_memory, allow_unstable),
         Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out)
             .map(|steps| {
                 eprintln!(
@@ -133,9 +144,10 @@ fn main() -> ExitCode {
         Command::Check {
             scenario,
             ignore_memory,
+            allow_unstable,
             matrices,
         } => {
-            let opts = load_options(ignore_memory);
+            let opts = load_options(ignore_memory, allow_unstable);
             rothe::config::load_with(&scenario, &opts).and_then(|model| {
                 let report = rothe::check::report(&model, opts.memory_limit)?;
                 print!("{report}");

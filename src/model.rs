@@ -138,6 +138,18 @@ pub struct Body {
     pub thickness: f64,
 }
 
+/// The time scheme of a dynamic analysis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeScheme {
+    /// Backward Euler (the paper's Rothe scheme, eq. 9): implicit, contact as a QP.
+    #[default]
+    BackwardEuler,
+    /// Central differences with lumped mass and the paper's kinematic contact
+    /// method: explicit, the step bounded by the critical (CFL) step.
+    CentralDifference,
+}
+
 /// Static or dynamic analysis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
@@ -154,6 +166,10 @@ pub enum AnalysisKind {
 pub struct Analysis {
     /// Static or dynamic.
     pub kind: AnalysisKind,
+    /// The dynamic scheme.
+    pub scheme: TimeScheme,
+    /// Central differences: the fraction of the critical step of the default step.
+    pub omega: f64,
     /// Step size `h`.
     pub dt: f64,
     /// End time `T`.
@@ -297,6 +313,11 @@ pub struct ContactPair {
     /// Search radius of the detection (m): the largest master segment or slave
     /// element edge.
     pub radius: f64,
+    /// Central differences: friction interpolation `β` (0 frictionless, 1 sticking).
+    pub friction: f64,
+    /// Central differences: weight `w` of the pre-impact velocity in the position
+    /// update over the time to impact.
+    pub position_weight: f64,
 }
 
 /// How the implicit contact QP is solved.

@@ -15,7 +15,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::energy::Ledger;
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;
-use crate::model::{AnalysisKind, Model};
+use crate::model::{AnalysisKind, Model, TimeScheme};
+use crate::time::central_difference::CentralDifference;
 use crate::output::recorder::{Recorder, Snapshot};
 use crate::output::summary::{EnergySummary, SolverSummary, Summary, TimingSummary};
 use crate::time::backward_euler::BackwardEuler;
@@ -117,13 +118,17 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
     };
     let summary_path = opts.out.join("summary.json");
     summary.write(&summary_path)?;
-    let result = catch_unwind(AssertUnwindSafe(|| match a.kind {
-        AnalysisKind::Dynamic => {
+    let result = catch_unwind(AssertUnwindSafe(|| match (a.kind, a.scheme) {
+        (AnalysisKind::Dynamic, TimeScheme::CentralDifference) => CentralDifference::new(model)
+            .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
+        (AnalysisKind::Dynamic, TimeScheme::BackwardEuler) => {
             BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
                 .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
         }
-        AnalysisKind::Static => Statics::with_memory_limit(model, opts.backend, opts.memory_limit)
-            .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
+        (AnalysisKind::Static, _) => {
+            Statics::with_memory_limit(model, opts.backend, opts.memory_limit)
+                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
+        }
     }))
     .unwrap_or_else(|p| Err(Error::Internal(panic_message(p.as_ref()))));
     summary.probes = rec.probes().clone();

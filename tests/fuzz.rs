@@ -169,6 +169,7 @@ fn apply(text: &str, m: &Mutation) -> String {
 fn exercise_scenario(text: &str, dir: &Path) -> Result<(), String> {
     let opts = LoadOptions {
         memory_limit: Some(LIMIT),
+        allow_unstable: false,
     };
     let model = match rothe::config::from_str_with(text, dir, &opts) {
         Ok(m) => m,

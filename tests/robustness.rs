@@ -180,6 +180,7 @@ fn memory_is_estimated_before_it_is_taken() {
         Path::new("."),
         &rothe::config::LoadOptions {
             memory_limit: Some(10_000),
+            allow_unstable: false,
         },
     )
     .unwrap_err()

@@ -29,12 +29,16 @@ pub struct LoadOptions {
     /// Refuse a model whose memory estimate exceeds this many bytes (`None`: no
     /// limit). Default: the memory available on this machine.
     pub memory_limit: Option<u64>,
+    /// Accept an explicit step above the critical step (`--allow-unstable`, for
+    /// stability studies). Default false: such a step is refused.
+    pub allow_unstable: bool,
 }
 
 impl Default for LoadOptions {
     fn default() -> Self {
         LoadOptions {
             memory_limit: crate::memory::available(),
+            allow_unstable: false,
         }
     }
 }
@@ -42,7 +46,10 @@ impl Default for LoadOptions {
 impl LoadOptions {
     /// No memory limit (`--ignore-memory`).
     pub fn unlimited() -> Self {
-        LoadOptions { memory_limit: None }
+        LoadOptions {
+            memory_limit: None,
+            allow_unstable: false,
+        }
     }
 }
 
@@ -107,6 +114,14 @@ pub struct ContactSpec {
     /// edge set). Default false: slave nodes against master segments only.
     #[serde(default)]
     pub both_ways: bool,
+    /// Central differences: the paper's friction interpolation `β` in `[0, 1]`
+    /// between the frictionless (0, default) and the sticking (1) impact.
+    #[serde(default)]
+    pub friction: Option<f64>,
+    /// Central differences: the paper's weight `w` in `[0, 1]` of the velocity before
+    /// the impact in the position update over the time to impact. Default 0.5.
+    #[serde(default)]
+    pub position_weight: Option<f64>,
 }
 
 fn default_vtk_every() -> usize {
@@ -121,16 +136,28 @@ pub struct AnalysisSpec {
     /// `dynamic` (default) or `static`.
     #[serde(default)]
     pub kind: AnalysisKind,
+    /// Time scheme of a dynamic analysis: `backward_euler` (default: the paper's Rothe
+    /// scheme) or `central_difference` (explicit, lumped mass, the kinematic contact
+    /// method).
+    #[serde(default)]
+    pub scheme: crate::model::TimeScheme,
     /// End time `T` (s).
     pub t_end: f64,
-    /// Step `h` (s).
-    pub dt: f64,
+    /// Step `h` (s). Required for backward Euler and statics; central differences
+    /// default it to `omega` times the critical step.
+    #[serde(default)]
+    pub dt: Option<f64>,
+    /// Central differences: the fraction of the critical (CFL) step the default step
+    /// takes (the paper's `ω`). Default 0.9.
+    #[serde(default)]
+    pub omega: Option<f64>,
     /// `stress` (default: the paper's walls) or `strain`.
     #[serde(default)]
     pub plane: Plane,
-    /// `consistent` (default: the paper's Galerkin mass) or `lumped`.
+    /// `consistent` (default for the implicit schemes: the paper's Galerkin mass) or
+    /// `lumped` (the only one central differences take, and their default).
     #[serde(default)]
-    pub mass: MassKind,
+    pub mass: Option<MassKind>,
     /// Mass damping `zeta` of eq. (4) (1/s). Default 0, as in the paper's examples.
     #[serde(default)]
     pub zeta: f64,

@@ -395,6 +395,8 @@ mod tests {
                 master: Master::Segments(vec![[0, 1], [1, 2]]),
             }],
             radius: 1.0,
+            friction: 0.0,
+            position_weight: 0.5,
         };
         let mut out = Vec::new();
         detect(&[pair], |n| coords[n], &mut out);
@@ -446,6 +448,8 @@ mod tests {
                 master: Master::Segments(segments),
             }],
             radius: 1.0,
+            friction: 0.0,
+            position_weight: 0.5,
         };
         let mut out = Vec::new();
         detect(
@@ -495,6 +499,8 @@ mod tests {
                 },
             }],
             radius: 0.1,
+            friction: 0.0,
+            position_weight: 0.5,
         };
         let mut out = Vec::new();
         detect(&[pair], |n| coords[n], &mut out);

@@ -151,32 +151,7 @@ impl<'m> ContactCorrection<'m> {
     pub fn new(model: &'m Model) -> Self {
         let mesh = &model.mesh;
         let n = mesh.n_dofs();
-        // Tributary lengths: half of every element edge joining two slave nodes.
-        let mut area = vec![0.0; mesh.n_nodes()];
-        for pair in &model.contacts {
-            for side in &pair.sides {
-                let mut is_slave = vec![false; mesh.n_nodes()];
-                for &s in &side.slaves {
-                    is_slave[s] = true;
-                }
-                let mut seen = std::collections::BTreeSet::new();
-                for b in &mesh.blocks {
-                    let t = model.bodies[b.body].thickness;
-                    for e in 0..b.elements.len() {
-                        let nodes = b.elements.element(e);
-                        for k in 0..nodes.len() {
-                            let (p, q) = (nodes[k], nodes[(k + 1) % nodes.len()]);
-                            if is_slave[p] && is_slave[q] && seen.insert((p.min(q), p.max(q))) {
-                                let (xp, xq) = (mesh.coords[p], mesh.coords[q]);
-                                let l = ((xp[0] - xq[0]).powi(2) + (xp[1] - xq[1]).powi(2)).sqrt();
-                                area[p] += 0.5 * l * t;
-                                area[q] += 0.5 * l * t;
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        let area = super::tributary_areas(model);
         ContactCorrection {
             model,
             pairs: &model.contacts,

@@ -128,7 +128,7 @@ pub(crate) fn solve_by_active_set(
 /// set). A row that depends on those before it (a pivot below 1e-13 of its
 /// diagonal: two rows of one slave in an all but flat notch) is dropped, its
 /// multiplier left zero. False when `W_AA` has a non-positive diagonal.
-fn on_active_set(
+pub(crate) fn on_active_set(
     w: &[f64],
     c: &[f64],
     active: &[usize],

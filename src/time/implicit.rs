@@ -305,6 +305,7 @@ impl Operators {
             u,
             v,
             mv,
+            a: Vec::new(),
             f_int,
             f_ext,
             ledger: Ledger::new(e_kin0, e_el0),
@@ -884,7 +885,7 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
 }
 
 /// A message for a rejected step: what failed, when, and where.
-fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> String {
+pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> String {
     let when = format!("at t = {t1:.6e} (h = {h:.3e})");
     match outcome {
         Outcome::Converged { .. } => format!("converged {when}"),

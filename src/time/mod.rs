@@ -9,6 +9,7 @@
 //! equilibrium loop of [`crate::nonlinear`].
 
 pub mod backward_euler;
+pub mod central_difference;
 pub mod cfl;
 pub mod forces;
 mod implicit;
@@ -36,6 +37,8 @@ pub struct State {
     pub v: Vec<f64>,
     /// `M v`.
     pub mv: Vec<f64>,
+    /// Accelerations `a_n` (central differences; empty for the implicit schemes).
+    pub a: Vec<f64>,
     /// Internal forces `f_int(u_n)`.
     pub f_int: Vec<f64>,
     /// External forces including support reactions.

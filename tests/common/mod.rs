@@ -26,6 +26,8 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
         contacts: Vec::new(),
         analysis: Analysis {
             kind: AnalysisKind::Static,
+            scheme: rothe::model::TimeScheme::BackwardEuler,
+            omega: 0.9,
             dt: 1.0,
             t_end: 1.0,
             lumped_mass: false,

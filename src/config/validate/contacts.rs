@@ -80,7 +80,11 @@ fn body_of(mesh: &Mesh, nodes: &[usize]) -> Option<usize> {
 
 /// The pairs, and the smallest master segment (or slave element) length for the
 /// default tolerance.
-pub(super) fn contacts(s: &Scenario, mesh: &Mesh) -> Result<(Vec<ContactPair>, f64)> {
+pub(super) fn contacts(
+    s: &Scenario,
+    mesh: &Mesh,
+    scheme: crate::model::TimeScheme,
+) -> Result<(Vec<ContactPair>, f64)> {
     let mut pairs = Vec::new();
     let mut shortest = f64::INFINITY;
     for (i, c) in s.contact.iter().enumerate() {
@@ -91,7 +95,33 @@ pub(super) fn contacts(s: &Scenario, mesh: &Mesh) -> Result<(Vec<ContactPair>, f
             master,
             rigid_line,
             both_ways,
+            friction,
+            position_weight,
         } = c;
+        let friction = friction.unwrap_or(0.0);
+        let position_weight = position_weight.unwrap_or(0.5);
+        for (what, v) in [("friction", friction), ("position_weight", position_weight)] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(Error::config(
+                    format!("{field}.{what}"),
+                    format!("{v:?} is not in [0, 1]"),
+                ));
+            }
+        }
+        if scheme != crate::model::TimeScheme::CentralDifference {
+            for (what, given) in [
+                ("friction", c.friction.is_some_and(|b| b != 0.0)),
+                ("position_weight", c.position_weight.is_some()),
+            ] {
+                if given {
+                    return Err(Error::config(
+                        format!("{field}.{what}"),
+                        "belongs to the explicit kinematic contact (analysis.scheme = \"central_difference\"); \
+                         the implicit contact is frictionless",
+                    ));
+                }
+            }
+        }
         if name.is_empty() || name.contains(',') || name.contains('\n') {
             return Err(Error::config(
                 format!("{field}.name"),
@@ -215,6 +245,8 @@ pub(super) fn contacts(s: &Scenario, mesh: &Mesh) -> Result<(Vec<ContactPair>, f
             name: name.clone(),
             sides,
             radius,
+            friction,
+            position_weight,
         });
     }
     Ok((pairs, shortest))

@@ -23,7 +23,7 @@ pub use meshes::estimate;
 use super::{LoadOptions, Scenario};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::model::{Analysis, Body, Model};
+use crate::model::{Analysis, AnalysisKind, Body, Model, TimeScheme};
 
 /// Builds the model of `s`; relative file names resolve against `dir`.
 pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
@@ -107,7 +107,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let constraints = constraints::constraints(s, &mesh)?;
     let loads = constraints::loads(s, &mesh, &bodies)?;
     let probes = constraints::probes(s, &mesh)?;
-    let (contacts, shortest) = contacts::contacts(s, &mesh)?;
+    let (contacts, shortest) = contacts::contacts(s, &mesh, a.scheme)?;
     let contact_tolerance = match a.contact_tolerance {
         Some(t) => {
             positive("analysis.contact_tolerance", t)?;
@@ -117,7 +117,8 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         None => 1e-6,
     };
 
-    Ok(Model {
+    let explicit = a.scheme == TimeScheme::CentralDifference;
+    let mut model = Model {
         mesh,
         materials,
         plane: a.plane,
@@ -129,9 +130,11 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         contacts,
         analysis: Analysis {
             kind: a.kind,
-            dt: a.dt,
+            scheme: a.scheme,
+            omega: a.omega.unwrap_or(DEFAULT_OMEGA),
+            dt: a.dt.unwrap_or(f64::NAN),
             t_end: a.t_end,
-            lumped_mass: a.mass == super::MassKind::Lumped,
+            lumped_mass: explicit || a.mass == Some(super::MassKind::Lumped),
             zeta: a.zeta,
             rayleigh: a.rayleigh,
             vtk_every: a.vtk_every,
@@ -144,28 +147,115 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             contact_tolerance,
             contact_qp: a.contact_qp,
         },
-    })
+    };
+    if explicit {
+        explicit_step(&mut model, a.dt, opts)?;
+    }
+    Ok(model)
 }
 
-/// The `[analysis]` table.
-fn analysis(a: &super::AnalysisSpec) -> Result<()> {
-    positive("analysis.dt", a.dt)?;
-    positive("analysis.t_end", a.t_end)?;
-    if a.dt > a.t_end {
-        return Err(Error::config(
-            "analysis.dt",
-            format!("step {} exceeds t_end {}", a.dt, a.t_end),
-        ));
+/// The paper's default fraction of the critical step.
+const DEFAULT_OMEGA: f64 = 0.9;
+
+/// Central differences: the step defaults to `ω` times the paper's critical step
+/// `L_e/c` (never above `ω` times the stable step); a given step above the stable
+/// step `min_e 2/ω_e` is refused (unless `allow_unstable`), naming the limit and the
+/// element that sets it (`time::cfl`, `theory/explicit.md`).
+fn explicit_step(model: &mut Model, dt: Option<f64>, opts: &LoadOptions) -> Result<()> {
+    let (Some(paper), Some(stable)) = (
+        crate::time::cfl::critical_step(model),
+        crate::time::cfl::stable_step(model),
+    ) else {
+        return Err(Error::config("bodies", "no element to set the critical step"));
+    };
+    let where_ = model.describe_point(stable.block, stable.element);
+    let a = &mut model.analysis;
+    match dt {
+        None => {
+            a.dt = a.omega * paper.dt.min(stable.dt);
+            step_count("analysis.dt", a.t_end, a.dt)?;
+        }
+        Some(h) if h > stable.dt && !opts.allow_unstable => {
+            return Err(Error::config(
+                "analysis.dt",
+                format!(
+                    "{h:?} s exceeds the stable step {:.6e} s of central differences \
+                     (2/ω_max of {where_}; the paper's estimate L_e/c is {:.6e} s); omit dt \
+                     for omega x the estimate, or run with --allow-unstable for a stability study",
+                    stable.dt, paper.dt
+                ),
+            ));
+        }
+        Some(_) => {}
     }
-    let steps = (a.t_end / a.dt).round();
+    Ok(())
+}
+
+/// `t_end / dt` must fit a step counter.
+fn step_count(field: &str, t_end: f64, dt: f64) -> Result<()> {
+    let steps = (t_end / dt).round();
     if steps.is_nan() || steps > checks::MAX_STEPS {
         return Err(Error::config(
-            "analysis.dt",
+            field,
             format!(
                 "t_end / dt = {steps:e} steps does not fit a step counter (at most 2^53); \
                  is dt in seconds?"
             ),
         ));
+    }
+    Ok(())
+}
+
+/// The `[analysis]` table.
+fn analysis(a: &super::AnalysisSpec) -> Result<()> {
+    positive("analysis.t_end", a.t_end)?;
+    let explicit = a.scheme == TimeScheme::CentralDifference;
+    if explicit && a.kind == AnalysisKind::Static {
+        return Err(Error::config(
+            "analysis.scheme",
+            "central differences integrate dynamics; a static analysis has no scheme",
+        ));
+    }
+    if explicit && a.mass == Some(super::MassKind::Consistent) {
+        return Err(Error::config(
+            "analysis.mass",
+            "central differences need the lumped mass (they invert it per dof); omit `mass`",
+        ));
+    }
+    if let Some(w) = a.omega {
+        if !explicit {
+            return Err(Error::config(
+                "analysis.omega",
+                "is the explicit step's fraction of the critical step (scheme = \"central_difference\")",
+            ));
+        }
+        positive("analysis.omega", w)?;
+        if w > 1.0 {
+            return Err(Error::config(
+                "analysis.omega",
+                format!("{w:?} is above 1: the default step would exceed the critical step"),
+            ));
+        }
+    }
+    match a.dt {
+        Some(dt) => {
+            positive("analysis.dt", dt)?;
+            if dt > a.t_end {
+                return Err(Error::config(
+                    "analysis.dt",
+                    format!("step {dt} exceeds t_end {}", a.t_end),
+                ));
+            }
+            step_count("analysis.dt", a.t_end, dt)?;
+        }
+        None if !explicit => {
+            return Err(Error::config(
+                "analysis.dt",
+                "missing: backward Euler and statics need the step (central differences \
+                 default it to omega x the critical step)",
+            ));
+        }
+        None => {}
     }
     checks::non_negative("analysis.zeta", a.zeta)?;
     positive("analysis.tolerance", a.tolerance)?;

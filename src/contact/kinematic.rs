@@ -1,0 +1,483 @@
+//! The kinematic contact method of the explicit path (the paper's Section 4):
+//! impenetrability enforced on the motion of a step, not by forces.
+//!
+//! Within a step every node moves at its half-step velocity. For each slave node and
+//! each master segment (or rigid line) in reach, [`super::collision::node_segment`]
+//! gives the earliest time `t_c` at which they meet. The colliding pairs then get a
+//! perfectly inelastic normal impact at `t_c`: impulses `p ≥ 0` along the normals,
+//! applied as `+p n` on the slave and `−(1−ξ) p n`, `−ξ p n` on the segment's nodes
+//! (so the total momentum does not change), with the post-impact normal relative
+//! velocities zero where `p > 0` and nonnegative elsewhere. Simultaneous contacts
+//! couple through the nodes they share: the impulses solve the small QP
+//! `min ½ pᵀWp + pᵀc, p ≥ 0`, `W = G M⁻¹ Gᵀ`, `c = G v` (the same dual QP as the
+//! implicit contact, on velocities). Friction follows the paper's interpolation
+//! `v× = β v_stick + (1 − β) v_free` between the frictionless impact and the sticking
+//! one (zero relative velocity, normal and tangential). The position update over the
+//! step is the paper's, `x¹ = x⁰ + t_c (w v + (1 − w) v×) + (h − t_c) v×`, with the
+//! weight `w` of the pair. A last pass projects any node still found behind a master
+//! at the end of the step back onto it, mass-weighted (positions only, momentum
+//! unchanged). See `theory/explicit.md`.
+
+use rstar::primitives::{GeomWithData, Line};
+use rstar::RTree;
+
+use super::collision::node_segment;
+use super::detect::{detect, Candidate};
+use super::implicit::{ContactState, PairRecord};
+use super::qp::{on_active_set, solve_by_active_set, DualQp};
+use crate::error::{Error, Result};
+use crate::model::{Master, Model};
+
+/// Key of a contact row: pair, side, slave node, master segment (`usize::MAX` for a
+/// rigid line), as in the implicit path.
+type Key = (usize, usize, usize, usize);
+
+/// Sweeps of the end-of-step projection.
+const PROJECTION_SWEEPS: usize = 4;
+
+/// One colliding pair of a step.
+#[derive(Clone, Copy, Debug)]
+struct Row {
+    key: Key,
+    /// Time of impact within the step.
+    t_c: f64,
+    /// Dofs and coefficients of the normal row (slave `+n`, segment `−(1−ξ)n, −ξn`).
+    normal: ([(usize, f64); 6], usize),
+    /// The same with the tangent `(−n_y, n_x)`.
+    tangent: ([(usize, f64); 6], usize),
+    /// Friction interpolation and position weight of the pair.
+    beta: f64,
+    weight: f64,
+}
+
+fn row_of(slave: usize, master: Option<([usize; 2], f64)>, d: [f64; 2]) -> ([(usize, f64); 6], usize) {
+    let mut r = [(0usize, 0.0f64); 6];
+    r[0] = (2 * slave, d[0]);
+    r[1] = (2 * slave + 1, d[1]);
+    match master {
+        Some(([a, b], xi)) => {
+            r[2] = (2 * a, -(1.0 - xi) * d[0]);
+            r[3] = (2 * a + 1, -(1.0 - xi) * d[1]);
+            r[4] = (2 * b, -xi * d[0]);
+            r[5] = (2 * b + 1, -xi * d[1]);
+            (r, 6)
+        }
+        None => (r, 2),
+    }
+}
+
+fn dot_row(row: &([(usize, f64); 6], usize), x: &[f64]) -> f64 {
+    row.0[..row.1].iter().map(|&(d, c)| c * x[d]).sum()
+}
+
+/// `Σ_d a_d b_d / m_d` of two rows.
+fn coupling(a: &([(usize, f64); 6], usize), b: &([(usize, f64); 6], usize), m_inv: &[f64]) -> f64 {
+    let mut w = 0.0;
+    for &(da, ca) in &a.0[..a.1] {
+        for &(db, cb) in &b.0[..b.1] {
+            if da == db {
+                w += ca * cb * m_inv[da];
+            }
+        }
+    }
+    w
+}
+
+fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    if l > 0.0 {
+        [d[1] / l, -d[0] / l]
+    } else {
+        [0.0, 0.0]
+    }
+}
+
+/// What the correction of the last step did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct KinematicStats {
+    /// Collisions resolved (rows with a positive impulse).
+    pub impacts: usize,
+    /// Impulse QPs that needed Clarabel (the active-set start failed).
+    pub clarabel: usize,
+    /// Nodes moved by the end-of-step projection.
+    pub projected: usize,
+}
+
+/// The kinematic contact of a model's pairs.
+pub struct KinematicContact<'m> {
+    model: &'m Model,
+    area: Vec<f64>,
+    rows: Vec<Row>,
+    // Workspace.
+    x: Vec<f64>,
+    w: Vec<f64>,
+    c: Vec<f64>,
+    p: Vec<f64>,
+    active: Vec<usize>,
+    work: Vec<f64>,
+    node_tc: Vec<f64>,
+    node_weight: Vec<f64>,
+    v_pre: Vec<f64>,
+    cands: Vec<Candidate>,
+    impulses: Vec<(Key, f64)>,
+    dual: DualQp,
+    stats: KinematicStats,
+    total: KinematicStats,
+}
+
+impl<'m> KinematicContact<'m> {
+    /// The correction for the contact pairs of `model`.
+    pub fn new(model: &'m Model) -> Self {
+        let n = model.mesh.n_dofs();
+        KinematicContact {
+            model,
+            area: super::tributary_areas(model),
+            rows: Vec::new(),
+            x: vec![0.0; n],
+            w: Vec::new(),
+            c: Vec::new(),
+            p: Vec::new(),
+            active: Vec::new(),
+            work: Vec::new(),
+            node_tc: vec![f64::INFINITY; model.mesh.n_nodes()],
+            node_weight: vec![1.0; model.mesh.n_nodes()],
+            v_pre: Vec::new(),
+            cands: Vec::new(),
+            impulses: Vec::new(),
+            dual: DualQp::default(),
+            stats: KinematicStats::default(),
+            total: KinematicStats::default(),
+        }
+    }
+
+    /// Counts of the whole run so far.
+    pub fn stats(&self) -> KinematicStats {
+        self.total
+    }
+
+    /// Corrects the motion of a step of size `h` from the displacements `u` (all
+    /// dofs): `v` holds the half-step velocities and becomes the post-impact ones,
+    /// `du` holds `h v` and becomes the step's increments. `m_inv` is the inverse
+    /// lumped mass per dof, zero on constrained dofs (which no impulse moves).
+    pub fn correct(
+        &mut self,
+        u: &[f64],
+        v: &mut [f64],
+        du: &mut [f64],
+        m_inv: &[f64],
+        h: f64,
+    ) -> Result<()> {
+        self.stats = KinematicStats::default();
+        self.impulses.clear();
+        self.collisions(u, v, h);
+        if !self.rows.is_empty() {
+            self.v_pre.clear();
+            self.v_pre.extend_from_slice(v);
+            self.impacts(v, m_inv)?;
+            self.positions(v, du, h);
+        }
+        self.project(u, du, v, m_inv);
+        self.total.impacts += self.stats.impacts;
+        self.total.clarabel += self.stats.clarabel;
+        self.total.projected += self.stats.projected;
+        Ok(())
+    }
+
+    /// The earliest collision of every slave node within the step.
+    fn collisions(&mut self, u: &[f64], v: &[f64], h: f64) {
+        self.rows.clear();
+        let coords = &self.model.mesh.coords;
+        let at = |n: usize| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]];
+        let vel = |n: usize| [v[2 * n], v[2 * n + 1]];
+        for (pi, pair) in self.model.contacts.iter().enumerate() {
+            for (si, side) in pair.sides.iter().enumerate() {
+                match &side.master {
+                    Master::Segments(segments) => {
+                        // Reach: the pair's radius (a segment or element edge) covers
+                        // the motion of a stable step many times over.
+                        let r2 = pair.radius * pair.radius;
+                        let tree = RTree::bulk_load(
+                            segments
+                                .iter()
+                                .enumerate()
+                                .map(|(k, &[a, b])| GeomWithData::new(Line::new(at(a), at(b)), k))
+                                .collect(),
+                        );
+                        for &s in &side.slaves {
+                            let mut best: Option<(f64, usize, f64)> = None;
+                            for hit in tree.locate_within_distance(at(s), r2) {
+                                let [a, b] = segments[hit.data];
+                                if a == s || b == s {
+                                    continue;
+                                }
+                                if let Some(c) =
+                                    node_segment(at(s), vel(s), at(a), vel(a), at(b), vel(b), h)
+                                {
+                                    if best.is_none_or(|(t, _, _)| c.t < t) {
+                                        best = Some((c.t, hit.data, c.xi));
+                                    }
+                                }
+                            }
+                            if let Some((t_c, k, xi)) = best {
+                                let [a, b] = segments[k];
+                                let pa = at(a);
+                                let pb = at(b);
+                                let va = vel(a);
+                                let vb = vel(b);
+                                let n = outward(
+                                    [pa[0] + t_c * va[0], pa[1] + t_c * va[1]],
+                                    [pb[0] + t_c * vb[0], pb[1] + t_c * vb[1]],
+                                );
+                                self.rows.push(Row {
+                                    key: (pi, si, s, k),
+                                    t_c,
+                                    normal: row_of(s, Some(([a, b], xi)), n),
+                                    tangent: row_of(s, Some(([a, b], xi)), [-n[1], n[0]]),
+                                    beta: pair.friction,
+                                    weight: pair.position_weight,
+                                });
+                            }
+                        }
+                    }
+                    Master::Rigid { a, b, n } => {
+                        // Oriented so that the segment convention's normal is n.
+                        let (a, b) = if (b[1] - a[1]) * n[0] - (b[0] - a[0]) * n[1] >= 0.0 {
+                            (*a, *b)
+                        } else {
+                            (*b, *a)
+                        };
+                        for &s in &side.slaves {
+                            if let Some(c) = node_segment(at(s), vel(s), a, [0.0; 2], b, [0.0; 2], h) {
+                                self.rows.push(Row {
+                                    key: (pi, si, s, usize::MAX),
+                                    t_c: c.t,
+                                    normal: row_of(s, None, *n),
+                                    tangent: row_of(s, None, [-n[1], n[0]]),
+                                    beta: pair.friction,
+                                    weight: pair.position_weight,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The impulses of the colliding rows, applied to `v`.
+    fn impacts(&mut self, v: &mut [f64], m_inv: &[f64]) -> Result<()> {
+        let m = self.rows.len();
+        self.w.clear();
+        self.w.resize(m * m, 0.0);
+        self.c.clear();
+        for (i, ri) in self.rows.iter().enumerate() {
+            self.c.push(dot_row(&ri.normal, v));
+            for (j, rj) in self.rows.iter().enumerate() {
+                self.w[i + j * m] = coupling(&ri.normal, &rj.normal, m_inv);
+            }
+        }
+        // Rows whose nodes are all constrained have a zero diagonal: no impulse.
+        let movable: Vec<bool> = (0..m).map(|i| self.w[i + i * m] > 0.0).collect();
+        for i in 0..m {
+            if !movable[i] {
+                self.c[i] = self.c[i].max(0.0);
+                for j in 0..m {
+                    self.w[i + j * m] = if i == j { 1.0 } else { 0.0 };
+                    self.w[j + i * m] = if i == j { 1.0 } else { 0.0 };
+                }
+            }
+        }
+        // The frictionless impact: min ½pᵀWp + pᵀc, p ≥ 0.
+        self.active.clear();
+        self.active.extend((0..m).filter(|&i| self.c[i] < 0.0));
+        let tol = 1e-12 * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let guessed = solve_by_active_set(
+            &self.w,
+            &self.c,
+            &mut self.active,
+            tol,
+            &mut self.p,
+            &mut self.work,
+        );
+        if !guessed {
+            self.stats.clarabel += 1;
+            self.dual.solve(&self.w, &self.c, &mut self.p).map_err(|e| {
+                Error::Stepping(format!("the impact impulses of the kinematic contact: {e}"))
+            })?;
+        }
+        let mut normal = self.p.clone();
+        let mut tangential = vec![0.0; m];
+        // Sticking impacts where friction asks for them: the relative velocity of
+        // every impacting row (normal and tangential) zero.
+        let sticking: Vec<usize> = (0..m).filter(|&i| self.p[i] > 0.0 && self.rows[i].beta > 0.0).collect();
+        if !sticking.is_empty() {
+            let k = 2 * sticking.len();
+            let rows: Vec<&([(usize, f64); 6], usize)> = sticking
+                .iter()
+                .map(|&i| &self.rows[i].normal)
+                .chain(sticking.iter().map(|&i| &self.rows[i].tangent))
+                .collect();
+            // Rows that press without friction stay as they are in both solutions.
+            let mut w2 = vec![0.0; k * k];
+            let mut c2 = vec![0.0; k];
+            // The other impacts' frictionless impulses act in the sticking solve too.
+            let mut v_free = v.to_vec();
+            for (i, r) in self.rows.iter().enumerate() {
+                if self.p[i] > 0.0 && r.beta == 0.0 {
+                    for &(d, cf) in &r.normal.0[..r.normal.1] {
+                        v_free[d] += m_inv[d] * cf * self.p[i];
+                    }
+                }
+            }
+            for (a, ra) in rows.iter().enumerate() {
+                c2[a] = dot_row(ra, &v_free);
+                for (b, rb) in rows.iter().enumerate() {
+                    w2[a + b * k] = coupling(ra, rb, m_inv);
+                }
+            }
+            let all: Vec<usize> = (0..k).collect();
+            let mut q = Vec::new();
+            let mut work = Vec::new();
+            let solved = on_active_set(&w2, &c2, &all, &mut q, &mut work)
+                && q[..sticking.len()].iter().all(|&x| x >= 0.0);
+            // A sticking impact that would pull is no impact: friction is left out
+            // for this step (the frictionless impulses stand).
+            if solved {
+                for (a, &i) in sticking.iter().enumerate() {
+                    let beta = self.rows[i].beta;
+                    normal[i] = (1.0 - beta) * self.p[i] + beta * q[a];
+                    tangential[i] = beta * q[sticking.len() + a];
+                }
+            }
+        }
+        for (i, r) in self.rows.iter().enumerate() {
+            if !movable[i] {
+                continue;
+            }
+            for (row, p) in [(&r.normal, normal[i]), (&r.tangent, tangential[i])] {
+                if p != 0.0 {
+                    for &(d, cf) in &row.0[..row.1] {
+                        v[d] += m_inv[d] * cf * p;
+                    }
+                }
+            }
+            if normal[i] > 0.0 {
+                self.stats.impacts += 1;
+                self.impulses.push((r.key, normal[i]));
+            }
+        }
+        self.p = normal;
+        Ok(())
+    }
+
+    /// The paper's position update over the step for the nodes of the impacts.
+    fn positions(&mut self, v: &[f64], du: &mut [f64], h: f64) {
+        for (i, r) in self.rows.iter().enumerate() {
+            if self.p[i] <= 0.0 {
+                continue;
+            }
+            for &(d, cf) in &r.normal.0[..r.normal.1] {
+                let n = d / 2;
+                if cf != 0.0 && r.t_c < self.node_tc[n] {
+                    self.node_tc[n] = r.t_c;
+                    self.node_weight[n] = r.weight;
+                }
+            }
+        }
+        for (n, t_c) in self.node_tc.iter_mut().enumerate() {
+            if t_c.is_finite() {
+                let w = self.node_weight[n];
+                for d in [2 * n, 2 * n + 1] {
+                    du[d] = h * v[d] + w * *t_c * (self.v_pre[d] - v[d]);
+                }
+                *t_c = f64::INFINITY;
+            }
+        }
+    }
+
+    /// Projects nodes found behind a master at `u + du` back onto it: a few
+    /// Gauss-Seidel sweeps of mass-weighted position corrections along the normals
+    /// (momentum unchanged), and any approach velocity of such a pair removed by an
+    /// impulse.
+    fn project(&mut self, u: &[f64], du: &mut [f64], v: &mut [f64], m_inv: &[f64]) {
+        for _ in 0..PROJECTION_SWEEPS {
+            self.end_geometry(u, du);
+            let mut moved = false;
+            for c in &self.cands {
+                if c.gap >= 0.0 {
+                    continue;
+                }
+                let (row, k) = c.row();
+                let row = (row, k);
+                let w = coupling(&row, &row, m_inv);
+                if w.is_nan() || w <= 0.0 {
+                    continue;
+                }
+                let q = -c.gap / w;
+                for &(d, cf) in &row.0[..row.1] {
+                    du[d] += m_inv[d] * cf * q;
+                }
+                let approach = dot_row(&row, v);
+                if approach < 0.0 {
+                    let p = -approach / w;
+                    for &(d, cf) in &row.0[..row.1] {
+                        v[d] += m_inv[d] * cf * p;
+                    }
+                }
+                self.stats.projected += 1;
+                moved = true;
+            }
+            if !moved {
+                break;
+            }
+        }
+    }
+
+    /// Candidates at the geometry `u + du`.
+    fn end_geometry(&mut self, u: &[f64], du: &[f64]) {
+        let coords = &self.model.mesh.coords;
+        for (n, c) in coords.iter().enumerate() {
+            self.x[2 * n] = c[0] + u[2 * n] + du[2 * n];
+            self.x[2 * n + 1] = c[1] + u[2 * n + 1] + du[2 * n + 1];
+        }
+        let x = &self.x;
+        detect(&self.model.contacts, |n| [x[2 * n], x[2 * n + 1]], &mut self.cands);
+    }
+
+    /// Writes the contact state at the end of the step (`u1` the new displacements):
+    /// gaps, the mean contact force of each impact over the step (`p/h`), pressures.
+    pub fn finish(&mut self, u1: &[f64], h: f64, out: &mut ContactState) {
+        let zero = vec![0.0; u1.len()];
+        self.end_geometry(u1, &zero);
+        let n_nodes = self.model.mesh.n_nodes();
+        out.pairs.clear();
+        out.pairs.resize(self.model.contacts.len(), PairRecord::default());
+        out.gap.clear();
+        out.gap.resize(n_nodes, f64::NAN);
+        out.pressure.clear();
+        out.pressure.resize(n_nodes, 0.0);
+        for c in &self.cands {
+            let rec = &mut out.pairs[c.pair];
+            rec.penetration = rec.penetration.max(-c.gap);
+            let g = &mut out.gap[c.slave];
+            *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
+        }
+        out.active.clear();
+        self.impulses.sort_unstable_by_key(|(k, _)| *k);
+        let mut last = None;
+        for &(key, p) in &self.impulses {
+            let f = p / h;
+            out.active.push((key, f));
+            let rec = &mut out.pairs[key.0];
+            rec.force += f;
+            let slave = (key.0, key.1, key.2);
+            if last.replace(slave) != Some(slave) {
+                rec.active += 1;
+            }
+            if self.area[key.2] > 0.0 {
+                out.pressure[key.2] += f / self.area[key.2];
+            }
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! The explicit path: central differences with lumped mass and the kinematic contact
+//! method. Stability limit against the mesh's highest mode, energy conservation at
+//! second order, the two bars against 1D wave theory, momentum through impacts,
+//! friction and the position weight, ledgers with every material model, and the
+//! same scenario through both paths.
+
+use std::path::Path;
+
+use rothe::config::LoadOptions;
+use rothe::linsolve::Backend;
+use rothe::model::Model;
+use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::central_difference::CentralDifference;
+use rothe::time::{Integrator, State};
+
+fn load(text: &str, allow_unstable: bool) -> rothe::Result<Model> {
+    let opts = LoadOptions {
+        memory_limit: None,
+        allow_unstable,
+    };
+    rothe::config::from_str_with(text, Path::new("."), &opts)
+}
+
+fn example(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// A steel plate 0.4 x 0.2 m fixed at its left edge, set moving at (1, 0.5) m/s: the
+/// support sends waves of every wavelength through it.
+fn plate(dt: Option<f64>, t_end: f64) -> String {
+    format!(
+        r#"
+[analysis]
+scheme = "central_difference"
+t_end = {t_end:e}
+{}
+vtk_every = 0
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "plate"
+material = "steel"
+thickness = 0.1
+velocity = [1.0, 0.5]
+mesh = {{ kind = "rectangle", size = [0.4, 0.2], divisions = [8, 4] }}
+[[supports]]
+set = "plate.left"
+fix = ["x", "y"]
+"#,
+        dt.map(|h| format!("dt = {h:e}")).unwrap_or_default()
+    )
+}
+
+/// Largest `|E_kin + E_el − E_0| / E_0` over a run, and whether it stayed finite.
+fn energy_drift(m: &Model) -> (f64, bool) {
+    let mut cd = CentralDifference::new(m).unwrap();
+    let mut s = cd.initial_state().unwrap();
+    let e0 = s.ledger.kinetic() + s.ledger.elastic();
+    let mut worst: f64 = 0.0;
+    for _ in 0..m.analysis.n_steps() {
+        match cd.step_accepted(&mut s) {
+            Ok(_) => {}
+            Err(_) => return (f64::INFINITY, false),
+        }
+        let e = s.ledger.kinetic() + s.ledger.elastic();
+        if !e.is_finite() {
+            return (f64::INFINITY, false);
+        }
+        worst = worst.max((e - e0).abs() / e0);
+        if worst > 1e6 {
+            // Blown up: the ledger still closes relative to its (huge) scale.
+            return (worst, true);
+        }
+        assert!(
+            s.ledger.residual().abs() <= 1e-11 * s.ledger.scale(),
+            "ledger residual {} of {}",
+            s.ledger.residual(),
+            s.ledger.scale()
+        );
+    }
+    (worst, true)
+}
+
+#[test]
+fn a_step_just_above_the_mesh_limit_blows_up_and_just_below_does_not() {
+    // The mesh's own limit 2/ω_max (power iteration on M⁻¹K) against the two
+    // estimates: the element bound min_e 2/ω_e (Irons' theorem: never above the
+    // mesh's) and the paper's L_e/c.
+    let m = load(&plate(None, 2e-3), false).unwrap();
+    let exact = rothe::time::cfl::mesh_stable_step(&m, 20_000);
+    let bound = rothe::time::cfl::stable_step(&m).unwrap().dt;
+    let paper = rothe::time::cfl::critical_step(&m).unwrap().dt;
+    eprintln!("paper {paper:.4e} s, element bound {bound:.4e} s, mesh {exact:.4e} s");
+    assert!(paper <= bound && bound <= exact * (1.0 + 1e-9));
+    // The default step is ω times the paper's estimate.
+    assert!((m.analysis.dt - 0.9 * paper).abs() < 1e-15);
+    // 2 % below the mesh's limit: bounded for 4000 steps; 2 % above: it blows up.
+    let below = load(&plate(Some(0.98 * exact), 4000.0 * 0.98 * exact), true).unwrap();
+    let (drift, finite) = energy_drift(&below);
+    assert!(finite && drift < 0.05, "below the limit: drift {drift}");
+    let above = load(&plate(Some(1.02 * exact), 4000.0 * 1.02 * exact), true).unwrap();
+    let (drift, _) = energy_drift(&above);
+    assert!(drift > 1e6, "above the limit: drift {drift}");
+}
+
+#[test]
+fn a_step_above_the_stable_step_is_refused_naming_the_limit_and_the_element() {
+    let m = load(&plate(None, 2e-3), false).unwrap();
+    let bound = rothe::time::cfl::stable_step(&m).unwrap();
+    let e = load(&plate(Some(1.01 * bound.dt), 2e-3), false).unwrap_err().to_string();
+    for word in ["analysis.dt", "stable step", "block 0 element", "--allow-unstable", "L_e/c"] {
+        assert!(e.contains(word), "`{word}` not in: {e}");
+    }
+    assert!(load(&plate(Some(1.01 * bound.dt), 2e-3), true).is_ok());
+    // A consistent mass or a step-less backward Euler are refused too.
+    let consistent = plate(None, 2e-3).replace("vtk_every = 0", "vtk_every = 0\nmass = \"consistent\"");
+    assert!(load(&consistent, false).unwrap_err().to_string().contains("analysis.mass"));
+    let implicit = plate(None, 2e-3).replace("scheme = \"central_difference\"\n", "");
+    assert!(load(&implicit, false).unwrap_err().to_string().contains("analysis.dt"));
+}
+
+#[test]
+fn elastic_waves_conserve_energy_to_second_order() {
+    // Velocity Verlet conserves E_kin − (h²/8) aᵀMa exactly, so E_kin + E_el drifts
+    // by O(h²): the observed order of the largest drift over 1 ms.
+    let m = load(&plate(None, 1e-3), false).unwrap();
+    let h0 = rothe::time::cfl::stable_step(&m).unwrap().dt * 0.5;
+    let drifts: Vec<f64> = [h0, h0 / 2.0, h0 / 4.0]
+        .iter()
+        .map(|&h| {
+            let m = load(&plate(Some(h), 1e-3), false).unwrap();
+            energy_drift(&m).0
+        })
+        .collect();
+    let orders: Vec<f64> = drifts.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    eprintln!("energy drifts {drifts:?}, observed orders {orders:?}");
+    for p in &orders {
+        assert!((1.8..2.2).contains(p), "orders {orders:?}");
+    }
+}
+
+/// The bars example through the explicit path, with step `omega` x the estimate.
+fn explicit_bars(omega: f64) -> Model {
+    let text = example("contact/bars_impact.toml")
+        .replace(
+            "dt = 1.0e-6",
+            &format!("scheme = \"central_difference\"\nomega = {omega}"),
+        )
+        .replace("vtk_every = 20", "vtk_every = 0")
+        .replace("contact_qp = \"condensed\"\n", "");
+    load(&text, false).unwrap()
+}
+
+fn momentum(m: &Model, s: &State, mass: &[f64], body: usize) -> (f64, f64) {
+    let (mut p, mut mm) = (0.0, 0.0);
+    for (n, &b) in m.mesh.node_body.iter().enumerate() {
+        if b == body {
+            p += mass[2 * n] * s.v[2 * n];
+            mm += mass[2 * n];
+        }
+    }
+    (p, mm)
+}
+
+#[test]
+fn two_bars_collide_as_1d_wave_theory_says_and_conserve_momentum() {
+    // 1D waves: contact for 2L/c = 0.4 ms at ρcAv/2 = 1e5 N, then the striker stands
+    // and the target leaves at v. The kinematic method: momentum conserved to 1e-12
+    // at every step, no node behind the master after any step.
+    for omega in [0.9, 0.45] {
+        let m = explicit_bars(omega);
+        let mut cd = CentralDifference::new(&m).unwrap();
+        let mass = cd.lumped_mass().to_vec();
+        let mut s = cd.initial_state().unwrap();
+        let p0 = momentum(&m, &s, &mass, 0).0 + momentum(&m, &s, &mass, 1).0;
+        let mut p_prev = p0;
+        let (mut t_on, mut t_off, mut plateau, mut count) = (None, None, 0.0, 0);
+        for _ in 0..m.analysis.n_steps() {
+            cd.step_accepted(&mut s).unwrap();
+            // Through every step, impacts included, the momentum changes by round-off
+            // only (1e-13); over the run that round-off adds up (the stiffness's
+            // column sums are zero to ε|K|, times the growing displacements).
+            let p = momentum(&m, &s, &mass, 0).0 + momentum(&m, &s, &mass, 1).0;
+            assert!((p - p_prev).abs() <= 1e-13 * p0.abs(), "momentum step {p} vs {p_prev}");
+            assert!((p - p0).abs() <= 1e-11 * p0.abs(), "momentum {p} vs {p0}");
+            p_prev = p;
+            assert!(s.contact.pairs[0].penetration <= 1e-12, "{}", s.contact.pairs[0].penetration);
+            assert!(s.ledger.residual().abs() <= 1e-11 * s.ledger.scale());
+            let f = s.contact.pairs[0].force;
+            if f > 0.0 {
+                t_on.get_or_insert(s.t - m.analysis.dt);
+                t_off = Some(s.t);
+                if s.t > 1e-4 && s.t < 3e-4 {
+                    plateau += f;
+                    count += 1;
+                }
+            }
+        }
+        let duration = t_off.unwrap() - t_on.unwrap();
+        let plateau = plateau / count as f64;
+        let (ps, ms) = momentum(&m, &s, &mass, 0);
+        let (pt, mt) = momentum(&m, &s, &mass, 1);
+        eprintln!(
+            "omega {omega}: h = {:.3e} s, duration {duration:.4e} s, plateau {plateau:.5e} N, striker {:.4} m/s, target {:.4} m/s, D_contact {:.4e} J",
+            m.analysis.dt,
+            ps / ms,
+            pt / mt,
+            s.ledger.dissipated().contact
+        );
+        assert!((duration - 4e-4).abs() < 0.02 * 4e-4, "duration {duration}");
+        assert!((plateau - 1e5).abs() < 0.02 * 1e5, "plateau {plateau}");
+        assert!((ps / ms).abs() < 0.03 && (pt / mt - 1.0).abs() < 0.03);
+    }
+}
