@@ -133,7 +133,14 @@ fn main() -> ExitCode {
             quiet,
             ignore_memory,
             allow_unstable,
-        } => run_command(&scenario, &out, backend, quiet, ignore_memory, allow_unstable),
+        } => run_command(
+            &scenario,
+            &out,
+            backend,
+            quiet,
+            ignore_memory,
+            allow_unstable,
+        ),
         Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out)
             .map(|steps| {
                 eprintln!(

@@ -16,8 +16,9 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use rothe::config::LoadOptions;
 use rothe::linsolve::Backend;
-use rothe::model::AnalysisKind;
+use rothe::model::{AnalysisKind, TimeScheme};
 use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::central_difference::CentralDifference;
 use rothe::time::statics::Statics;
 use rothe::time::{Integrator, StepOutcome};
 
@@ -188,6 +189,12 @@ fn exercise_scenario(text: &str, dir: &Path) -> Result<(), String> {
         return Ok(());
     }
     let mut integrator: Box<dyn Integrator> = match model.analysis.kind {
+        AnalysisKind::Dynamic if model.analysis.scheme == TimeScheme::CentralDifference => {
+            match CentralDifference::new(&model) {
+                Ok(i) => Box::new(i),
+                Err(_) => return Ok(()),
+            }
+        }
         AnalysisKind::Dynamic => {
             match BackwardEuler::with_memory_limit(&model, Backend::Faer, Some(LIMIT)) {
                 Ok(i) => Box::new(i),
@@ -260,7 +267,9 @@ static STEPPED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize:
 static REFUSED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 fn campaign(cases: u32) {
-    let scenarios = examples("examples/scenarios");
+    let mut scenarios = examples("examples/scenarios");
+    scenarios.extend(examples("examples/contact"));
+    scenarios.extend(examples("examples/explicit"));
     let materials = examples("examples/materials");
     let all: Vec<(PathBuf, String, bool)> = scenarios
         .into_iter()
@@ -301,7 +310,11 @@ fn campaign(cases: u32) {
                 ))),
             }
         })
-        .unwrap();
+        .unwrap_or_else(|e| {
+            // The hook is quiet: say what failed before failing.
+            eprintln!("{e}");
+            panic!("the campaign failed: {e}")
+        });
     let (stepped, refused) = (
         STEPPED.load(std::sync::atomic::Ordering::Relaxed),
         REFUSED.load(std::sync::atomic::Ordering::Relaxed),

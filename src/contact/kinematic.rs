@@ -50,7 +50,11 @@ struct Row {
     weight: f64,
 }
 
-fn row_of(slave: usize, master: Option<([usize; 2], f64)>, d: [f64; 2]) -> ([(usize, f64); 6], usize) {
+fn row_of(
+    slave: usize,
+    master: Option<([usize; 2], f64)>,
+    d: [f64; 2],
+) -> ([(usize, f64); 6], usize) {
     let mut r = [(0usize, 0.0f64); 6];
     r[0] = (2 * slave, d[0]);
     r[1] = (2 * slave + 1, d[1]);
@@ -110,7 +114,6 @@ pub struct KinematicContact<'m> {
     area: Vec<f64>,
     rows: Vec<Row>,
     // Workspace.
-    x: Vec<f64>,
     w: Vec<f64>,
     c: Vec<f64>,
     p: Vec<f64>,
@@ -122,19 +125,17 @@ pub struct KinematicContact<'m> {
     cands: Vec<Candidate>,
     impulses: Vec<(Key, f64)>,
     dual: DualQp,
-    stats: KinematicStats,
+    step: KinematicStats,
     total: KinematicStats,
 }
 
 impl<'m> KinematicContact<'m> {
     /// The correction for the contact pairs of `model`.
     pub fn new(model: &'m Model) -> Self {
-        let n = model.mesh.n_dofs();
         KinematicContact {
             model,
             area: super::tributary_areas(model),
             rows: Vec::new(),
-            x: vec![0.0; n],
             w: Vec::new(),
             c: Vec::new(),
             p: Vec::new(),
@@ -146,7 +147,7 @@ impl<'m> KinematicContact<'m> {
             cands: Vec::new(),
             impulses: Vec::new(),
             dual: DualQp::default(),
-            stats: KinematicStats::default(),
+            step: KinematicStats::default(),
             total: KinematicStats::default(),
         }
     }
@@ -168,7 +169,7 @@ impl<'m> KinematicContact<'m> {
         m_inv: &[f64],
         h: f64,
     ) -> Result<()> {
-        self.stats = KinematicStats::default();
+        self.step = KinematicStats::default();
         self.impulses.clear();
         self.collisions(u, v, h);
         if !self.rows.is_empty() {
@@ -178,9 +179,9 @@ impl<'m> KinematicContact<'m> {
             self.positions(v, du, h);
         }
         self.project(u, du, v, m_inv);
-        self.total.impacts += self.stats.impacts;
-        self.total.clarabel += self.stats.clarabel;
-        self.total.projected += self.stats.projected;
+        self.total.impacts += self.step.impacts;
+        self.total.clarabel += self.step.clarabel;
+        self.total.projected += self.step.projected;
         Ok(())
     }
 
@@ -248,7 +249,9 @@ impl<'m> KinematicContact<'m> {
                             (*b, *a)
                         };
                         for &s in &side.slaves {
-                            if let Some(c) = node_segment(at(s), vel(s), a, [0.0; 2], b, [0.0; 2], h) {
+                            if let Some(c) =
+                                node_segment(at(s), vel(s), a, [0.0; 2], b, [0.0; 2], h)
+                            {
                                 self.rows.push(Row {
                                     key: (pi, si, s, usize::MAX),
                                     t_c: c.t,
@@ -301,16 +304,20 @@ impl<'m> KinematicContact<'m> {
             &mut self.work,
         );
         if !guessed {
-            self.stats.clarabel += 1;
-            self.dual.solve(&self.w, &self.c, &mut self.p).map_err(|e| {
-                Error::Stepping(format!("the impact impulses of the kinematic contact: {e}"))
-            })?;
+            self.step.clarabel += 1;
+            self.dual
+                .solve(&self.w, &self.c, &mut self.p)
+                .map_err(|e| {
+                    Error::Stepping(format!("the impact impulses of the kinematic contact: {e}"))
+                })?;
         }
         let mut normal = self.p.clone();
         let mut tangential = vec![0.0; m];
         // Sticking impacts where friction asks for them: the relative velocity of
         // every impacting row (normal and tangential) zero.
-        let sticking: Vec<usize> = (0..m).filter(|&i| self.p[i] > 0.0 && self.rows[i].beta > 0.0).collect();
+        let sticking: Vec<usize> = (0..m)
+            .filter(|&i| self.p[i] > 0.0 && self.rows[i].beta > 0.0)
+            .collect();
         if !sticking.is_empty() {
             let k = 2 * sticking.len();
             let rows: Vec<&([(usize, f64); 6], usize)> = sticking
@@ -363,7 +370,7 @@ impl<'m> KinematicContact<'m> {
                 }
             }
             if normal[i] > 0.0 {
-                self.stats.impacts += 1;
+                self.step.impacts += 1;
                 self.impulses.push((r.key, normal[i]));
             }
         }
@@ -396,13 +403,17 @@ impl<'m> KinematicContact<'m> {
         }
     }
 
-    /// Projects nodes found behind a master at `u + du` back onto it: a few
+    /// Projects nodes found behind a master at `u + du` back onto it (and leaves the
+    /// candidates of the final geometry in `self.cands`): a few
     /// Gauss-Seidel sweeps of mass-weighted position corrections along the normals
     /// (momentum unchanged), and any approach velocity of such a pair removed by an
     /// impulse.
     fn project(&mut self, u: &[f64], du: &mut [f64], v: &mut [f64], m_inv: &[f64]) {
-        for _ in 0..PROJECTION_SWEEPS {
+        for sweep in 0..=PROJECTION_SWEEPS {
             self.end_geometry(u, du);
+            if sweep == PROJECTION_SWEEPS {
+                break;
+            }
             let mut moved = false;
             for c in &self.cands {
                 if c.gap >= 0.0 {
@@ -425,7 +436,7 @@ impl<'m> KinematicContact<'m> {
                         v[d] += m_inv[d] * cf * p;
                     }
                 }
-                self.stats.projected += 1;
+                self.step.projected += 1;
                 moved = true;
             }
             if !moved {
@@ -437,22 +448,26 @@ impl<'m> KinematicContact<'m> {
     /// Candidates at the geometry `u + du`.
     fn end_geometry(&mut self, u: &[f64], du: &[f64]) {
         let coords = &self.model.mesh.coords;
-        for (n, c) in coords.iter().enumerate() {
-            self.x[2 * n] = c[0] + u[2 * n] + du[2 * n];
-            self.x[2 * n + 1] = c[1] + u[2 * n + 1] + du[2 * n + 1];
-        }
-        let x = &self.x;
-        detect(&self.model.contacts, |n| [x[2 * n], x[2 * n + 1]], &mut self.cands);
+        detect(
+            &self.model.contacts,
+            |n| {
+                [
+                    coords[n][0] + u[2 * n] + du[2 * n],
+                    coords[n][1] + u[2 * n + 1] + du[2 * n + 1],
+                ]
+            },
+            &mut self.cands,
+        );
     }
 
     /// Writes the contact state at the end of the step (`u1` the new displacements):
     /// gaps, the mean contact force of each impact over the step (`p/h`), pressures.
-    pub fn finish(&mut self, u1: &[f64], h: f64, out: &mut ContactState) {
-        let zero = vec![0.0; u1.len()];
-        self.end_geometry(u1, &zero);
+    pub fn finish(&mut self, h: f64, out: &mut ContactState) {
+        // The candidates of the last projection sweep are those of the step's end.
         let n_nodes = self.model.mesh.n_nodes();
         out.pairs.clear();
-        out.pairs.resize(self.model.contacts.len(), PairRecord::default());
+        out.pairs
+            .resize(self.model.contacts.len(), PairRecord::default());
         out.gap.clear();
         out.gap.resize(n_nodes, f64::NAN);
         out.pressure.clear();

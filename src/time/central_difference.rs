@@ -79,11 +79,18 @@ impl<'m> CentralDifference<'m> {
             Mass::Lumped(d) => d.clone(),
             Mass::Consistent(_) => mass.row_sums(&asm.pattern),
         };
-        let mut m_inv: Vec<f64> = m.iter().map(|&x| if x > 0.0 { 1.0 / x } else { 0.0 }).collect();
+        let mut m_inv: Vec<f64> = m
+            .iter()
+            .map(|&x| if x > 0.0 { 1.0 / x } else { 0.0 })
+            .collect();
         for c in &model.constraints {
             m_inv[c.dof] = 0.0;
         }
-        if let Some(d) = (0..m.len()).find(|&d| !(m[d] > 0.0) && m_inv[d] == 0.0 && !model.constraints.iter().any(|c| c.dof == d)) {
+        if let Some(d) = (0..m.len()).find(|&d| {
+            (m[d].is_nan() || m[d] <= 0.0)
+                && m_inv[d] == 0.0
+                && !model.constraints.iter().any(|c| c.dof == d)
+        }) {
             return Err(Error::Config {
                 field: "bodies".into(),
                 message: format!(
@@ -222,7 +229,8 @@ impl Integrator for CentralDifference<'_> {
         }
         for d in 0..n {
             if self.m_inv[d] > 0.0 {
-                a[d] = self.m_inv[d] * (f_ext[d] - f_int[d] - self.damp_k * kv[d]) - self.damp_m * v[d];
+                a[d] = self.m_inv[d] * (f_ext[d] - f_int[d] - self.damp_k * kv[d])
+                    - self.damp_m * v[d];
             }
         }
         // Reactions on the constrained dofs: what makes M a = f_ext − f_int − f_damp.
@@ -310,7 +318,8 @@ impl Integrator for CentralDifference<'_> {
         for d in 0..n {
             if self.m_inv[d] > 0.0 {
                 let kv = if c_k != 0.0 { w.kv[d] } else { 0.0 };
-                w.a1[d] = (self.m_inv[d] * (w.f_ext1[d] - w.f_int1[d] - c_k * kv) - c_m * w.v_hat[d])
+                w.a1[d] = (self.m_inv[d] * (w.f_ext1[d] - w.f_int1[d] - c_k * kv)
+                    - c_m * w.v_hat[d])
                     / (1.0 + 0.5 * c_m * h);
             }
         }
@@ -330,7 +339,8 @@ impl Integrator for CentralDifference<'_> {
         }
         // The ledger's terms in one pass over the dofs.
         let (mut internal, mut external, mut damping) = (0.0, 0.0, 0.0);
-        let (mut kinetic, mut ama0, mut ama1, mut dk_corr, mut mismatch) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut kinetic, mut ama0, mut ama1, mut dk_corr, mut mismatch) =
+            (0.0, 0.0, 0.0, 0.0, 0.0);
         let mut jump = 0.0;
         for d in 0..n {
             let (m, du) = (self.m[d], w.du[d]);
@@ -371,7 +381,21 @@ impl Integrator for CentralDifference<'_> {
             None => (0.5 * super::dot(&w.u1, &w.f_int1), Dissipation::default()),
         };
         let contact = -0.5 * dk_corr - 0.5 * h * mismatch;
-        s.ledger.record(&StepIncrements {
+        if let Some(d) = (0..n).find(|&d| !w.v1[d].is_finite() || !w.a1[d].is_finite()) {
+            let (quantity, value) = if w.a1[d].is_finite() {
+                ("velocity", w.v1[d])
+            } else {
+                ("acceleration", w.a1[d])
+            };
+            let outcome = Outcome::NonFinite {
+                quantity,
+                dof: Some(d),
+                value,
+            };
+            return Ok(self.rejected(outcome, t1));
+        }
+        let mut ledger = s.ledger;
+        ledger.record(&StepIncrements {
             kinetic: 0.5 * kinetic,
             elastic,
             work,
@@ -379,8 +403,17 @@ impl Integrator for CentralDifference<'_> {
             scheme_loss: -h * h / 8.0 * (ama1 - ama0),
             contact,
         });
+        if let Some((quantity, value)) = ledger.first_non_finite() {
+            let outcome = Outcome::NonFinite {
+                quantity,
+                dof: None,
+                value,
+            };
+            return Ok(self.rejected(outcome, t1));
+        }
+        s.ledger = ledger;
         if let Some(kc) = self.contact.as_mut() {
-            kc.finish(&w.u1, h, &mut s.contact);
+            kc.finish(h, &mut s.contact);
         }
         s.points.iter_mut().for_each(|p| p.commit());
         std::mem::swap(&mut s.u, &mut w.u1);

@@ -116,9 +116,14 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
 pub fn mesh_stable_step(model: &Model, iterations: usize) -> f64 {
     let asm = crate::assembly::Assembler::new(&model.mesh);
     let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
-    let m = asm.mass(&model.mesh, &model.materials, true).row_sums(&asm.pattern);
+    let m = asm
+        .mass(&model.mesh, &model.materials, true)
+        .row_sums(&asm.pattern);
     let n = m.len();
-    let mut s: Vec<f64> = m.iter().map(|&x| if x > 0.0 { 1.0 / x.sqrt() } else { 0.0 }).collect();
+    let mut s: Vec<f64> = m
+        .iter()
+        .map(|&x| if x > 0.0 { 1.0 / x.sqrt() } else { 0.0 })
+        .collect();
     for c in &model.constraints {
         s[c.dof] = 0.0;
     }
@@ -197,7 +202,9 @@ fn largest_eigenvalue(a: &mut [f64; 64], n: usize) -> f64 {
             }
         }
     }
-    (0..n).map(|i| a[i * n + i]).fold(f64::NEG_INFINITY, f64::max)
+    (0..n)
+        .map(|i| a[i * n + i])
+        .fold(f64::NEG_INFINITY, f64::max)
 }
 
 #[cfg(test)]

@@ -166,7 +166,10 @@ fn explicit_step(model: &mut Model, dt: Option<f64>, opts: &LoadOptions) -> Resu
         crate::time::cfl::critical_step(model),
         crate::time::cfl::stable_step(model),
     ) else {
-        return Err(Error::config("bodies", "no element to set the critical step"));
+        return Err(Error::config(
+            "bodies",
+            "no element to set the critical step",
+        ));
     };
     let where_ = model.describe_point(stable.block, stable.element);
     let a = &mut model.analysis;
