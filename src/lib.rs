@@ -39,7 +39,9 @@ pub mod mesh;
 pub mod model;
 pub mod nonlinear;
 pub mod output;
+pub mod plot;
 pub mod run;
+pub mod study;
 pub mod system;
 pub mod time;
 #[doc(hidden)]

@@ -1,4 +1,5 @@
-//! The `rothe` command: `run`, `check`, `material`.
+//! The `rothe` command: `run`, `check`, `study`, `compare`, `plot`, `report`,
+//! `material`.
 //!
 //! Errors print as `error: <field or file>: <what is wrong>` and exit with status 1.
 //! A panic never reaches the user as a Rust backtrace: it is reported as an internal
@@ -7,8 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
-use rothe::config::LoadOptions;
+use clap::{Args, Parser, Subcommand};
+use rothe::config::{LoadOptions, Overrides};
 use rothe::linsolve::Backend;
 use rothe::run::{panic_message, run, RunOptions};
 
@@ -27,8 +28,8 @@ struct Cli {
 enum Command {
     /// Run a scenario and write history.csv, summary.json and VTK files.
     Run {
-        /// Scenario file (TOML).
-        scenario: PathBuf,
+        #[command(flatten)]
+        scenario: ScenarioArgs,
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -38,13 +39,51 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
-        /// Run even when the memory estimate exceeds the memory available.
+        /// Also write the displacement of every step to fields.bin (the time study's
+        /// error norms read it).
         #[arg(long)]
-        ignore_memory: bool,
-        /// Accept an explicit step above the critical (CFL) step, for stability
-        /// studies.
+        record_fields: bool,
+    },
+    /// Convergence studies: `time` (a sequence of steps), `mesh` (a sequence of mesh
+    /// sizes), `collect` (tables and plots of an emitted sweep run elsewhere).
+    Study {
+        #[command(subcommand)]
+        study: StudyCommand,
+    },
+    /// Run a scenario through the implicit path (backward Euler, contact QP) and the
+    /// explicit path (central differences, kinematic contact) and set the two ledgers
+    /// side by side.
+    Compare {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        #[command(flatten)]
+        sweep: SweepArgs,
+    },
+    /// Draw the charts of a run's output directory into DIR/plots (PNG and SVG).
+    Plot {
+        /// A run's output directory (with history.csv).
+        dir: PathBuf,
+    },
+    /// Run the paper's two benchmarks (every model and mesh, implicit and explicit)
+    /// and write report.md with tables and plots.
+    Report {
+        /// Directory holding two_blocks.toml and rc_beam_punch.toml.
+        #[arg(long, default_value = "examples/benchmarks")]
+        benchmarks: PathBuf,
+        /// Benchmark 1's mesh sizes (m).
+        #[arg(long, value_delimiter = ',', default_value = "0.2,0.15,0.1,0.05")]
+        meshes: Vec<f64>,
+        /// Benchmark 1's mesh of the implicit-against-explicit comparison (m).
+        #[arg(long, default_value_t = 0.1)]
+        compare_mesh: f64,
+        /// Benchmark 2's element size (m); default the scenario's.
         #[arg(long)]
-        allow_unstable: bool,
+        beam_size: Option<f64>,
+        /// Set one value of every run's scenario, `dotted.path=value` (repeatable).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        sets: Vec<String>,
+        #[command(flatten)]
+        sweep: SweepArgs,
     },
     /// Drive one material point along a strain or stress path; writes material.csv.
     Material {
@@ -57,14 +96,8 @@ enum Command {
     /// Validate a scenario and print its size, steps and output volume, the explicit
     /// CFL step and the memory it needs, without solving.
     Check {
-        /// Scenario file (TOML).
-        scenario: PathBuf,
-        /// Report even when the memory estimate exceeds the memory available.
-        #[arg(long)]
-        ignore_memory: bool,
-        /// Accept an explicit step above the critical (CFL) step.
-        #[arg(long)]
-        allow_unstable: bool,
+        #[command(flatten)]
+        scenario: ScenarioArgs,
         /// Also write K, M, the first step's effective matrix and the contact gap
         /// rows G in Matrix Market format into this directory.
         #[arg(long)]
@@ -72,33 +105,172 @@ enum Command {
     },
 }
 
-fn load_options(ignore_memory: bool, allow_unstable: bool) -> LoadOptions {
-    let mut opts = if ignore_memory {
-        LoadOptions::unlimited()
-    } else {
-        LoadOptions::default()
-    };
-    opts.allow_unstable = allow_unstable;
-    opts
+/// The convergence studies.
+#[derive(Subcommand)]
+enum StudyCommand {
+    /// The scenario for a sequence of steps h: errors of the Rothe interpolants
+    /// against the finest run, observed orders, Richardson estimates.
+    Time {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        /// The steps (s), comma separated.
+        #[arg(long = "h", value_delimiter = ',', conflicts_with = "halvings")]
+        h: Vec<f64>,
+        /// Or: the scenario's step and N halvings of it.
+        #[arg(long)]
+        halvings: Option<usize>,
+        #[command(flatten)]
+        sweep: SweepArgs,
+    },
+    /// The scenario for a sequence of mesh sizes (`meshing.element_size`).
+    Mesh {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        /// The element sizes (m), comma separated.
+        #[arg(long, value_delimiter = ',', required = true)]
+        sizes: Vec<f64>,
+        #[command(flatten)]
+        sweep: SweepArgs,
+    },
+    /// Tables, plots and summary of a sweep whose runs were made elsewhere (from
+    /// `--emit`): reads DIR/plan.json and DIR/runs/*.
+    Collect {
+        /// The study directory.
+        dir: PathBuf,
+    },
+}
+
+/// Where a sweep writes and how it runs.
+#[derive(Args, Clone, Debug)]
+struct SweepArgs {
+    /// Output directory of the sweep.
+    #[arg(long, default_value = "out/study")]
+    out: PathBuf,
+    /// Do not run: write DIR/runs.txt (one `rothe run` per line), DIR/slurm.sh (a job
+    /// array) and DIR/plan.json, for `rothe study collect DIR` afterwards.
+    #[arg(long, value_name = "DIR")]
+    emit: Option<PathBuf>,
+    /// Runs at once (default: the machine's cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// No progress display.
+    #[arg(long)]
+    quiet: bool,
+}
+
+impl SweepArgs {
+    /// Emits the plan, or sweeps and collects it.
+    fn execute(&self, plan: &rothe::study::Plan) -> rothe::Result<()> {
+        if let Some(dir) = &self.emit {
+            for f in plan.emit(dir)? {
+                println!("wrote {}", f.display());
+            }
+            println!(
+                "{} runs; run them (e.g. `sbatch {}`), then `rothe study collect {}`",
+                plan.runs.len(),
+                dir.join("slurm.sh").display(),
+                dir.display()
+            );
+            return Ok(());
+        }
+        let mut opts = rothe::study::SweepOptions {
+            progress: !self.quiet,
+            ..Default::default()
+        };
+        if let Some(j) = self.jobs {
+            opts.jobs = j;
+        }
+        let outcomes = rothe::study::sweep(plan, &self.out, &opts)?;
+        let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
+        let md = rothe::study::collect(&self.out)?;
+        if plan.kind == rothe::study::StudyKind::Report {
+            println!("wrote {}", self.out.join("report.md").display());
+        } else {
+            println!("{md}");
+        }
+        eprintln!(
+            "{} runs ({failed} failed) in {:.1} s of run time; output in {}",
+            outcomes.len(),
+            outcomes.iter().map(|o| o.seconds).sum::<f64>(),
+            self.out.display()
+        );
+        Ok(())
+    }
+}
+
+/// A scenario and how to read it: the file, its variants and overrides, and the
+/// checks a user may lift.
+#[derive(Args, Clone, Debug)]
+struct ScenarioArgs {
+    /// Scenario file (TOML).
+    scenario: PathBuf,
+    /// Select an option of one of the scenario's variant groups, `group=option`
+    /// (repeatable), e.g. `--variant concrete=mazars`.
+    #[arg(long = "variant", value_name = "GROUP=OPTION")]
+    variants: Vec<String>,
+    /// Set one value of the scenario, `dotted.path=value` (repeatable), e.g.
+    /// `--set analysis.dt=5e-7 --set meshing.element_size=0.05`.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    sets: Vec<String>,
+    /// Remove one key of the scenario (its default applies), e.g. `--unset
+    /// analysis.dt` for the explicit scheme's stable step (repeatable).
+    #[arg(long = "unset", value_name = "PATH")]
+    unsets: Vec<String>,
+    /// Go on even when the memory estimate exceeds the memory available.
+    #[arg(long)]
+    ignore_memory: bool,
+    /// Accept an explicit step above the critical (CFL) step, for stability
+    /// studies.
+    #[arg(long)]
+    allow_unstable: bool,
+}
+
+impl ScenarioArgs {
+    fn options(&self) -> LoadOptions {
+        let mut opts = if self.ignore_memory {
+            LoadOptions::unlimited()
+        } else {
+            LoadOptions::default()
+        };
+        opts.allow_unstable = self.allow_unstable;
+        opts
+    }
+
+    fn overrides(&self) -> rothe::Result<Overrides> {
+        let mut ov = Overrides::none();
+        for v in &self.variants {
+            ov = ov.variant(v)?;
+        }
+        for p in &self.unsets {
+            ov = ov.unset(p);
+        }
+        for s in &self.sets {
+            ov = ov.set(s)?;
+        }
+        Ok(ov)
+    }
+
+    fn load(&self) -> rothe::Result<rothe::model::Model> {
+        rothe::config::load_with_overrides(&self.scenario, &self.options(), &self.overrides()?)
+    }
 }
 
 fn run_command(
-    scenario: &Path,
+    scenario: &ScenarioArgs,
     out: &Path,
     backend: Backend,
     quiet: bool,
-    ignore_memory: bool,
-    allow_unstable: bool,
+    record_fields: bool,
 ) -> rothe::Result<()> {
-    let opts = load_options(ignore_memory, allow_unstable);
-    let model = rothe::config::load_with(scenario, &opts)?;
+    let model = scenario.load()?;
     let summary = run(
         &model,
         &RunOptions {
             out: out.to_path_buf(),
             backend,
             progress: !quiet,
-            memory_limit: opts.memory_limit,
+            memory_limit: scenario.options().memory_limit,
+            record_fields,
         },
     )?;
     eprintln!(
@@ -118,8 +290,19 @@ fn main() -> ExitCode {
     // A panic is reported below as an internal error, not printed by the default hook.
     std::panic::set_hook(Box::new(|_| {}));
     let input = match &cli.command {
-        Command::Run { scenario, .. } | Command::Check { scenario, .. } => scenario.clone(),
+        Command::Run { scenario, .. } | Command::Check { scenario, .. } => {
+            scenario.scenario.clone()
+        }
         Command::Material { file, .. } => file.clone(),
+        Command::Compare { scenario, .. } => scenario.scenario.clone(),
+        Command::Study { study } => match study {
+            StudyCommand::Time { scenario, .. } | StudyCommand::Mesh { scenario, .. } => {
+                scenario.scenario.clone()
+            }
+            StudyCommand::Collect { dir } => dir.clone(),
+        },
+        Command::Plot { dir } => dir.clone(),
+        Command::Report { benchmarks, .. } => benchmarks.clone(),
     };
     let out_dir = match &cli.command {
         Command::Run { out, .. } => Some(out.clone()),
@@ -131,16 +314,26 @@ fn main() -> ExitCode {
             out,
             backend,
             quiet,
-            ignore_memory,
-            allow_unstable,
-        } => run_command(
-            &scenario,
-            &out,
-            backend,
-            quiet,
-            ignore_memory,
-            allow_unstable,
-        ),
+            record_fields,
+        } => run_command(&scenario, &out, backend, quiet, record_fields),
+        Command::Study { study } => study_command(study),
+        Command::Compare { scenario, sweep } => scenario
+            .overrides()
+            .and_then(|base| rothe::study::compare::plan(&scenario.scenario, &base))
+            .and_then(|plan| sweep.execute(&plan)),
+        Command::Plot { dir } => rothe::plot::plot_run(&dir).map(|files| {
+            for f in files {
+                println!("wrote {}", f.display());
+            }
+        }),
+        Command::Report {
+            benchmarks,
+            meshes,
+            compare_mesh,
+            beam_size,
+            sets,
+            sweep,
+        } => report_command(benchmarks, meshes, compare_mesh, beam_size, &sets, sweep),
         Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out)
             .map(|steps| {
                 eprintln!(
@@ -148,15 +341,10 @@ fn main() -> ExitCode {
                     out.join("material.csv").display()
                 );
             }),
-        Command::Check {
-            scenario,
-            ignore_memory,
-            allow_unstable,
-            matrices,
-        } => {
-            let opts = load_options(ignore_memory, allow_unstable);
-            rothe::config::load_with(&scenario, &opts).and_then(|model| {
-                let report = rothe::check::report(&model, opts.memory_limit)?;
+        Command::Check { scenario, matrices } => {
+            let limit = scenario.options().memory_limit;
+            scenario.load().and_then(|model| {
+                let report = rothe::check::report(&model, limit)?;
                 print!("{report}");
                 if let Some(dir) = matrices {
                     for f in rothe::check::write_matrices(&model, &dir)? {
@@ -185,6 +373,61 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn study_command(study: StudyCommand) -> rothe::Result<()> {
+    match study {
+        StudyCommand::Time {
+            scenario,
+            h,
+            halvings,
+            sweep,
+        } => {
+            let base = scenario.overrides()?;
+            let hs = match halvings {
+                Some(n) => rothe::study::time_study::halvings(&scenario.scenario, &base, n)?,
+                None => h,
+            };
+            let plan = rothe::study::time_study::plan(&scenario.scenario, &base, &hs)?;
+            sweep.execute(&plan)
+        }
+        StudyCommand::Mesh {
+            scenario,
+            sizes,
+            sweep,
+        } => {
+            let base = scenario.overrides()?;
+            let plan = rothe::study::mesh_study::plan(&scenario.scenario, &base, &sizes)?;
+            sweep.execute(&plan)
+        }
+        StudyCommand::Collect { dir } => rothe::study::collect(&dir).map(|md| println!("{md}")),
+    }
+}
+
+fn report_command(
+    benchmarks: PathBuf,
+    meshes: Vec<f64>,
+    compare_mesh: f64,
+    beam_size: Option<f64>,
+    sets: &[String],
+    mut sweep: SweepArgs,
+) -> rothe::Result<()> {
+    let mut base = Overrides::none();
+    for s in sets {
+        base = base.set(s)?;
+    }
+    let opts = rothe::study::report::ReportOptions {
+        benchmarks,
+        meshes,
+        compare_mesh,
+        beam_size,
+        base,
+    };
+    if sweep.out == Path::new("out/study") {
+        sweep.out = PathBuf::from("out/report");
+    }
+    let plan = rothe::study::report::plan(&opts)?;
+    sweep.execute(&plan)
 }
 
 /// After a panic outside the run's own guard: marks an existing `summary.json` as

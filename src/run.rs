@@ -16,6 +16,7 @@ use crate::energy::Ledger;
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;
 use crate::model::{AnalysisKind, Model, TimeScheme};
+use crate::output::checks::Checks;
 use crate::output::recorder::{Recorder, Snapshot};
 use crate::output::summary::{EnergySummary, SolverSummary, Summary, TimingSummary};
 use crate::time::backward_euler::BackwardEuler;
@@ -36,6 +37,9 @@ pub struct RunOptions {
     /// Refuse a factor whose memory estimate exceeds this many bytes, before it is
     /// allocated (`None`: no limit).
     pub memory_limit: Option<u64>,
+    /// Also write every step's displacement to `fields.bin`
+    /// ([`crate::output::fields`]), for the time study's error norms.
+    pub record_fields: bool,
 }
 
 impl RunOptions {
@@ -46,6 +50,7 @@ impl RunOptions {
             backend,
             progress: false,
             memory_limit: None,
+            record_fields: false,
         }
     }
 }
@@ -95,6 +100,9 @@ pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
     let start = Instant::now();
     let mut rec = Recorder::new(model, &opts.out)?;
+    if opts.record_fields {
+        rec.record_fields(model, &opts.out)?;
+    }
     let a = &model.analysis;
     let mut summary = Summary {
         status: "running".into(),
@@ -107,6 +115,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         probes: Default::default(),
         contact: Default::default(),
         energy: EnergySummary::from(&Ledger::default()),
+        checks: Checks::of(&Ledger::default()),
         timing: TimingSummary::zero(),
         solver: SolverSummary {
             backend: opts.backend.name().into(),
@@ -137,6 +146,9 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         Ok(()) => {
             summary.status = "completed".into();
             summary.write(&summary_path)?;
+            for f in summary.checks.failures() {
+                eprintln!("warning: {}: energy check failed: {f}", opts.out.display());
+            }
             Ok(summary)
         }
         Err(e) => {
@@ -155,6 +167,7 @@ fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I
     summary.steps = s.step;
     summary.t_end = s.t;
     summary.energy = EnergySummary::from(&s.ledger);
+    summary.checks = Checks::of(&s.ledger);
     summary.probes = rec.probes().clone();
     summary.contact = rec.contact().clone();
     summary.timing.assembly_s = timing.assembly_s;

@@ -523,6 +523,7 @@ fn full_run_histories_agree() {
             backend,
             progress: false,
             memory_limit: None,
+            record_fields: false,
         };
         let summary = rothe::run::run(&model, &opts).unwrap();
         assert_eq!(summary.status, "completed");

@@ -30,6 +30,7 @@ fn run_text(text: &str, dir: &std::path::Path) -> rothe::Result<rothe::output::s
             backend: Backend::Faer,
             progress: false,
             memory_limit: None,
+            record_fields: false,
         },
     )
 }

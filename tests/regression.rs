@@ -104,6 +104,7 @@ fn histories_match_their_references() {
                 backend: Backend::Faer,
                 progress: false,
                 memory_limit: None,
+                record_fields: false,
             },
         )
         .unwrap();

@@ -4,6 +4,7 @@
 //!
 //! Start with [`load`]; the format is documented in the README and `examples/`.
 
+pub mod overrides;
 mod validate;
 
 pub use validate::{material, HUGE_STEPS};
@@ -56,6 +57,8 @@ impl LoadOptions {
 use std::collections::BTreeMap;
 use std::path::Path;
 
+pub use overrides::Overrides;
+
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
@@ -91,6 +94,20 @@ pub struct Scenario {
     /// Contact pairs and unilateral supports.
     #[serde(default)]
     pub contact: Vec<ContactSpec>,
+    /// Defaults of the generated meshes.
+    #[serde(default)]
+    pub meshing: MeshingSpec,
+}
+
+/// `[meshing]`: defaults of the generated (rectangle) meshes, so that one key sets the
+/// mesh size of every body (`--set meshing.element_size=0.05`, `rothe study mesh`).
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshingSpec {
+    /// Cell size (m) of every rectangle body that gives neither `divisions` nor its
+    /// own `element_size`.
+    #[serde(default)]
+    pub element_size: Option<f64>,
 }
 
 /// `[[contact]]`: a slave node or edge set against a master edge set of another body
@@ -419,8 +436,23 @@ pub enum MeshSpec {
         origin: [f64; 2],
         /// Width and height.
         size: [f64; 2],
-        /// Cells along x and y.
-        divisions: [usize; 2],
+        /// Cells along x and y (equal cells). Give this, or `element_size` (here or in
+        /// `[meshing]`).
+        #[serde(default)]
+        divisions: Option<[usize; 2]>,
+        /// Largest cell size (m): each side (each band between `x_lines` /
+        /// `y_lines`) is cut into the fewest equal cells no larger than it. Overrides
+        /// `[meshing] element_size` for this body.
+        #[serde(default)]
+        element_size: Option<f64>,
+        /// Grid lines the mesh must have, as distances from `origin` along x
+        /// (strictly inside, increasing): rebar lines, a probe's node, the edge of
+        /// another body. Only with `element_size`.
+        #[serde(default)]
+        x_lines: Vec<f64>,
+        /// The same along y.
+        #[serde(default)]
+        y_lines: Vec<f64>,
         /// `quad4` (default) or `tri3`.
         #[serde(default = "default_element")]
         element: ElementKind,
@@ -541,41 +573,61 @@ pub fn load(path: &Path) -> Result<Model> {
 
 /// [`load`] with options.
 pub fn load_with(path: &Path, opts: &LoadOptions) -> Result<Model> {
+    load_with_overrides(path, opts, &Overrides::none())
+}
+
+/// [`load_with`] after selecting variants and setting values ([`overrides`]).
+pub fn load_with_overrides(path: &Path, opts: &LoadOptions, ov: &Overrides) -> Result<Model> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let scenario = parse(&text).map_err(|e| match e {
+    let in_file = |e: Error| match e {
         Error::Config { field, message } => Error::Config {
             field: format!("{}: {field}", path.display()),
             message,
         },
         other => other,
-    })?;
+    };
+    let scenario = parse_with(&text, ov).map_err(in_file)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    validate::build(&scenario, dir, opts).map_err(|e| match e {
-        Error::Config { field, message } => Error::Config {
-            field: format!("{}: {field}", path.display()),
-            message,
-        },
-        other => other,
-    })
+    validate::build(&scenario, dir, opts).map_err(in_file)
+}
+
+/// Parses scenario text after applying `ov` (no validation). Without variants and
+/// overrides this is [`parse`], whose messages give line numbers.
+pub fn parse_with(text: &str, ov: &Overrides) -> Result<Scenario> {
+    let table: toml::Table = toml::from_str(text).map_err(|e| toml_error(text, e))?;
+    if ov.is_empty() && !table.contains_key("variants") {
+        return parse(text);
+    }
+    let merged = overrides::apply(table, ov)?;
+    toml::Value::Table(merged)
+        .try_into()
+        .map_err(|e: toml::de::Error| {
+            Error::config(
+                "scenario (after variants and --set)",
+                e.message().to_string(),
+            )
+        })
+}
+
+fn toml_error(text: &str, e: toml::de::Error) -> Error {
+    let span = e.span().map(|s| {
+        let end = s.start.min(text.len());
+        let line = text.as_bytes()[..end]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1;
+        format!("line {line}")
+    });
+    Error::config(
+        span.unwrap_or_else(|| "scenario".into()),
+        e.message().to_string(),
+    )
 }
 
 /// Parses scenario text (no validation).
 pub fn parse(text: &str) -> Result<Scenario> {
-    toml::from_str(text).map_err(|e| {
-        let span = e.span().map(|s| {
-            let end = s.start.min(text.len());
-            let line = text.as_bytes()[..end]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1;
-            format!("line {line}")
-        });
-        Error::config(
-            span.unwrap_or_else(|| "scenario".into()),
-            e.message().to_string(),
-        )
-    })
+    toml::from_str(text).map_err(|e| toml_error(text, e))
 }
 
 /// Parses and validates scenario text; relative mesh paths resolve against `dir`.
@@ -585,7 +637,7 @@ pub fn from_str(text: &str, dir: &Path) -> Result<Model> {
 
 /// [`from_str`] with options.
 pub fn from_str_with(text: &str, dir: &Path, opts: &LoadOptions) -> Result<Model> {
-    validate::build(&parse(text)?, dir, opts)
+    validate::build(&parse_with(text, &Overrides::none())?, dir, opts)
 }
 
 /// The memory estimate of a model (the factor's exact nonzeros when known).

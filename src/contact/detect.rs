@@ -245,10 +245,63 @@ impl Chain {
     }
 }
 
+/// The slaves of rigid lines that lie below their line's level by more than `depth`
+/// at the geometry `x(node)` (committed: the start of a step), as `(pair, side,
+/// slave)`.
+///
+/// A rigid line is a support of finite length. A slave just beyond its end is free
+/// and may sink below the line's level (a beam rotating over the edge of its
+/// support); if it later moves sideways back within the line's ends it passes beside
+/// the support's end face, and a node-to-line constraint would instead fling it up
+/// onto the line in one step: an impulse doing large positive work (`D_contact`
+/// went to −12 `E_kin⁰` in benchmark 2's Kelvin-Voigt beam before this rule). A slave
+/// held by the line never lies that deep (its steps accept at most the contact
+/// tolerance), so such slaves are not candidates of that line for the step.
+pub fn beneath_rigid<X>(pairs: &[ContactPair], x: X, depth: f64) -> Vec<(usize, usize, usize)>
+where
+    X: Fn(usize) -> [f64; 2],
+{
+    let mut out = Vec::new();
+    for (pi, pair) in pairs.iter().enumerate() {
+        for (si, side) in pair.sides.iter().enumerate() {
+            if let Master::Rigid { a, n, .. } = &side.master {
+                for &s in &side.slaves {
+                    let p = x(s);
+                    if (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1] < -depth {
+                        out.push((pi, si, s));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Candidates of every pair at the geometry `x(node)`, appended to `out` (cleared
 /// first), ordered by pair, side and slave node (a slave in a notch gives two, by
 /// segment).
 pub fn detect<X>(pairs: &[ContactPair], x: X, out: &mut Vec<Candidate>)
+where
+    X: Fn(usize) -> [f64; 2],
+{
+    detect_except(pairs, x, &RigidHistory::default(), out)
+}
+
+/// What a step knows of its rigid lines' slaves from the committed state, as sorted
+/// `(pair, side, slave)` lists.
+#[derive(Clone, Debug, Default)]
+pub struct RigidHistory {
+    /// Slaves that came around a line's end ([`beneath_rigid`]): not candidates.
+    pub beneath: Vec<(usize, usize, usize)>,
+    /// Slaves the line held at the end of the last step: candidates even a little
+    /// beyond the line's ends (within the pair's radius), so that a slave at the very
+    /// end of a support, which slides outward as the body above it bends, stays on
+    /// it instead of slipping off and coming back around the end.
+    pub held: Vec<(usize, usize, usize)>,
+}
+
+/// [`detect`] with what the committed state knows of the rigid lines' slaves.
+pub fn detect_except<X>(pairs: &[ContactPair], x: X, rigid: &RigidHistory, out: &mut Vec<Candidate>)
 where
     X: Fn(usize) -> [f64; 2],
 {
@@ -348,12 +401,15 @@ where
                     let t = [b[0] - a[0], b[1] - a[1]];
                     let l2 = t[0] * t[0] + t[1] * t[1];
                     for &s in &side.slaves {
+                        if rigid.beneath.binary_search(&(pi, si, s)).is_ok() {
+                            continue;
+                        }
                         let p = x(s);
                         let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
                         let gap = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
-                        if (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi)
-                            && gap * gap <= r2
-                        {
+                        let within = (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi)
+                            || rigid.held.binary_search(&(pi, si, s)).is_ok();
+                        if within && gap * gap <= r2 {
                             out.push(Candidate {
                                 pair: pi,
                                 side: si,
@@ -503,11 +559,28 @@ mod tests {
             position_weight: 0.5,
         };
         let mut out = Vec::new();
-        detect(&[pair], |n| coords[n], &mut out);
+        detect(std::slice::from_ref(&pair), |n| coords[n], &mut out);
         // Node 0 is beyond the radius, node 1 beyond the end of the line.
         assert_eq!(out.len(), 1);
         assert_eq!(out[0].slave, 2);
         assert!((out[0].gap + 0.001).abs() < 1e-15);
         assert_eq!(out[0].row().1, 2);
+        // Node 2 below the line by more than the depth is passed over.
+        let pairs = [pair];
+        let beneath = beneath_rigid(&pairs, |n| coords[n], 5e-4);
+        assert_eq!(beneath, [(0, 0, 2)]);
+        let mut rigid = RigidHistory {
+            beneath,
+            held: Vec::new(),
+        };
+        detect_except(&pairs, |n| coords[n], &rigid, &mut out);
+        assert!(out.is_empty());
+        // A held slave stays a candidate beyond the line's end (node 1 at ξ = 2.2
+        // is within the radius of the line's level).
+        rigid.held = vec![(0, 0, 1)];
+        detect_except(&pairs, |n| coords[n], &rigid, &mut out);
+        assert_eq!(out.len(), 1);
+        assert_eq!((out[0].slave, out[0].xi), (1, 1.0));
+        assert!(beneath_rigid(&pairs, |n| coords[n], 2e-3).is_empty());
     }
 }

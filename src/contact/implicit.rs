@@ -144,7 +144,14 @@ pub struct ContactCorrection<'m> {
     qp_generation: usize,
     dual: DualQp,
     stats: ContactStats,
+    rigid: super::detect::RigidHistory,
 }
+
+/// How many contact tolerances below a rigid line a slave lies at the start of a
+/// step when it came around the line's end ([`super::detect::beneath_rigid`]): a
+/// slave the line holds lies at most one below it (accepted steps penetrate at most
+/// the tolerance); two leave room for round-off.
+const BENEATH_TOLERANCES: f64 = 2.0;
 
 impl<'m> ContactCorrection<'m> {
     /// The correction for the contact pairs of `model`.
@@ -185,12 +192,21 @@ impl<'m> ContactCorrection<'m> {
             qp_generation: usize::MAX,
             dual: DualQp::default(),
             stats: ContactStats::default(),
+            rigid: Default::default(),
         }
     }
 
     /// Starts a step from the contact state of the last one: its multipliers are the
     /// first guess of the forces, its active set the reference of the first QP.
-    pub fn begin_step(&mut self, committed: &ContactState, lead: Option<(f64, &[f64])>) {
+    pub fn begin_step(&mut self, committed: &ContactState, u: &[f64], lead: Option<(f64, &[f64])>) {
+        // Slaves that came around the end of a rigid line are not its candidates;
+        // those it holds stay on it a little beyond its ends.
+        let coords = &self.model.mesh.coords;
+        self.rigid.beneath = super::detect::beneath_rigid(
+            self.pairs,
+            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+            BENEATH_TOLERANCES * self.tol,
+        );
         // The displacement h v the step is expected to make, by which the first
         // correction is linearised ahead (zero on the constrained dofs).
         self.lead.clear();
@@ -216,6 +232,14 @@ impl<'m> ContactCorrection<'m> {
             .collect();
         self.previous = self.current.clone();
         self.added = false;
+        self.rigid.held = self
+            .current
+            .iter()
+            .filter(|k| k.3 == usize::MAX)
+            .map(|k| (k.0, k.1, k.2))
+            .collect();
+        self.rigid.held.sort_unstable();
+        self.rigid.held.dedup();
     }
 
     /// Ends an accepted step with increment `du`: writes the contact state and returns
@@ -263,7 +287,12 @@ impl<'m> ContactCorrection<'m> {
             self.x[2 * n + 1] = c[1] + u[2 * n + 1];
         }
         let x = &self.x;
-        detect(self.pairs, |n| [x[2 * n], x[2 * n + 1]], &mut self.cands);
+        super::detect::detect_except(
+            self.pairs,
+            |n| [x[2 * n], x[2 * n + 1]],
+            &self.rigid,
+            &mut self.cands,
+        );
         self.stats.detect_s += t.elapsed().as_secs_f64();
     }
 

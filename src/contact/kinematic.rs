@@ -22,7 +22,7 @@ use rstar::primitives::{GeomWithData, Line};
 use rstar::RTree;
 
 use super::collision::node_segment;
-use super::detect::{detect, Candidate};
+use super::detect::Candidate;
 use super::implicit::{ContactState, PairRecord};
 use super::qp::{on_active_set, solve_by_active_set, DualQp};
 use crate::error::{Error, Result};
@@ -108,6 +108,10 @@ pub struct KinematicStats {
     pub projected: usize,
 }
 
+/// Contact tolerances below a rigid line that mark a slave come around its end
+/// ([`super::detect::beneath_rigid`]).
+const BENEATH_TOLERANCES: f64 = 2.0;
+
 /// The kinematic contact of a model's pairs.
 pub struct KinematicContact<'m> {
     model: &'m Model,
@@ -127,6 +131,7 @@ pub struct KinematicContact<'m> {
     dual: DualQp,
     step: KinematicStats,
     total: KinematicStats,
+    rigid: super::detect::RigidHistory,
 }
 
 impl<'m> KinematicContact<'m> {
@@ -149,6 +154,7 @@ impl<'m> KinematicContact<'m> {
             dual: DualQp::default(),
             step: KinematicStats::default(),
             total: KinematicStats::default(),
+            rigid: Default::default(),
         }
     }
 
@@ -171,6 +177,13 @@ impl<'m> KinematicContact<'m> {
     ) -> Result<()> {
         self.step = KinematicStats::default();
         self.impulses.clear();
+        // Slaves that came around the end of a rigid line pass beside it.
+        let coords = &self.model.mesh.coords;
+        self.rigid.beneath = super::detect::beneath_rigid(
+            &self.model.contacts,
+            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+            BENEATH_TOLERANCES * self.model.analysis.contact_tolerance,
+        );
         self.collisions(u, v, h);
         if !self.rows.is_empty() {
             self.v_pre.clear();
@@ -249,6 +262,9 @@ impl<'m> KinematicContact<'m> {
                             (*b, *a)
                         };
                         for &s in &side.slaves {
+                            if self.rigid.beneath.binary_search(&(pi, si, s)).is_ok() {
+                                continue;
+                            }
                             if let Some(c) =
                                 node_segment(at(s), vel(s), a, [0.0; 2], b, [0.0; 2], h)
                             {
@@ -448,7 +464,7 @@ impl<'m> KinematicContact<'m> {
     /// Candidates at the geometry `u + du`.
     fn end_geometry(&mut self, u: &[f64], du: &[f64]) {
         let coords = &self.model.mesh.coords;
-        detect(
+        super::detect::detect_except(
             &self.model.contacts,
             |n| {
                 [
@@ -456,6 +472,7 @@ impl<'m> KinematicContact<'m> {
                     coords[n][1] + u[2 * n + 1] + du[2 * n + 1],
                 ]
             },
+            &self.rigid,
             &mut self.cands,
         );
     }

@@ -137,6 +137,36 @@ impl Material {
         elasticity(self.e, self.nu, plane)
     }
 
+    /// The stiffness the material shows to a sudden strain (what an explicit step
+    /// sees): `C`, and `(1 + α) C` for the standard linear solid (`α C` without the
+    /// parallel spring), whose Maxwell branch answers at once.
+    pub fn instantaneous_stiffness(&self, plane: Plane) -> [[f64; 3]; 3] {
+        let c = self.c(plane);
+        match self.model {
+            Model::Sls {
+                alpha, parallel, ..
+            } => {
+                let f = alpha + if parallel { 1.0 } else { 0.0 };
+                c.map(|row| row.map(|x| f * x))
+            }
+            _ => c,
+        }
+    }
+
+    /// The viscosity `η` of a Kelvin-Voigt material (`σ_v = η ε̇`, Voigt form on
+    /// engineering strain), `None` for the others.
+    pub fn viscosity(&self, plane: Plane) -> Option<[[f64; 3]; 3]> {
+        match self.model {
+            Model::KelvinVoigt(Viscosity::Proportional(alpha)) => {
+                Some(self.c(plane).map(|row| row.map(|x| alpha * x)))
+            }
+            Model::KelvinVoigt(Viscosity::Identity(beta)) => {
+                Some(viscoelastic::identity_viscosity(beta))
+            }
+            _ => None,
+        }
+    }
+
     /// True when the stress is `C ε` with no history: the stiffness is constant and
     /// the global force is `K u`, so no Gauss-point loop is needed per step.
     pub fn is_linear_elastic(&self) -> bool {

@@ -3,6 +3,8 @@
 //! collection rewritten after each, and `summary.json` at the end (also on failure,
 //! with the error).
 
+pub mod checks;
+pub mod fields;
 pub mod history;
 pub mod post;
 pub mod recorder;

@@ -50,6 +50,7 @@ pub struct Recorder {
     pair_names: Vec<String>,
     last_t: f64,
     empty_pairs: Vec<PairRecord>,
+    fields: Option<super::fields::FieldWriter>,
 }
 
 impl Recorder {
@@ -81,7 +82,17 @@ impl Recorder {
             empty_pairs: vec![PairRecord::default(); pair_names.len()],
             pair_names,
             last_t: 0.0,
+            fields: None,
         })
+    }
+
+    /// Also writes every recorded state's displacement to `out/fields.bin`.
+    pub fn record_fields(&mut self, model: &Model, out: &Path) -> Result<()> {
+        self.fields = Some(super::fields::FieldWriter::create(
+            &out.join("fields.bin"),
+            model.mesh.n_dofs(),
+        )?);
+        Ok(())
     }
 
     /// Records one state: a history row, and a VTK file when the step is on the
@@ -115,6 +126,9 @@ impl Recorder {
             &self.samples,
             pairs,
         )?;
+        if let Some(f) = &mut self.fields {
+            f.append(s.t, s.u)?;
+        }
         if let Some(vtk) = &mut self.vtk {
             if s.step % self.vtk_every == 0 {
                 let extra = if s.points.is_empty() {

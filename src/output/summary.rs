@@ -180,6 +180,8 @@ pub struct Summary {
     pub contact: BTreeMap<String, ContactSummary>,
     /// Energies.
     pub energy: EnergySummary,
+    /// The paper's energy checks with their values.
+    pub checks: super::checks::Checks,
     /// Timings.
     pub timing: TimingSummary,
     /// Solver facts.

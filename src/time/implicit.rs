@@ -689,7 +689,7 @@ pub(crate) enum Corrector<'m> {
 impl Corrector<'_> {
     fn begin_step(&mut self, s: &State, h: Option<f64>) {
         if let Corrector::Contact(c) = self {
-            c.begin_step(&s.contact, h.map(|h| (h, s.v.as_slice())));
+            c.begin_step(&s.contact, &s.u, h.map(|h| (h, s.v.as_slice())));
         }
     }
 

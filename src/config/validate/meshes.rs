@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::checks::{finite, positive};
-use crate::config::{LoadOptions, MeshSpec, Scenario};
+use crate::config::{LoadOptions, MeshSpec, MeshingSpec, Scenario};
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::memory::{factor_nnz_estimate, Estimate};
@@ -14,16 +14,115 @@ use crate::model::Body;
 
 /// The nodes and elements of a rectangle of `nx x ny` cells, or `None` if the counts
 /// overflow.
-fn rectangle_size(nx: usize, ny: usize, element: ElementKind) -> Option<(u64, u64)> {
-    let nodes = (nx as u64)
-        .checked_add(1)?
-        .checked_mul((ny as u64).checked_add(1)?)?;
-    let cells = (nx as u64).checked_mul(ny as u64)?;
+fn rectangle_size(nx: u64, ny: u64, element: ElementKind) -> Option<(u64, u64)> {
+    let nodes = nx.checked_add(1)?.checked_mul(ny.checked_add(1)?)?;
+    let cells = nx.checked_mul(ny)?;
     let elements = match element {
         ElementKind::Tri3 => cells.checked_mul(2)?,
         _ => cells,
     };
     Some((nodes, elements))
+}
+
+/// How one rectangle is cut, resolved from its spec and `[meshing]`.
+enum Cuts<'a> {
+    /// `divisions`: equal cells.
+    Equal([usize; 2]),
+    /// `element_size` with optional grid lines.
+    Sized { size: f64, lines: [&'a [f64]; 2] },
+}
+
+/// Resolves and checks a rectangle's cuts (before anything is allocated).
+fn rectangle_cuts<'a>(
+    field: &str,
+    size: [f64; 2],
+    divisions: Option<[usize; 2]>,
+    element_size: Option<f64>,
+    lines: [&'a [f64]; 2],
+    meshing: &MeshingSpec,
+) -> Result<Cuts<'a>> {
+    if let Some(d) = divisions {
+        if element_size.is_some() {
+            return Err(Error::config(
+                format!("{field}.element_size"),
+                "give `divisions` or `element_size`, not both",
+            ));
+        }
+        if !lines[0].is_empty() || !lines[1].is_empty() {
+            return Err(Error::config(
+                format!("{field}.x_lines"),
+                "grid lines need `element_size` (here or in [meshing]), not `divisions`",
+            ));
+        }
+        if d[0] == 0 || d[1] == 0 {
+            return Err(Error::config(
+                format!("{field}.divisions"),
+                format!("must be at least 1 each way, got {d:?}"),
+            ));
+        }
+        return Ok(Cuts::Equal(d));
+    }
+    let (h, h_field) = match (element_size, meshing.element_size) {
+        (Some(h), _) => (h, format!("{field}.element_size")),
+        (None, Some(h)) => (h, "meshing.element_size".to_string()),
+        (None, None) => {
+            return Err(Error::config(
+                format!("{field}.divisions"),
+                "give `divisions`, or `element_size` here or in [meshing]",
+            ))
+        }
+    };
+    positive(&h_field, h)?;
+    for (axis, name) in [(0, "x_lines"), (1, "y_lines")] {
+        let f = format!("{field}.{name}");
+        finite(&f, lines[axis])?;
+        let mut prev = 0.0;
+        for &c in lines[axis] {
+            if c <= prev || c >= size[axis] {
+                return Err(Error::config(
+                    &f,
+                    format!(
+                        "grid lines must increase strictly inside (0, {}), got {:?}",
+                        size[axis], lines[axis]
+                    ),
+                ));
+            }
+            prev = c;
+        }
+        // Count the cells before building anything: a tiny size is refused here.
+        let cells = cells_along(size[axis], h, lines[axis]);
+        if cells > 1e9 {
+            return Err(Error::config(
+                &h_field,
+                format!("{h} m gives {cells:.3e} cells along {name}: far too many"),
+            ));
+        }
+    }
+    Ok(Cuts::Sized { size: h, lines })
+}
+
+/// The number of cells [`structured::graded_lines`] makes (as a float, so that a
+/// tiny size cannot overflow).
+fn cells_along(length: f64, size: f64, lines: &[f64]) -> f64 {
+    let mut cuts = vec![0.0];
+    cuts.extend_from_slice(lines);
+    cuts.push(length);
+    cuts.windows(2)
+        .map(|w| structured::cells_in_band(w[1] - w[0], size))
+        .sum()
+}
+
+impl Cuts<'_> {
+    /// Cells along x and y.
+    fn counts(&self, size: [f64; 2]) -> (u64, u64) {
+        match self {
+            Cuts::Equal(d) => (d[0] as u64, d[1] as u64),
+            Cuts::Sized { size: h, lines } => (
+                cells_along(size[0], *h, lines[0]) as u64,
+                cells_along(size[1], *h, lines[1]) as u64,
+            ),
+        }
+    }
 }
 
 /// Estimates the generated meshes before building them, so that a mistyped
@@ -37,14 +136,29 @@ pub(super) fn check_generated_size(
     let (mut nodes, mut elements, mut points, mut history) = (0u64, 0u64, 0u64, 0u64);
     for (bi, b) in s.bodies.iter().enumerate() {
         if let MeshSpec::Rectangle {
-            divisions, element, ..
+            size,
+            divisions,
+            element_size,
+            x_lines,
+            y_lines,
+            element,
+            ..
         } = &b.mesh
         {
-            let field = format!("bodies[{bi}].mesh.divisions");
-            let (n, e) = rectangle_size(divisions[0], divisions[1], *element).ok_or_else(|| {
+            let field = format!("bodies[{bi}].mesh");
+            let cuts = rectangle_cuts(
+                &field,
+                *size,
+                *divisions,
+                *element_size,
+                [x_lines, y_lines],
+                &s.meshing,
+            )?;
+            let (nx, ny) = cuts.counts(*size);
+            let (n, e) = rectangle_size(nx, ny, *element).ok_or_else(|| {
                 Error::config(
-                    &field,
-                    format!("{divisions:?} cells: the node count overflows"),
+                    format!("{field}.divisions"),
+                    format!("[{nx}, {ny}] cells: the node count overflows"),
                 )
             })?;
             nodes = nodes.saturating_add(n);
@@ -113,36 +227,48 @@ pub fn estimate(mesh: &Mesh, materials: &[Material], factor_nnz: Option<usize>) 
 }
 
 /// A body's part from its mesh spec.
-pub(super) fn body_part(field: &str, spec: &MeshSpec, dir: &Path) -> Result<Part> {
+pub(super) fn body_part(
+    field: &str,
+    spec: &MeshSpec,
+    meshing: &MeshingSpec,
+    dir: &Path,
+) -> Result<Part> {
     match spec {
         MeshSpec::Rectangle {
             origin,
             size,
             divisions,
+            element_size,
+            x_lines,
+            y_lines,
             element,
         } => {
             finite(&format!("{field}.origin"), origin)?;
             positive(&format!("{field}.size[0]"), size[0])?;
             positive(&format!("{field}.size[1]"), size[1])?;
-            if divisions[0] == 0 || divisions[1] == 0 {
-                return Err(Error::config(
-                    format!("{field}.divisions"),
-                    format!("must be at least 1 each way, got {divisions:?}"),
-                ));
-            }
             if *element == ElementKind::Bar2 {
                 return Err(Error::config(
                     format!("{field}.element"),
                     "a rectangle is meshed with quad4 or tri3",
                 ));
             }
-            Ok(structured::rectangle(
-                *origin,
+            let cuts = rectangle_cuts(
+                field,
                 *size,
-                divisions[0],
-                divisions[1],
-                *element,
-            ))
+                *divisions,
+                *element_size,
+                [x_lines, y_lines],
+                meshing,
+            )?;
+            Ok(match cuts {
+                Cuts::Equal(d) => structured::rectangle(*origin, *size, d[0], d[1], *element),
+                Cuts::Sized { size: h, lines } => structured::grid(
+                    *origin,
+                    &structured::graded_lines(size[0], h, lines[0]),
+                    &structured::graded_lines(size[1], h, lines[1]),
+                    *element,
+                ),
+            })
         }
         MeshSpec::Gmsh { file } => {
             if file.trim().is_empty() {

@@ -84,12 +84,14 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         finite(&format!("{field}.velocity"), &b.velocity)?;
         let mat = find_material(format!("{field}.material"), &b.material)?;
         let part =
-            meshes::body_part(&format!("{field}.mesh"), &b.mesh, dir).map_err(|e| match e {
-                Error::Config { field, message } => Error::Config {
-                    field,
-                    message: format!("body `{}`: {message}", b.name),
-                },
-                e => e,
+            meshes::body_part(&format!("{field}.mesh"), &b.mesh, &s.meshing, dir).map_err(|e| {
+                match e {
+                    Error::Config { field, message } => Error::Config {
+                        field,
+                        message: format!("body `{}`: {message}", b.name),
+                    },
+                    e => e,
+                }
             })?;
         mesh.add_part(&part, bi, &b.name, mat, b.thickness);
         bodies.push(Body {

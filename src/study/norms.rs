@@ -1,0 +1,113 @@
+//! Inner products of displacement fields on a mesh: `L2(Ω)` and `H1(Ω)`
+//! (`(x, y)_H1 = ∫ x·y + ∇x:∇y dΩ`), by the stiffness quadrature of every continuum
+//! element (exact for bilinear fields on parallelograms). Bars are lines of the
+//! continuum's nodes and add nothing. The domain is the plane section (no thickness
+//! weight): the norms of the Rothe theory on `Ω ⊂ R²`.
+
+use crate::fe::{kinematics, stiffness_rule, ElementKind};
+use crate::mesh::Mesh;
+
+/// One Gauss point: weight × det J, shape values and gradients, element nodes.
+struct Point {
+    w: f64,
+    n: [f64; 4],
+    dndx: [[f64; 2]; 4],
+    nodes: [usize; 4],
+    nn: usize,
+}
+
+/// The quadrature of a mesh, computed once and reused for every inner product.
+pub struct Norms {
+    points: Vec<Point>,
+}
+
+/// `(x, y)` in `L2` and in `H1`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Products {
+    /// `∫ x·y`.
+    pub l2: f64,
+    /// `∫ x·y + ∇x:∇y`.
+    pub h1: f64,
+}
+
+impl Norms {
+    /// The quadrature of every continuum element of `mesh`.
+    pub fn new(mesh: &Mesh) -> Self {
+        let mut points = Vec::new();
+        for b in &mesh.blocks {
+            let kind = b.elements.kind;
+            if kind == ElementKind::Bar2 {
+                continue;
+            }
+            let nn = kind.nodes();
+            for e in 0..b.elements.len() {
+                let conn = b.elements.element(e);
+                let x: Vec<[f64; 2]> = conn.iter().map(|&n| mesh.coords[n]).collect();
+                let mut nodes = [0; 4];
+                nodes[..nn].copy_from_slice(conn);
+                for &(xi, w) in stiffness_rule(kind) {
+                    let k = kinematics(kind, &x, xi);
+                    points.push(Point {
+                        w: w * k.det_j,
+                        n: k.n,
+                        dndx: k.dndx,
+                        nodes,
+                        nn,
+                    });
+                }
+            }
+        }
+        Norms { points }
+    }
+
+    /// `(x, y)` for two nodal displacement vectors (two dofs per node).
+    pub fn products(&self, x: &[f64], y: &[f64]) -> Products {
+        let mut p = Products::default();
+        for q in &self.points {
+            let (mut vx, mut vy) = ([0.0; 2], [0.0; 2]);
+            let (mut gx, mut gy) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+            for a in 0..q.nn {
+                let d = 2 * q.nodes[a];
+                for c in 0..2 {
+                    vx[c] += q.n[a] * x[d + c];
+                    vy[c] += q.n[a] * y[d + c];
+                    for k in 0..2 {
+                        gx[c][k] += q.dndx[a][k] * x[d + c];
+                        gy[c][k] += q.dndx[a][k] * y[d + c];
+                    }
+                }
+            }
+            let v = vx[0] * vy[0] + vx[1] * vy[1];
+            let g = gx[0][0] * gy[0][0]
+                + gx[0][1] * gy[0][1]
+                + gx[1][0] * gy[1][0]
+                + gx[1][1] * gy[1][1];
+            p.l2 += q.w * v;
+            p.h1 += q.w * (v + g);
+        }
+        p
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::structured;
+
+    #[test]
+    fn norms_of_linear_fields_are_exact() {
+        // u = (x, 0) on [0,2]x[0,1]: ∫|u|² = ∫x² = 8/3 · 1, ∫|∇u|² = 2.
+        let mut mesh = Mesh::default();
+        let part = structured::rectangle([0.0, 0.0], [2.0, 1.0], 4, 3, ElementKind::Quad4);
+        mesh.add_part(&part, 0, "b", 0, 1.0);
+        let u: Vec<f64> = mesh.coords.iter().flat_map(|c| [c[0], 0.0]).collect();
+        let p = Norms::new(&mesh).products(&u, &u);
+        // Bilinear interpolation of x² is not exact, but of the product x·x at 2x2
+        // Gauss points of a linear field it is.
+        assert!((p.l2 - 8.0 / 3.0).abs() < 1e-12, "{}", p.l2);
+        assert!((p.h1 - p.l2 - 2.0).abs() < 1e-12, "{}", p.h1);
+        let v: Vec<f64> = mesh.coords.iter().flat_map(|c| [0.0, c[1]]).collect();
+        let q = Norms::new(&mesh).products(&u, &v);
+        assert!(q.l2.abs() < 1e-14 && q.h1.abs() < 1e-14);
+    }
+}

@@ -1,0 +1,415 @@
+//! `rothe report`: the paper's two benchmarks, every model and mesh, implicit and
+//! explicit, and a Markdown report of peak deflections and normalised dissipation
+//! beside the paper's figures, with the plots a paper would print. Why the numbers
+//! differ from the paper's: `theory/benchmarks.md`.
+
+use std::path::{Path, PathBuf};
+
+use super::collect::RunData;
+use super::compare::{ledger_table, pair};
+use super::mesh_study::{dissipation_cells, dissipation_header};
+use super::plan::{Plan, PlannedRun, StudyKind};
+use super::table::{num, Table};
+use crate::config::Overrides;
+use crate::error::{Error, Result};
+use crate::plot::{draw, Figure, Series, Style};
+
+/// The concrete models of benchmark 1 (the variants of `two_blocks.toml`).
+pub const BENCHMARK1_MODELS: [&str; 4] = ["elastic", "kelvin_voigt", "mazars", "rankine_hill"];
+/// The meshes of benchmark 1 (NOTES.md).
+pub const BENCHMARK1_MESHES: [f64; 4] = [0.2, 0.15, 0.1, 0.05];
+/// The concrete models of benchmark 2.
+pub const BENCHMARK2_MODELS: [&str; 3] = ["mazars", "rankine_hill", "kelvin_voigt"];
+
+/// What the report runs.
+#[derive(Clone, Debug)]
+pub struct ReportOptions {
+    /// Directory holding `two_blocks.toml` and `rc_beam_punch.toml`.
+    pub benchmarks: PathBuf,
+    /// Benchmark 1's meshes.
+    pub meshes: Vec<f64>,
+    /// Benchmark 1's mesh of the implicit-against-explicit comparison.
+    pub compare_mesh: f64,
+    /// Benchmark 2's element size (`None`: the scenario's own).
+    pub beam_size: Option<f64>,
+    /// Overrides applied to every run (e.g. a shorter `analysis.t_end` for a quick look).
+    pub base: Overrides,
+}
+
+impl Default for ReportOptions {
+    fn default() -> Self {
+        ReportOptions {
+            benchmarks: PathBuf::from("examples/benchmarks"),
+            meshes: BENCHMARK1_MESHES.to_vec(),
+            compare_mesh: 0.1,
+            beam_size: None,
+            base: Overrides::none(),
+        }
+    }
+}
+
+fn variant(model: &str) -> Overrides {
+    Overrides::none()
+        .variant(&format!("concrete={model}"))
+        .expect("g=o")
+}
+
+fn size(s: f64) -> Overrides {
+    Overrides::none()
+        .set(&format!("meshing.element_size={s}"))
+        .expect("k=v")
+}
+
+/// The plan of the report: benchmark 1 for every model and mesh, benchmark 2 for its
+/// models, and the explicit path of both (benchmark 1 at `compare_mesh`).
+pub fn plan(o: &ReportOptions) -> Result<Plan> {
+    let b1 = o.benchmarks.join("two_blocks.toml");
+    let b2 = o.benchmarks.join("rc_beam_punch.toml");
+    for f in [&b1, &b2] {
+        if !f.is_file() {
+            return Err(Error::config(
+                "--benchmarks",
+                format!("{} does not exist", f.display()),
+            ));
+        }
+    }
+    let abs1 = super::plan::absolute(&b1)?;
+    let abs2 = super::plan::absolute(&b2)?;
+    let mut runs = Vec::new();
+    for m in BENCHMARK1_MODELS {
+        for &s in &o.meshes {
+            runs.push(PlannedRun {
+                id: format!("b1_{m}_{s}"),
+                scenario: abs1.clone(),
+                overrides: o.base.then(&variant(m)).then(&size(s)),
+                param: s,
+                label: format!("{m}, {s} m"),
+                record_fields: false,
+            });
+        }
+        let base = o.base.then(&variant(m)).then(&size(o.compare_mesh));
+        let explicit = pair(&abs1, &base, &format!("b1_{m}_{}_", o.compare_mesh), "")?;
+        runs.push(PlannedRun {
+            label: format!("{m}, {} m, explicit", o.compare_mesh),
+            ..explicit[1].clone()
+        });
+    }
+    for m in BENCHMARK2_MODELS {
+        let mut base = o.base.then(&variant(m));
+        if let Some(s) = o.beam_size {
+            base = base.then(&size(s));
+        }
+        let both = pair(&abs2, &base, &format!("b2_{m}_"), "")?;
+        runs.push(PlannedRun {
+            label: m.to_string(),
+            ..both[0].clone()
+        });
+        runs.push(PlannedRun {
+            label: format!("{m}, explicit"),
+            ..both[1].clone()
+        });
+    }
+    if !o.meshes.contains(&o.compare_mesh) {
+        return Err(Error::config(
+            "--compare-mesh",
+            format!("{} is not one of the meshes {:?}", o.compare_mesh, o.meshes),
+        ));
+    }
+    Ok(Plan {
+        kind: StudyKind::Report,
+        runs,
+    })
+}
+
+/// The paper's figures the report sets beside its own (NOTES.md).
+const PAPER: &str = "Paper (commercial explicit code, shells, line-to-line contact): \
+benchmark 1 peak probe deflection about 1.45 mm (Mazars) and 1.6 mm (Rankine-Hill), \
+Rankine-Hill dissipating about 53 % more than Mazars; benchmark 2 Mazars' peak \
+deflection about 4.8 × Rankine-Hill's, normalised dissipation about 65 % for both, and \
+the viscoelastic and elastoplastic beams swinging to negative deflection after the \
+first impact.";
+
+fn find<'a>(runs: &'a [RunData], id: &str) -> Option<&'a RunData> {
+    runs.iter().find(|r| r.run.id == id && r.completed())
+}
+
+/// Whether a body lifted off a support after an impact: the support's force
+/// (history column) was positive at some step after the impact force first was,
+/// and zero at a later one.
+pub fn lifts_off(support: &[f64], impact: &[f64]) -> bool {
+    let Some(first) = impact.iter().position(|&x| x > 0.0) else {
+        return false;
+    };
+    let Some(pressed) = support[first..].iter().position(|&x| x > 0.0) else {
+        return false;
+    };
+    support[first + pressed..].contains(&0.0)
+}
+
+fn run_lifts_off(r: &RunData, support: &str) -> bool {
+    lifts_off(
+        &r.column(&format!("{support}_force")),
+        &r.column("impact_force"),
+    )
+}
+
+/// Writes the report's tables and plots into `dir`; returns the Markdown.
+pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
+    let plots = dir.join("plots");
+    let meshes: Vec<f64> = {
+        let mut m: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.run.id.starts_with("b1_") && !r.run.id.ends_with("explicit"))
+            .map(|r| r.run.param)
+            .collect();
+        m.sort_by(|a, b| b.total_cmp(a));
+        m.dedup();
+        m
+    };
+    let b1 = |m: &str, s: f64| find(runs, &format!("b1_{m}_{s}"));
+    let mut md = String::from(
+        "# rothe: the paper's benchmarks\n\nEvery run below is an implicit (backward \
+         Euler, contact QP) run of `examples/benchmarks/` unless marked explicit; \
+         energies are normalised by the initial kinetic energy `E_kin⁰`. Why the numbers \
+         differ from the paper's: `theory/benchmarks.md`.\n\n",
+    );
+    md.push_str(PAPER);
+    md.push_str("\n\n## Benchmark 1: two blocks\n\n### Peak probe deflection [mm]\n\n");
+    let mut header = vec!["model".to_string()];
+    header.extend(meshes.iter().map(|s| format!("{s} m")));
+    let mut peaks = Table::new(&header);
+    let mut diss = Table::new(&header);
+    let mut mat = Table::new(&header);
+    for m in BENCHMARK1_MODELS {
+        let mut p = vec![m.to_string()];
+        let mut d = vec![m.to_string()];
+        let mut q = vec![m.to_string()];
+        for &s in &meshes {
+            let r = b1(m, s);
+            p.push(num(r.map(|r| -1e3 * r.probe_min("probe"))));
+            d.push(num(r.map(|r| r.dissipated_total() / r.kinetic_0())));
+            q.push(num(r.map(|r| r.dissipated_material() / r.kinetic_0())));
+        }
+        peaks.push(p);
+        diss.push(d);
+        mat.push(q);
+    }
+    md.push_str(&peaks.markdown());
+    md.push_str("\n### Material dissipation / E_kin⁰ (viscous + damage + plastic)\n\n");
+    md.push_str(&mat.markdown());
+    md.push_str("\n### Total dissipation / E_kin⁰ (every ledger line: material, contact, the scheme's own loss)\n\n");
+    md.push_str(&diss.markdown());
+    md.push_str("\n### Rankine-Hill against Mazars\n\n");
+    let mut ratio = Table::new(&[
+        "mesh",
+        "material dissipation RH / Mazars",
+        "paper",
+        "peak deflection RH / Mazars",
+        "paper",
+    ]);
+    for &s in &meshes {
+        if let (Some(rh), Some(mz)) = (b1("rankine_hill", s), b1("mazars", s)) {
+            ratio.push(vec![
+                format!("{s} m"),
+                num(Some(rh.dissipated_material() / mz.dissipated_material())),
+                "1.53".into(),
+                num(Some(rh.probe_min("probe") / mz.probe_min("probe"))),
+                "1.10".into(),
+            ]);
+        }
+    }
+    md.push_str(&ratio.markdown());
+    // Figures 6-9: probe per mesh, one chart per model.
+    md.push('\n');
+    for m in BENCHMARK1_MODELS {
+        let mut fig = Figure::new(
+            format!("Benchmark 1, {m}: probe under the steel's corner"),
+            "t [ms]",
+            "u_y [mm]",
+        );
+        for &s in &meshes {
+            if let Some(r) = b1(m, s) {
+                fig = fig.with(Series::new(
+                    format!("{s} m"),
+                    r.series("probe_uy", 1e3),
+                    Style::Line,
+                ));
+            }
+        }
+        draw(&fig, &plots.join(format!("b1_probe_{m}")))?;
+        md.push_str(&format!(
+            "![benchmark 1 probe, {m}](plots/b1_probe_{m}.png)\n"
+        ));
+    }
+    // Figures 10-12 and 13: energies per model and normalised dissipation, finest mesh.
+    let fine = meshes.last().copied().unwrap_or(0.1);
+    for m in BENCHMARK1_MODELS {
+        if let Some(r) = b1(m, fine) {
+            energies(
+                r,
+                &format!("Benchmark 1, {m}, {fine} m: energies"),
+                &plots.join(format!("b1_energies_{m}")),
+            )?;
+            md.push_str(&format!(
+                "![benchmark 1 energies, {m}](plots/b1_energies_{m}.png)\n"
+            ));
+        }
+    }
+    let mut fig = Figure::new(
+        format!("Benchmark 1, {fine} m: dissipation"),
+        "t [ms]",
+        "D / E_kin⁰ [-]",
+    );
+    for m in BENCHMARK1_MODELS {
+        if let Some(r) = b1(m, fine) {
+            fig = fig.with(Series::new(
+                m,
+                r.dissipation_series(r.kinetic_0()),
+                Style::Line,
+            ));
+        }
+    }
+    draw(&fig, &plots.join("b1_dissipation"))?;
+    md.push_str("![benchmark 1 dissipation](plots/b1_dissipation.png)\n");
+
+    md.push_str("\n## Benchmark 2: reinforced beam and punch\n\n");
+    let mut t2 = Table::new(&{
+        let mut h = vec![
+            "model".to_string(),
+            "peak deflection [mm]".into(),
+            "max upward [mm]".into(),
+            "lifts off".into(),
+        ];
+        h.extend(dissipation_header());
+        h
+    });
+    for m in BENCHMARK2_MODELS {
+        if let Some(r) = find(runs, &format!("b2_{m}_implicit")) {
+            let mut row = vec![
+                m.to_string(),
+                num(Some(-1e3 * r.probe_min("midspan"))),
+                num(r.number("/probes/midspan/max_uy").map(|v| 1e3 * v)),
+                (run_lifts_off(r, "left_support") || run_lifts_off(r, "right_support")).to_string(),
+            ];
+            row.extend(dissipation_cells(r));
+            t2.push(row);
+        }
+    }
+    md.push_str(&t2.markdown());
+    if let (Some(mz), Some(rh)) = (
+        find(runs, "b2_mazars_implicit"),
+        find(runs, "b2_rankine_hill_implicit"),
+    ) {
+        md.push_str(&format!(
+            "\nMazars' peak deflection / Rankine-Hill's: {} (paper 4.8); normalised total \
+             dissipation {} and {} (paper about 0.65 for both).\n\n",
+            num(Some(mz.probe_min("midspan") / rh.probe_min("midspan"))),
+            num(Some(mz.dissipated_total() / mz.kinetic_0())),
+            num(Some(rh.dissipated_total() / rh.kinetic_0())),
+        ));
+    }
+    let mut fig = Figure::new("Benchmark 2: mid-span deflection", "t [ms]", "u_y [mm]");
+    let mut fig_d = Figure::new("Benchmark 2: dissipation", "t [ms]", "D / E_kin⁰ [-]");
+    for m in BENCHMARK2_MODELS {
+        if let Some(r) = find(runs, &format!("b2_{m}_implicit")) {
+            fig = fig.with(Series::new(m, r.series("midspan_uy", 1e3), Style::Line));
+            fig_d = fig_d.with(Series::new(
+                m,
+                r.dissipation_series(r.kinetic_0()),
+                Style::Line,
+            ));
+            energies(
+                r,
+                &format!("Benchmark 2, {m}: energies"),
+                &plots.join(format!("b2_energies_{m}")),
+            )?;
+        }
+    }
+    draw(&fig, &plots.join("b2_probe"))?;
+    draw(&fig_d, &plots.join("b2_dissipation"))?;
+    md.push_str("![benchmark 2 probe](plots/b2_probe.png)\n![benchmark 2 dissipation](plots/b2_dissipation.png)\n");
+    for m in BENCHMARK2_MODELS {
+        md.push_str(&format!(
+            "![benchmark 2 energies, {m}](plots/b2_energies_{m}.png)\n"
+        ));
+    }
+
+    md.push_str("\n## Implicit against explicit\n\n");
+    for m in BENCHMARK1_MODELS {
+        let ex = runs.iter().find(|r| {
+            r.run.id.starts_with(&format!("b1_{m}_"))
+                && r.run.id.ends_with("_explicit")
+                && r.completed()
+        });
+        let Some(ex) = ex else { continue };
+        let s: f64 = ex
+            .run
+            .id
+            .trim_start_matches(&format!("b1_{m}_"))
+            .trim_end_matches("_explicit")
+            .parse()
+            .unwrap_or(f64::NAN);
+        if let Some(im) = b1(m, s) {
+            md.push_str(&format!("### Benchmark 1, {m}, {s} m\n\n"));
+            md.push_str(&ledger_table(im, ex).markdown());
+            md.push('\n');
+        }
+    }
+    for m in BENCHMARK2_MODELS {
+        if let (Some(im), Some(ex)) = (
+            find(runs, &format!("b2_{m}_implicit")),
+            find(runs, &format!("b2_{m}_explicit")),
+        ) {
+            md.push_str(&format!("### Benchmark 2, {m}\n\n"));
+            md.push_str(&ledger_table(im, ex).markdown());
+            md.push('\n');
+        }
+    }
+
+    md.push_str("\n## Energy checks and run times\n\n");
+    let mut t = Table::new(&["run", "status", "checks", "dofs", "steps", "wall time [s]"]);
+    let mut total = 0.0;
+    for r in runs {
+        let secs = r.seconds();
+        if secs.is_finite() {
+            total += secs;
+        }
+        t.push(vec![
+            r.run.label.clone(),
+            r.status().into(),
+            if r.checks_hold() {
+                "hold".into()
+            } else {
+                "FAIL".into()
+            },
+            num(r.number("/dofs")),
+            num(r.number("/steps")),
+            num(Some(secs)),
+        ]);
+    }
+    md.push_str(&t.markdown());
+    md.push_str(&format!("\nSum of the runs' wall times: {total:.1} s.\n"));
+    t.write_csv(&dir.join("runs.csv"))?;
+    Ok(md)
+}
+
+/// The energies of one run against time: E_kin, E_el, W_ext, each nonzero
+/// dissipation line and the total.
+fn energies(r: &RunData, title: &str, stem: &Path) -> Result<()> {
+    let mut fig = Figure::new(title, "t [ms]", "energy [J]");
+    for (c, l) in [("E_kin", "E_kin"), ("E_el", "E_el"), ("W_ext", "W_ext")] {
+        fig = fig.with(Series::new(l, r.series(c, 1.0), Style::Line));
+    }
+    for c in super::collect::DISSIPATION_COLUMNS {
+        let s = r.series(c, 1.0);
+        if s.iter().any(|p| p.1 != 0.0) {
+            fig = fig.with(Series::new(c, s, Style::Line));
+        }
+    }
+    fig = fig.with(Series::new(
+        "D total",
+        r.dissipation_series(1.0),
+        Style::Dashed,
+    ));
+    draw(&fig, stem).map(|_| ())
+}
