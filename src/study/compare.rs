@@ -106,7 +106,8 @@ pub fn ledger_table(a: &RunData, b: &RunData) -> Table {
     ]);
     let k0 = a.kinetic_0().max(b.kinetic_0());
     let row = |t: &mut Table, name: &str, x: f64, y: f64, why: &str| {
-        let pct = if k0 > 0.0 {
+        // Only the energy lines are put against the initial kinetic energy.
+        let pct = if k0 > 0.0 && name.ends_with("[J]") {
             Some(100.0 * (y - x) / k0)
         } else {
             None
