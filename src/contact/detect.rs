@@ -245,29 +245,41 @@ impl Chain {
     }
 }
 
-/// The slaves of rigid lines that lie below their line's level by more than `depth`
-/// at the geometry `x(node)` (committed: the start of a step), as `(pair, side,
-/// slave)`.
+/// The slaves of rigid lines that came around a line's end: at the geometry
+/// `x(node)` (committed: the start of a step) they lie below the line's level by
+/// more than `depth`, and either beyond its ends or already so in `previous` (the
+/// last step's list), as sorted `(pair, side, slave)`.
 ///
 /// A rigid line is a support of finite length. A slave just beyond its end is free
 /// and may sink below the line's level (a beam rotating over the edge of its
 /// support); if it later moves sideways back within the line's ends it passes beside
 /// the support's end face, and a node-to-line constraint would instead fling it up
 /// onto the line in one step: an impulse doing large positive work (`D_contact`
-/// went to −12 `E_kin⁰` in benchmark 2's Kelvin-Voigt beam before this rule). A slave
-/// held by the line never lies that deep (its steps accept at most the contact
-/// tolerance), so such slaves are not candidates of that line for the step.
-pub fn beneath_rigid<X>(pairs: &[ContactPair], x: X, depth: f64) -> Vec<(usize, usize, usize)>
+/// went to −12 `E_kin⁰` in benchmark 2's Kelvin-Voigt beam before this rule). Such a
+/// slave stays passed over until it rises above the line's level again. A slave that
+/// starts a run below a line within its ends is not passed over: the constraint
+/// holds it (or reports an infeasible QP).
+pub fn beneath_rigid<X>(
+    pairs: &[ContactPair],
+    x: X,
+    depth: f64,
+    previous: &[(usize, usize, usize)],
+) -> Vec<(usize, usize, usize)>
 where
     X: Fn(usize) -> [f64; 2],
 {
     let mut out = Vec::new();
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
-            if let Master::Rigid { a, n, .. } = &side.master {
+            if let Master::Rigid { a, b, n } = &side.master {
+                let t = [b[0] - a[0], b[1] - a[1]];
+                let l2 = t[0] * t[0] + t[1] * t[1];
                 for &s in &side.slaves {
                     let p = x(s);
-                    if (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1] < -depth {
+                    let below = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1] < -depth;
+                    let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
+                    let beyond = !(-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi);
+                    if below && (beyond || previous.binary_search(&(pi, si, s)).is_ok()) {
                         out.push((pi, si, s));
                     }
                 }
@@ -565,10 +577,15 @@ mod tests {
         assert_eq!(out[0].slave, 2);
         assert!((out[0].gap + 0.001).abs() < 1e-15);
         assert_eq!(out[0].row().1, 2);
-        // Node 2 below the line by more than the depth is passed over.
+        // Node 2 lies below the line within its ends: held, not passed over, unless
+        // it came around the end (it was passed over at the last step).
         let pairs = [pair];
-        let beneath = beneath_rigid(&pairs, |n| coords[n], 5e-4);
+        assert!(beneath_rigid(&pairs, |n| coords[n], 5e-4, &[]).is_empty());
+        let beneath = beneath_rigid(&pairs, |n| coords[n], 5e-4, &[(0, 0, 2)]);
         assert_eq!(beneath, [(0, 0, 2)]);
+        // Beyond the end and below: passed over.
+        let beyond = [[0.1, 0.2], [0.3, -0.001], [0.2, 0.0]];
+        assert_eq!(beneath_rigid(&pairs, |n| beyond[n], 5e-4, &[]), [(0, 0, 1)]);
         let mut rigid = RigidHistory {
             beneath,
             held: Vec::new(),
@@ -581,6 +598,6 @@ mod tests {
         detect_except(&pairs, |n| coords[n], &rigid, &mut out);
         assert_eq!(out.len(), 1);
         assert_eq!((out[0].slave, out[0].xi), (1, 1.0));
-        assert!(beneath_rigid(&pairs, |n| coords[n], 2e-3).is_empty());
+        assert!(beneath_rigid(&pairs, |n| coords[n], 2e-3, &[(0, 0, 2)]).is_empty());
     }
 }

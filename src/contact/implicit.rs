@@ -206,6 +206,7 @@ impl<'m> ContactCorrection<'m> {
             self.pairs,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
             BENEATH_TOLERANCES * self.tol,
+            &self.rigid.beneath,
         );
         // The displacement h v the step is expected to make, by which the first
         // correction is linearised ahead (zero on the constrained dofs).

@@ -183,6 +183,7 @@ impl<'m> KinematicContact<'m> {
             &self.model.contacts,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
             BENEATH_TOLERANCES * self.model.analysis.contact_tolerance,
+            &self.rigid.beneath,
         );
         self.collisions(u, v, h);
         if !self.rows.is_empty() {
