@@ -114,3 +114,36 @@ pub fn w1_with(ny: usize, model_lines: &str) -> Result<Model> {
         std::path::Path::new("."),
     )
 }
+
+/// The reduced effective matrix `c_m M + c_k K` of a model (consistent mass unless
+/// the model's analysis lumps it), as the integrators build it: the matrices the
+/// solver tests and benches factorise.
+pub fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> crate::linsolve::LowerCsc {
+    let asm = crate::assembly::Assembler::new(&model.mesh);
+    let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+    let mass = asm.mass(&model.mesh, &model.materials, false);
+    let dofs =
+        crate::system::DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+    let mut reduced = crate::system::ReducedMatrix::new(&asm.pattern, &dofs);
+    reduced.fill(&dofs, c_m, &mass, &[(c_k, &k)]);
+    reduced.csc
+}
+
+/// The memory bandwidth of a STREAM-triad-like kernel `a = b + s c` over three
+/// arrays of `n` doubles (bytes/s, 24 bytes per element, best of `reps`), so that a
+/// solve's achieved bandwidth can be set beside the machine's in the same run.
+pub fn triad_bandwidth(n: usize, reps: usize) -> f64 {
+    let b = vec![1.0f64; n];
+    let c = vec![2.0f64; n];
+    let mut a = vec![0.0f64; n];
+    let mut best = f64::INFINITY;
+    for _ in 0..reps.max(1) {
+        let t = std::time::Instant::now();
+        for ((x, y), z) in a.iter_mut().zip(&b).zip(&c) {
+            *x = y + 3.0 * z;
+        }
+        std::hint::black_box(&a);
+        best = best.min(t.elapsed().as_secs_f64());
+    }
+    24.0 * n as f64 / best
+}

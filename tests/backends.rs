@@ -114,16 +114,7 @@ fn cantilever(kind: &str, divisions: [usize; 2], t_end: f64) -> Model {
         .expect("valid scenario")
 }
 
-/// The reduced effective matrix `c_m M + c_k K` of a model, as the integrator builds it.
-fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> LowerCsc {
-    let asm = Assembler::new(&model.mesh);
-    let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
-    let mass = asm.mass(&model.mesh, &model.materials, false);
-    let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let mut reduced = ReducedMatrix::new(&asm.pattern, &dofs);
-    reduced.fill(&dofs, c_m, &mass, &[(c_k, &k)]);
-    reduced.csc
-}
+use rothe::workload::effective_matrix;
 
 fn stiffness_matrix(model: &Model) -> LowerCsc {
     let n = model.mesh.n_dofs();

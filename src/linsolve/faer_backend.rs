@@ -30,6 +30,8 @@ pub struct FaerCholesky {
     solve_cols: usize,
     factorized: bool,
     ordering: Option<(Vec<usize>, Vec<usize>)>,
+    /// rothe's own supernodal solves (`None` for a simplicial factor).
+    own: Option<super::supernodal::SupernodalSolver>,
 }
 
 impl FaerCholesky {
@@ -49,6 +51,39 @@ impl FaerCholesky {
             (Some(s), true) => Some((s, &self.l_values)),
             _ => None,
         }
+    }
+
+    /// Solves with faer's own triangular solves (the reference of rothe's
+    /// supernodal ones, which the backend uses when the factor is supernodal).
+    pub fn solve_with_faer(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()> {
+        if self.symbolic.is_none() || !self.factorized {
+            return Err(not_analysed(NAME));
+        }
+        let n = self.symbolic.as_ref().map_or(0, |s| s.nrows());
+        check_block(NAME, n, rhs, ncols)?;
+        if n == 0 || ncols == 0 {
+            return Ok(());
+        }
+        self.ensure_solve_scratch(ncols)?;
+        let sym = self.symbolic.as_ref().expect("checked");
+        let llt = LltRef::<usize, f64>::new(sym, &self.l_values);
+        let stack = MemStack::new(self.solve_scratch.as_mut().expect("ensured"));
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, n, ncols),
+            Par::Seq,
+            stack,
+        );
+        Ok(())
+    }
+
+    /// rothe's supernodal solver of the current factor and the factor's values
+    /// (`None` before a factorisation or for a simplicial factor).
+    pub fn supernodal(&mut self) -> Option<(&mut super::supernodal::SupernodalSolver, &[f64])> {
+        if !self.factorized {
+            return None;
+        }
+        self.own.as_mut().map(|o| (o, self.l_values.as_slice()))
     }
 
     /// The original column eliminated `k`-th.
@@ -101,6 +136,13 @@ impl SymmetricSolver for FaerCholesky {
         // (`factor_nnz`) before it is taken.
         self.l_values = Vec::new();
         self.factor_scratch = None;
+        self.own = match sym.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => Some(super::supernodal::SupernodalSolver::new(
+                sn,
+                sym.perm().map(|p| p.arrays().0),
+            )),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        };
         self.symbolic = Some(sym);
         self.solve_scratch = None;
         self.solve_cols = 0;
@@ -168,17 +210,11 @@ impl SymmetricSolver for FaerCholesky {
         if n == 0 || ncols == 0 {
             return Ok(());
         }
-        self.ensure_solve_scratch(ncols)?;
-        let sym = self.symbolic.as_ref().expect("checked");
-        let llt = LltRef::<usize, f64>::new(sym, &self.l_values);
-        let stack = MemStack::new(self.solve_scratch.as_mut().expect("ensured"));
-        llt.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, ncols),
-            Par::Seq,
-            stack,
-        );
-        Ok(())
+        if let Some(own) = &mut self.own {
+            own.solve_in_place(&self.l_values, rhs, ncols);
+            return Ok(());
+        }
+        self.solve_with_faer(rhs, ncols)
     }
 
     fn set_ordering(&mut self, order: Vec<usize>) {

@@ -15,6 +15,7 @@
 
 pub mod faer_backend;
 pub mod ordering;
+pub mod supernodal;
 
 #[cfg(feature = "cholmod")]
 pub mod cholmod_backend;

@@ -1,0 +1,94 @@
+//! The triangular solves at the memory bound: a STREAM-triad probe of this
+//! machine's bandwidth, and one solve, a block of 8 and the sparse forward solve on
+//! W1's effective matrix, rothe's own supernodal solves against faer's. Each group
+//! prints the bytes the factor streams (`2 nnz(L) · 8 B` per solve) so the ratio to
+//! the triad bandwidth can be read off the same run.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use rothe::linsolve::faer_backend::FaerCholesky;
+use rothe::linsolve::SymmetricSolver;
+
+/// `a = b + s c` over arrays far larger than the caches: 24 bytes moved per element
+/// (two loads, one store; a write-allocate adds 8 more on machines without
+/// streaming stores, which this counts as the STREAM convention does not).
+fn triad(c: &mut Criterion) {
+    let n = 1 << 24; // 3 arrays of 128 MB
+    let b = vec![1.0f64; n];
+    let cc = vec![2.0f64; n];
+    let mut a = vec![0.0f64; n];
+    let mut g = c.benchmark_group("stream");
+    g.sample_size(10);
+    g.throughput(Throughput::Bytes(24 * n as u64));
+    g.bench_function("triad", |bench| {
+        bench.iter(|| {
+            for ((x, y), z) in a.iter_mut().zip(&b).zip(&cc) {
+                *x = y + 3.0 * z;
+            }
+            black_box(&a);
+        })
+    });
+    g.finish();
+}
+
+fn w1_factor(ny: usize) -> (FaerCholesky, usize, usize) {
+    let model = rothe::workload::w1(ny).unwrap();
+    let h = model.analysis.dt;
+    let a = rothe::workload::effective_matrix(&model, 1.0 / (h * h), 1.0);
+    let mut f = FaerCholesky::new();
+    f.analyze(&a).unwrap();
+    f.factorize(&a).unwrap();
+    let nnz = f.factor_nnz().unwrap();
+    (f, a.n, nnz)
+}
+
+fn solves(c: &mut Criterion) {
+    let mut g = c.benchmark_group("w1_solve");
+    g.sample_size(10);
+    for ny in [100usize, 250] {
+        let (mut f, n, nnz) = w1_factor(ny);
+        let bytes = 2 * nnz as u64 * 8;
+        eprintln!(
+            "W1 ny = {ny}: n = {n}, nnz(L) = {nnz}, one solve streams {:.1} MB",
+            bytes as f64 / 1e6
+        );
+        let b: Vec<f64> = (0..8 * n).map(|i| ((i as f64) * 0.37).sin()).collect();
+        g.throughput(Throughput::Bytes(bytes));
+        let mut x = b[..n].to_vec();
+        g.bench_with_input(BenchmarkId::new("own_1", ny), &ny, |bench, _| {
+            bench.iter(|| f.solve_block_in_place(&mut x, 1).unwrap())
+        });
+        g.bench_with_input(BenchmarkId::new("faer_1", ny), &ny, |bench, _| {
+            bench.iter(|| f.solve_with_faer(&mut x, 1).unwrap())
+        });
+        let mut x8 = b.clone();
+        g.bench_with_input(BenchmarkId::new("own_8", ny), &ny, |bench, _| {
+            bench.iter(|| f.solve_block_in_place(&mut x8, 8).unwrap())
+        });
+        g.bench_with_input(BenchmarkId::new("faer_8", ny), &ny, |bench, _| {
+            bench.iter(|| f.solve_with_faer(&mut x8, 8).unwrap())
+        });
+        if let Some((s, values)) = f.supernodal() {
+            let values = values.to_vec();
+            let mut y = vec![0.0; n];
+            let b1 = b[..n].to_vec();
+            g.bench_with_input(
+                BenchmarkId::new("own_forward_dense", ny),
+                &ny,
+                |bench, _| bench.iter(|| s.forward_dense(&values, &b1, &mut y)),
+            );
+            // A contact-like right-hand side: a few dofs at the free end.
+            let entries: Vec<(usize, f64)> = (0..6).map(|k| (n - 1 - 2 * k, 1.0)).collect();
+            g.bench_with_input(
+                BenchmarkId::new("own_forward_sparse_6", ny),
+                &ny,
+                |bench, _| bench.iter(|| s.forward_sparse(&values, &entries, &mut y)),
+            );
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, triad, solves);
+criterion_main!(benches);

@@ -1,0 +1,182 @@
+//! rothe's own supernodal triangular solves against faer's: one right-hand side, a
+//! block of them, and the forward solve of a sparse right-hand side, on grid
+//! Laplacians, random sparse SPD matrices of several patterns and sizes, and FE
+//! matrices of the W1 cantilever.
+
+use rothe::linsolve::faer_backend::FaerCholesky;
+use rothe::linsolve::{LowerCsc, SymmetricSolver};
+
+/// A deterministic pseudo-random sequence in [-0.5, 0.5).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+}
+
+/// The lower triangle of a symmetric matrix from its strictly-lower entries, made
+/// SPD by a dominant diagonal.
+fn spd(n: usize, lower: &[(usize, usize, f64)]) -> LowerCsc {
+    let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    let mut diag = vec![1.0; n];
+    for &(i, j, v) in lower {
+        let (i, j) = (i.max(j), i.min(j));
+        if i == j {
+            continue;
+        }
+        cols[j].push((i, v));
+        diag[i] += v.abs();
+        diag[j] += v.abs();
+    }
+    let mut a = LowerCsc {
+        n,
+        col_ptr: vec![0],
+        row_idx: Vec::new(),
+        values: Vec::new(),
+    };
+    for (j, col) in cols.iter_mut().enumerate() {
+        col.sort_by_key(|e| e.0);
+        col.dedup_by_key(|e| e.0);
+        a.row_idx.push(j);
+        a.values.push(diag[j]);
+        for &(i, v) in col.iter() {
+            a.row_idx.push(i);
+            a.values.push(v);
+        }
+        a.col_ptr.push(a.row_idx.len());
+    }
+    a
+}
+
+fn grid(m: usize) -> LowerCsc {
+    let mut e = Vec::new();
+    for j in 0..m * m {
+        let (x, y) = (j % m, j / m);
+        if x + 1 < m {
+            e.push((j + 1, j, -1.0));
+        }
+        if y + 1 < m {
+            e.push((j + m, j, -1.0));
+        }
+        if x + 1 < m && y + 1 < m {
+            e.push((j + m + 1, j, -0.5));
+        }
+    }
+    spd(m * m, &e)
+}
+
+fn random(n: usize, per_col: usize, band: Option<usize>, seed: u64) -> LowerCsc {
+    let mut r = Rng(seed);
+    let mut e = Vec::new();
+    for j in 0..n {
+        for _ in 0..per_col {
+            let span = band.unwrap_or(n);
+            let off = 1 + ((r.next() + 0.5) * span as f64) as usize;
+            if j + off < n {
+                e.push((j + off, j, r.next()));
+            }
+        }
+    }
+    spd(n, &e)
+}
+
+fn w1(ny: usize) -> LowerCsc {
+    let model = rothe::workload::w1(ny).unwrap();
+    let h: f64 = 1e-5;
+    rothe::workload::effective_matrix(&model, 1.0 / (h * h), 1.0)
+}
+
+fn matrices() -> Vec<(String, LowerCsc)> {
+    vec![
+        ("grid 40".into(), grid(40)),
+        ("grid 150".into(), grid(150)),
+        ("random 500 banded".into(), random(500, 4, Some(30), 7)),
+        ("random 6000 banded".into(), random(6000, 8, Some(150), 11)),
+        ("random 1500 wide".into(), random(1500, 3, None, 13)),
+        ("W1 ny=20".into(), w1(20)),
+        ("W1 ny=40".into(), w1(40)),
+    ]
+}
+
+fn rel(a: &[f64], b: &[f64]) -> f64 {
+    let num = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    num / b.iter().map(|y| y.abs()).fold(f64::MIN_POSITIVE, f64::max)
+}
+
+fn factor(a: &LowerCsc) -> FaerCholesky {
+    let mut f = FaerCholesky::new();
+    f.analyze(a).unwrap();
+    f.factorize(a).unwrap();
+    f
+}
+
+#[test]
+fn own_solves_agree_with_faers() {
+    let mut supernodal = 0;
+    for (name, a) in matrices() {
+        let mut f = factor(&a);
+        supernodal += usize::from(f.supernodal().is_some());
+        let mut r = Rng(3);
+        for k in [1, 3, 8, 11] {
+            let b: Vec<f64> = (0..a.n * k).map(|_| r.next()).collect();
+            let mut mine = b.clone();
+            f.solve_block_in_place(&mut mine, k).unwrap();
+            let mut theirs = b.clone();
+            f.solve_with_faer(&mut theirs, k).unwrap();
+            let e = rel(&mine, &theirs);
+            assert!(e < 1e-12, "{name}, k = {k}: {e:e}");
+            // A block of k is the k single solves.
+            for c in 0..k {
+                let mut one = b[c * a.n..(c + 1) * a.n].to_vec();
+                f.solve_in_place(&mut one).unwrap();
+                assert!(rel(&one, &mine[c * a.n..(c + 1) * a.n]) < 1e-14, "{name}");
+            }
+        }
+    }
+    assert!(
+        supernodal >= 3,
+        "only {supernodal} of the matrices got a supernodal factor"
+    );
+}
+
+#[test]
+fn a_sparse_right_hand_side_gives_the_dense_forward_solve() {
+    for (name, a) in matrices() {
+        let mut f = factor(&a);
+        let n = a.n;
+        let Some((s, values)) = f.supernodal() else {
+            continue;
+        };
+        let values = values.to_vec();
+        for entries in [
+            vec![(0, 1.0)],
+            vec![(n / 2, -2.0), (n - 1, 0.5)],
+            vec![(n / 3, 1.0), (n / 3 + 1, 1.0)],
+        ] {
+            let mut b = vec![0.0; n];
+            for &(i, v) in &entries {
+                b[i] += v;
+            }
+            let (mut dense, mut sparse) = (vec![0.0; n], vec![0.0; n]);
+            s.forward_dense(&values, &b, &mut dense);
+            let visited = s.forward_sparse(&values, &entries, &mut sparse);
+            assert!(rel(&sparse, &dense) < 1e-14, "{name} {entries:?}");
+            assert!(visited <= s.supernodes());
+        }
+        // One nonzero on a leaf visits only its path to the root.
+        let (mut y, total) = (vec![0.0; n], s.supernodes());
+        let few = (0..n)
+            .map(|i| s.forward_sparse(&values, &[(i, 1.0)], &mut y))
+            .min()
+            .unwrap();
+        assert!(few < total || total == 1, "{name}: {few} of {total}");
+    }
+}
