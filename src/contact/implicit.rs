@@ -145,6 +145,7 @@ pub struct ContactCorrection<'m> {
     dual: DualQp,
     stats: ContactStats,
     rigid: super::detect::RigidHistory,
+    push_entries: Vec<(usize, f64)>,
 }
 
 /// How many contact tolerances below a rigid line a slave lies at the start of a
@@ -193,6 +194,7 @@ impl<'m> ContactCorrection<'m> {
             dual: DualQp::default(),
             stats: ContactStats::default(),
             rigid: Default::default(),
+            push_entries: Vec::new(),
         }
     }
 
@@ -532,16 +534,18 @@ impl Correction for ContactCorrection<'_> {
                 self.stats.qp_s += t.elapsed().as_secs_f64();
                 if r.is_ok() {
                     if compliant {
-                        // δ = δ₀ + A⁻¹Gᵀλ: one solve.
-                        self.push.clear();
-                        self.push.resize(nf, 0.0);
+                        // δ = δ₀ + A⁻¹Gᵀλ: one solve of a right-hand side on the
+                        // contact dofs (its forward sweep over their reach only).
+                        self.push_entries.clear();
                         for (j, &i) in self.rows.iter().enumerate() {
                             let row = g.row(i);
                             for (&e, v) in row.col_indices().iter().zip(row.values()) {
-                                self.push[e] += self.lambda_rows[j] * v;
+                                self.push_entries.push((e, self.lambda_rows[j] * v));
                             }
                         }
-                        sys.solve(&mut self.push)?;
+                        self.push.clear();
+                        self.push.resize(nf, 0.0);
+                        sys.solve_sparse(&self.push_entries, &mut self.push)?;
                         for (d, p) in self.delta0.iter_mut().zip(&self.push) {
                             *d += p;
                         }

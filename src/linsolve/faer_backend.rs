@@ -30,7 +30,8 @@ pub struct FaerCholesky {
     solve_cols: usize,
     factorized: bool,
     ordering: Option<(Vec<usize>, Vec<usize>)>,
-    /// rothe's own supernodal solves (`None` for a simplicial factor).
+    /// rothe's own solves over the factor (a simplicial factor as supernodes of one
+    /// column; `None` only if its layout is not the expected one).
     own: Option<super::supernodal::SupernodalSolver>,
 }
 
@@ -77,8 +78,9 @@ impl FaerCholesky {
         Ok(())
     }
 
-    /// rothe's supernodal solver of the current factor and the factor's values
-    /// (`None` before a factorisation or for a simplicial factor).
+    /// rothe's own solver of the current factor (supernodal; a simplicial factor as
+    /// one-column supernodes) and the factor's values (`None` before a
+    /// factorisation).
     pub fn supernodal(&mut self) -> Option<(&mut super::supernodal::SupernodalSolver, &[f64])> {
         if !self.factorized {
             return None;
@@ -141,7 +143,13 @@ impl SymmetricSolver for FaerCholesky {
                 sn,
                 sym.perm().map(|p| p.arrays().0),
             )),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
+            SymbolicCholeskyRaw::Simplicial(sm) => {
+                super::supernodal::SupernodalSolver::from_simplicial(
+                    sm.col_ptr(),
+                    sm.row_idx(),
+                    sym.perm().map(|p| p.arrays().0),
+                )
+            }
         };
         self.symbolic = Some(sym);
         self.solve_scratch = None;
@@ -215,6 +223,33 @@ impl SymmetricSolver for FaerCholesky {
             return Ok(());
         }
         self.solve_with_faer(rhs, ncols)
+    }
+
+    fn solve_sparse(&mut self, entries: &[(usize, f64)], out: &mut [f64]) -> Result<()> {
+        if self.symbolic.is_none() || !self.factorized {
+            return Err(not_analysed(NAME));
+        }
+        let n = self.symbolic.as_ref().map_or(0, |s| s.nrows());
+        check_block(NAME, n, out, 1)?;
+        if let Some(&(i, _)) = entries.iter().find(|(i, _)| *i >= n) {
+            return Err(Error::Solver {
+                backend: NAME,
+                message: format!("sparse right-hand side entry {i} beyond the order {n}"),
+            });
+        }
+        match &mut self.own {
+            Some(own) => {
+                own.solve_sparse(&self.l_values, entries, out);
+                Ok(())
+            }
+            None => {
+                out.fill(0.0);
+                for &(i, v) in entries {
+                    out[i] += v;
+                }
+                self.solve_with_faer(out, 1)
+            }
+        }
     }
 
     fn set_ordering(&mut self, order: Vec<usize>) {

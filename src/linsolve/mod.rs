@@ -125,6 +125,17 @@ pub trait SymmetricSolver: Send {
     }
     /// Overwrites the `n x ncols` column-major block `rhs` with `A⁻¹ rhs`, reading
     /// the factor once for all columns.
+    /// `out = A⁻¹ b` for the sparse `b` whose nonzeros are `entries` (repeated
+    /// indices summed). The faer backend's supernodal solve visits only the
+    /// elimination-tree reach of the nonzeros in its forward sweep; the default is a
+    /// dense solve.
+    fn solve_sparse(&mut self, entries: &[(usize, f64)], out: &mut [f64]) -> Result<()> {
+        out.fill(0.0);
+        for &(i, v) in entries {
+            out[i] += v;
+        }
+        self.solve_in_place(out)
+    }
     fn solve_block_in_place(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()>;
     /// Number of nonzeros of the factor `L`, once analysed.
     fn factor_nnz(&self) -> Option<usize>;

@@ -59,27 +59,64 @@ impl SupernodalSolver {
     /// The solver of the factor with structure `sym` and elimination order `perm`
     /// (`None`: the identity).
     pub fn new(sym: &SymbolicSupernodalCholesky<usize>, perm: Option<&[usize]>) -> Self {
-        let n = sym.nrows();
         let ns = sym.n_supernodes();
         let begin = sym.supernode_begin();
         let end = sym.supernode_end();
         let cp_rows = sym.col_ptr_for_row_idx();
         let cp_vals = sym.col_ptr_for_val();
         let nnz = sym.nnz_per_super();
-        let mut nodes = Vec::with_capacity(ns);
-        let mut node_of = vec![0; n];
-        for s in 0..ns {
-            let sn = Supernode {
+        let nodes = (0..ns)
+            .map(|s| Supernode {
                 begin: begin[s],
                 ncols: end[s] - begin[s],
                 pattern: cp_rows[s],
                 npattern: nnz[s],
                 values: cp_vals[s],
-            };
-            node_of[sn.begin..sn.begin + sn.ncols].fill(s);
-            nodes.push(sn);
+            })
+            .collect();
+        Self::from_nodes(sym.nrows(), nodes, sym.row_idx().to_vec(), perm)
+    }
+
+    /// The solver of a simplicial factor (compressed columns `col_ptr`, `row_idx`,
+    /// the diagonal first in every column), as supernodes of one column each: the
+    /// same layout, a column being a `(1 + p) × 1` block. `None` when a column does
+    /// not start with its diagonal.
+    pub fn from_simplicial(
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        perm: Option<&[usize]>,
+    ) -> Option<Self> {
+        let n = col_ptr.len().checked_sub(1)?;
+        let mut nodes = Vec::with_capacity(n);
+        let mut pattern_rows = Vec::with_capacity(row_idx.len().saturating_sub(n));
+        for j in 0..n {
+            let (a, b) = (col_ptr[j], col_ptr[j + 1]);
+            if b <= a || row_idx[a] != j {
+                return None;
+            }
+            nodes.push(Supernode {
+                begin: j,
+                ncols: 1,
+                pattern: pattern_rows.len(),
+                npattern: b - a - 1,
+                values: a,
+            });
+            pattern_rows.extend_from_slice(&row_idx[a + 1..b]);
         }
-        let rows = sym.row_idx().to_vec();
+        Some(Self::from_nodes(n, nodes, pattern_rows, perm))
+    }
+
+    fn from_nodes(
+        n: usize,
+        nodes: Vec<Supernode>,
+        rows: Vec<usize>,
+        perm: Option<&[usize]>,
+    ) -> Self {
+        let ns = nodes.len();
+        let mut node_of = vec![0; n];
+        for (s, sn) in nodes.iter().enumerate() {
+            node_of[sn.begin..sn.begin + sn.ncols].fill(s);
+        }
         let parent = nodes
             .iter()
             .map(|sn| {
@@ -157,7 +194,14 @@ impl SupernodalSolver {
         if self.tmp.len() < self.max_pattern() * K {
             self.tmp.resize(self.max_pattern() * K, 0.0);
         }
-        sweeps_best::<K>(&self.nodes, &self.rows, values, &mut self.x, &mut self.tmp);
+        sweeps_best::<K>(
+            Sweeps::Both,
+            &self.nodes,
+            &self.rows,
+            values,
+            &mut self.x,
+            &mut self.tmp,
+        );
         for i in 0..n {
             let p = self.perm[i];
             for c in 0..K {
@@ -203,6 +247,30 @@ impl SupernodalSolver {
             self.mark[s] = false;
         }
         self.reach.len()
+    }
+
+    /// `x = A⁻¹ b` for the `b` whose nonzeros are `entries` (original numbering,
+    /// repeated indices summed), into `out`: the forward solve visits only the
+    /// reach of the nonzeros ([`Self::forward_sparse`]), the backward solve all
+    /// supernodes. For right-hand sides on a few dofs (a contact correction
+    /// `A⁻¹Gᵀλ`) it costs about half a dense solve.
+    pub fn solve_sparse(&mut self, values: &[f64], entries: &[(usize, f64)], out: &mut [f64]) {
+        let n = self.n;
+        let mut y = std::mem::take(&mut self.x);
+        y.resize(n, 0.0);
+        self.forward_sparse(values, entries, &mut y[..n]);
+        sweeps_best::<1>(
+            Sweeps::Backward,
+            &self.nodes,
+            &self.rows,
+            values,
+            &mut y[..n],
+            &mut self.tmp,
+        );
+        for i in 0..n {
+            out[self.perm[i]] = y[i];
+        }
+        self.x = y;
     }
 
     /// The dense forward solve `y = L⁻¹ P b` of one right-hand side (`y` in
@@ -267,6 +335,19 @@ fn forward_node<const K: usize, M: MulAdd>(
 ) {
     let (b, ns, np) = (sn.begin, sn.ncols, sn.npattern);
     let ld = ns + np;
+    if ns == 1 {
+        // One column (a simplicial factor's): straight into x, no buffer.
+        let col = &values[sn.values..sn.values + ld];
+        let inv = 1.0 / col[0];
+        let xj: [f64; K] = std::array::from_fn(|c| x[b * K + c] * inv);
+        x[b * K..(b + 1) * K].copy_from_slice(&xj);
+        for (&l, &row) in col[1..].iter().zip(&rows[sn.pattern..sn.pattern + np]) {
+            for c in 0..K {
+                x[row * K + c] = M::mul_add(l, -xj[c], x[row * K + c]);
+            }
+        }
+        return;
+    }
     let tmp = &mut tmp[..np * K];
     tmp.fill(0.0);
     let block = &values[sn.values..sn.values + ld * ns];
@@ -311,6 +392,23 @@ fn backward_node<const K: usize, M: MulAdd>(
 ) {
     let (b, ns, np) = (sn.begin, sn.ncols, sn.npattern);
     let ld = ns + np;
+    if ns == 1 {
+        let col = &values[sn.values..sn.values + ld];
+        let mut acc = [[0.0; K]; LANES];
+        let pattern = &rows[sn.pattern..sn.pattern + np];
+        for (k, (&l, &row)) in col[1..].iter().zip(pattern).enumerate().rev() {
+            let lane = k % LANES;
+            for c in 0..K {
+                acc[lane][c] = M::mul_add(l, x[row * K + c], acc[lane][c]);
+            }
+        }
+        let inv = 1.0 / col[0];
+        for c in 0..K {
+            let sum: f64 = acc.iter().map(|a| a[c]).sum();
+            x[b * K + c] = (x[b * K + c] - sum) * inv;
+        }
+        return;
+    }
     let tmp = &mut tmp[..np * K];
     for (t, &row) in tmp
         .chunks_exact_mut(K)
@@ -354,17 +452,29 @@ fn dot_rows_rev<const K: usize, M: MulAdd>(l: &[f64], y: &[f64], acc: &mut [[f64
     }
 }
 
-/// The forward and backward sweeps over all supernodes, for one kernel flavour.
+/// Which sweeps a solve makes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Sweeps {
+    /// Forward and backward: `A⁻¹`.
+    Both,
+    /// Backward only (after a sparse forward solve).
+    Backward,
+}
+
+/// The sweeps over all supernodes, for one kernel flavour.
 #[inline(always)]
 fn sweeps<const K: usize, M: MulAdd>(
+    which: Sweeps,
     nodes: &[Supernode],
     rows: &[usize],
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
 ) {
-    for sn in nodes {
-        forward_node::<K, M>(sn, rows, values, x, tmp);
+    if which == Sweeps::Both {
+        for sn in nodes {
+            forward_node::<K, M>(sn, rows, values, x, tmp);
+        }
     }
     for sn in nodes.iter().rev() {
         backward_node::<K, M>(sn, rows, values, x, tmp);
@@ -378,17 +488,19 @@ fn sweeps<const K: usize, M: MulAdd>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn sweeps_avx2<const K: usize>(
+    which: Sweeps,
     nodes: &[Supernode],
     rows: &[usize],
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
 ) {
-    sweeps::<K, Fused>(nodes, rows, values, x, tmp)
+    sweeps::<K, Fused>(which, nodes, rows, values, x, tmp)
 }
 
 /// [`sweeps`] with the fastest kernels this CPU runs.
 fn sweeps_best<const K: usize>(
+    which: Sweeps,
     nodes: &[Supernode],
     rows: &[usize],
     values: &[f64],
@@ -399,9 +511,9 @@ fn sweeps_best<const K: usize>(
     {
         if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
             // SAFETY: both features were just detected.
-            unsafe { sweeps_avx2::<K>(nodes, rows, values, x, tmp) };
+            unsafe { sweeps_avx2::<K>(which, nodes, rows, values, x, tmp) };
             return;
         }
     }
-    sweeps::<K, Plain>(nodes, rows, values, x, tmp)
+    sweeps::<K, Plain>(which, nodes, rows, values, x, tmp)
 }

@@ -176,6 +176,17 @@ impl EffectiveSystem {
         r
     }
 
+    /// `out = A⁻¹ b` for the free-dof vector `b` given by its nonzeros `entries`
+    /// (free numbering, repeated indices summed): a forward solve over their reach
+    /// only where the backend has one.
+    pub fn solve_sparse(&mut self, entries: &[(usize, f64)], out: &mut [f64]) -> Result<()> {
+        let t = Instant::now();
+        let r = self.solver.solve_sparse(entries, out);
+        self.timing.solve_s += t.elapsed().as_secs_f64();
+        self.timing.solves += 1;
+        r
+    }
+
     /// Overwrites the column-major `n_free x ncols` block `rhs` with `A⁻¹ rhs`; the
     /// factor is read once for the whole block.
     pub fn solve_block(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()> {
