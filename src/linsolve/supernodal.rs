@@ -33,6 +33,85 @@ struct Supernode {
     values: usize,
 }
 
+/// Blocks of at least this many right-hand sides are split over two threads.
+const PARALLEL_COLUMNS: usize = 8;
+
+/// Systems of at least this order are worth a second thread.
+const PARALLEL_ORDER: usize = 20_000;
+
+/// The buffers of one block solve.
+#[derive(Default)]
+struct Workspace {
+    /// Row-major work copy of the right-hand sides (`n × k`).
+    x: Vec<f64>,
+    /// Gathered or accumulated pattern rows (`max p_s × k`).
+    tmp: Vec<f64>,
+}
+
+/// What a block solve reads of the factor's structure.
+struct Structure<'a> {
+    n: usize,
+    nodes: &'a [Supernode],
+    rows: &'a [usize],
+    perm: &'a [usize],
+}
+
+impl Structure<'_> {
+    /// Solves the `k` column-major right-hand sides in `rhs`, `8, 4, 2, 1` at a
+    /// time, in the workspace `w`.
+    fn solve_cols(&self, values: &[f64], rhs: &mut [f64], k: usize, w: &mut Workspace) {
+        let n = self.n;
+        let mut col = 0;
+        while col < k {
+            let width = match k - col {
+                r if r >= 8 => 8,
+                r if r >= 4 => 4,
+                r if r >= 2 => 2,
+                _ => 1,
+            };
+            let block = &mut rhs[col * n..(col + width) * n];
+            match width {
+                8 => self.solve_block::<8>(values, block, w),
+                4 => self.solve_block::<4>(values, block, w),
+                2 => self.solve_block::<2>(values, block, w),
+                _ => self.solve_block::<1>(values, block, w),
+            }
+            col += width;
+        }
+    }
+
+    /// `K` right-hand sides: permute into the row-major work copy, solve, permute
+    /// back.
+    fn solve_block<const K: usize>(&self, values: &[f64], rhs: &mut [f64], w: &mut Workspace) {
+        let n = self.n;
+        w.x.resize(n * K, 0.0);
+        for i in 0..n {
+            let p = self.perm[i];
+            for c in 0..K {
+                w.x[i * K + c] = rhs[c * n + p];
+            }
+        }
+        let need = self.nodes.iter().map(|s| s.npattern).max().unwrap_or(0) * K;
+        if w.tmp.len() < need {
+            w.tmp.resize(need, 0.0);
+        }
+        sweeps_best::<K>(
+            Sweeps::Both,
+            self.nodes,
+            self.rows,
+            values,
+            &mut w.x,
+            &mut w.tmp,
+        );
+        for i in 0..n {
+            let p = self.perm[i];
+            for c in 0..K {
+                rhs[c * n + p] = w.x[i * K + c];
+            }
+        }
+    }
+}
+
 /// A supernodal factor's structure prepared for solves, and the workspace.
 pub struct SupernodalSolver {
     n: usize,
@@ -47,9 +126,11 @@ pub struct SupernodalSolver {
     perm: Vec<usize>,
     /// `inverse[perm[i]] = i`.
     inverse: Vec<usize>,
-    /// Row-major work copy of the right-hand sides (`n × k`).
+    /// Workspaces of the block solves (two: a wide block runs as two halves).
+    work: [Workspace; 2],
+    /// The sparse solves' copy of the right-hand side (elimination order).
     x: Vec<f64>,
-    /// Gathered or accumulated pattern rows (`max p_s × k`).
+    /// Gathered or accumulated pattern rows of the sparse solves.
     tmp: Vec<f64>,
     mark: Vec<bool>,
     reach: Vec<usize>,
@@ -141,6 +222,7 @@ impl SupernodalSolver {
             parent,
             perm,
             inverse,
+            work: Default::default(),
             x: Vec::new(),
             tmp: vec![0.0; max_pattern],
             mark: vec![false; ns],
@@ -161,52 +243,24 @@ impl SupernodalSolver {
         if n == 0 || k == 0 {
             return;
         }
-        let mut col = 0;
-        while col < k {
-            let w = match k - col {
-                r if r >= 8 => 8,
-                r if r >= 4 => 4,
-                r if r >= 2 => 2,
-                _ => 1,
-            };
-            let block = &mut rhs[col * n..(col + w) * n];
-            match w {
-                8 => self.solve_block::<8>(values, block),
-                4 => self.solve_block::<4>(values, block),
-                2 => self.solve_block::<2>(values, block),
-                _ => self.solve_block::<1>(values, block),
-            }
-            col += w;
-        }
-    }
-
-    /// `K` right-hand sides: permute into the row-major work copy, solve, permute
-    /// back.
-    fn solve_block<const K: usize>(&mut self, values: &[f64], rhs: &mut [f64]) {
-        let n = self.n;
-        self.x.resize(n * K, 0.0);
-        for i in 0..n {
-            let p = self.perm[i];
-            for c in 0..K {
-                self.x[i * K + c] = rhs[c * n + p];
-            }
-        }
-        if self.tmp.len() < self.max_pattern() * K {
-            self.tmp.resize(self.max_pattern() * K, 0.0);
-        }
-        sweeps_best::<K>(
-            Sweeps::Both,
-            &self.nodes,
-            &self.rows,
-            values,
-            &mut self.x,
-            &mut self.tmp,
-        );
-        for i in 0..n {
-            let p = self.perm[i];
-            for c in 0..K {
-                rhs[c * n + p] = self.x[i * K + c];
-            }
+        let st = Structure {
+            n,
+            nodes: &self.nodes,
+            rows: &self.rows,
+            perm: &self.perm,
+        };
+        if k >= PARALLEL_COLUMNS && n >= PARALLEL_ORDER && rayon::current_num_threads() > 1 {
+            // Two halves of the block on two threads, each with its own workspace:
+            // wide blocks are bound by the multiply-adds, not by the factor's stream.
+            let half = k / 2;
+            let (left, right) = rhs.split_at_mut(half * n);
+            let (w0, w1) = self.work.split_at_mut(1);
+            rayon::join(
+                || st.solve_cols(values, left, half, &mut w0[0]),
+                || st.solve_cols(values, right, k - half, &mut w1[0]),
+            );
+        } else {
+            st.solve_cols(values, rhs, k, &mut self.work[0]);
         }
     }
 
