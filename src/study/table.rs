@@ -63,12 +63,15 @@ impl Table {
     }
 }
 
-/// A number in a table: 4 significant digits, `-` for a missing value, `NaN` kept.
+/// A number in a table: an integral value as an integer, others to 4 significant
+/// digits; `-` for a missing value, `NaN` kept.
 pub fn num(v: Option<f64>) -> String {
     match v {
         None => "-".into(),
         Some(x) if x.is_nan() => "NaN".into(),
         Some(0.0) => "0".into(),
+        // Counts (dofs, steps, iterations) print as integers.
+        Some(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{x:.0}"),
         Some(x) if (1e-3..1e5).contains(&x.abs()) => {
             let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
             format!("{x:.digits$}")
@@ -90,6 +93,8 @@ mod tests {
         assert_eq!(num(Some(1.23456)), "1.235");
         assert_eq!(num(Some(1234.5)), "1234");
         assert_eq!(num(Some(2.5e-6)), "2.500e-6");
+        assert_eq!(num(Some(96.0)), "96");
+        assert_eq!(num(Some(-6000.0)), "-6000");
         assert_eq!(num(None), "-");
         assert_eq!(num(Some(f64::NAN)), "NaN");
     }
