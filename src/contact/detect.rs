@@ -299,6 +299,46 @@ where
     detect_except(pairs, x, &RigidHistory::default(), out)
 }
 
+/// The slaves rigid lines hold at the geometry `x(node)` (committed): lying within
+/// `depth` of the line's level, and within its ends or already held in `previous`
+/// (a held slave that slides past an end stays held while it stays on the level),
+/// as sorted `(pair, side, slave)`. The explicit path keeps this list itself; the
+/// implicit one takes it from its active set.
+pub fn held_rigid<X>(
+    pairs: &[ContactPair],
+    x: X,
+    depth: f64,
+    previous: &[(usize, usize, usize)],
+) -> Vec<(usize, usize, usize)>
+where
+    X: Fn(usize) -> [f64; 2],
+{
+    let mut out = Vec::new();
+    for (pi, pair) in pairs.iter().enumerate() {
+        for (si, side) in pair.sides.iter().enumerate() {
+            if let Master::Rigid { a, b, n } = &side.master {
+                let t = [b[0] - a[0], b[1] - a[1]];
+                let l2 = t[0] * t[0] + t[1] * t[1];
+                for &s in &side.slaves {
+                    let p = x(s);
+                    let gap = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
+                    let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
+                    let within = (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi);
+                    let reach = pair.radius * pair.radius / l2;
+                    let near = xi * xi <= reach || (xi - 1.0) * (xi - 1.0) <= reach || within;
+                    if gap.abs() <= depth
+                        && near
+                        && (within || previous.binary_search(&(pi, si, s)).is_ok())
+                    {
+                        out.push((pi, si, s));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
 /// What a step knows of its rigid lines' slaves from the committed state, as sorted
 /// `(pair, side, slave)` lists.
 #[derive(Clone, Debug, Default)]
@@ -599,5 +639,17 @@ mod tests {
         assert_eq!(out.len(), 1);
         assert_eq!((out[0].slave, out[0].xi), (1, 1.0));
         assert!(beneath_rigid(&pairs, |n| coords[n], 2e-3, &[(0, 0, 2)]).is_empty());
+        // Held: on the line's level within its ends, or past an end if held before.
+        let on = [[0.1, 0.0], [0.2305, 0.0], [0.3, 0.0]];
+        assert_eq!(held_rigid(&pairs, |n| on[n], 1e-6, &[]), [(0, 0, 0)]);
+        assert_eq!(
+            held_rigid(&pairs, |n| on[n], 1e-6, &[(0, 0, 1), (0, 0, 2)]),
+            [(0, 0, 0), (0, 0, 1), (0, 0, 2)]
+        );
+        let off = [[0.1, 0.01], [0.2305, 0.0], [0.5, 0.0]];
+        assert_eq!(
+            held_rigid(&pairs, |n| off[n], 1e-6, &[(0, 0, 1), (0, 0, 2)]),
+            [(0, 0, 1)]
+        );
     }
 }

@@ -185,6 +185,14 @@ impl<'m> KinematicContact<'m> {
             BENEATH_TOLERANCES * self.model.analysis.contact_tolerance,
             &self.rigid.beneath,
         );
+        // Slaves on a rigid line stay on it a little past its ends.
+        let previous = std::mem::take(&mut self.rigid.held);
+        self.rigid.held = super::detect::held_rigid(
+            &self.model.contacts,
+            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+            BENEATH_TOLERANCES * self.model.analysis.contact_tolerance,
+            &previous,
+        );
         self.collisions(u, v, h);
         if !self.rows.is_empty() {
             self.v_pre.clear();
@@ -262,10 +270,22 @@ impl<'m> KinematicContact<'m> {
                         } else {
                             (*b, *a)
                         };
+                        // A held slave meets the line extended by the pair's radius.
+                        let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+                        let e = [
+                            (b[0] - a[0]) / len * pair.radius,
+                            (b[1] - a[1]) / len * pair.radius,
+                        ];
+                        let (a_x, b_x) = ([a[0] - e[0], a[1] - e[1]], [b[0] + e[0], b[1] + e[1]]);
                         for &s in &side.slaves {
                             if self.rigid.beneath.binary_search(&(pi, si, s)).is_ok() {
                                 continue;
                             }
+                            let (a, b) = if self.rigid.held.binary_search(&(pi, si, s)).is_ok() {
+                                (a_x, b_x)
+                            } else {
+                                (a, b)
+                            };
                             if let Some(c) =
                                 node_segment(at(s), vel(s), a, [0.0; 2], b, [0.0; 2], h)
                             {
