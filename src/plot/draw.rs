@@ -478,12 +478,13 @@ mod demo {
     use super::super::figure::{reference_slope, Series};
     use super::*;
 
-    /// Draws sample figures into `/tmp/plotdemo/figures` to look at:
+    /// Draws sample figures into `plotdemo/figures` under the temporary directory:
     /// `cargo test --release --lib plot::draw::demo -- --ignored`.
     #[test]
     #[ignore]
     fn demo_figures() {
-        let dir = Path::new("/tmp/plotdemo/figures");
+        let dir = std::env::temp_dir().join("plotdemo/figures");
+        let dir = dir.as_path();
         let h: Vec<f64> = (0..6).map(|i| 0.5f64.powi(i)).collect();
         let fig = Figure::new(
             "Convergence of the displacement",

@@ -259,14 +259,15 @@ mod tests {
         assert!(plot_run(dir.path()).is_err());
     }
 
-    /// Writes the sample into `/tmp/plotdemo` and plots it there, to look at.
+    /// Writes the sample into `plotdemo` under the temporary directory and plots it
+    /// there, to look at.
     #[test]
     #[ignore]
     fn demo() {
-        let dir = Path::new("/tmp/plotdemo");
-        std::fs::create_dir_all(dir).unwrap();
+        let dir = std::env::temp_dir().join("plotdemo");
+        std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("history.csv"), sample_history(1001)).unwrap();
-        for f in plot_run(dir).unwrap() {
+        for f in plot_run(&dir).unwrap() {
             println!("{}", f.display());
         }
     }
