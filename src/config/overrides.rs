@@ -108,23 +108,6 @@ fn split_assignment(flag: &str, spec: &str) -> Result<(String, String)> {
     }
 }
 
-/// The names of the variant groups and their options in a parsed scenario table.
-pub fn variant_groups(table: &Table) -> Vec<(String, Vec<String>)> {
-    match table.get("variants") {
-        Some(Value::Table(groups)) => groups
-            .iter()
-            .map(|(g, opts)| {
-                let names = match opts {
-                    Value::Table(t) => t.keys().cloned().collect(),
-                    _ => Vec::new(),
-                };
-                (g.clone(), names)
-            })
-            .collect(),
-        _ => Vec::new(),
-    }
-}
-
 /// Applies `ov` to a parsed scenario table and removes its `[variants]` table.
 pub fn apply(mut table: Table, ov: &Overrides) -> Result<Table> {
     let variants = match table.remove("variants") {

@@ -245,6 +245,12 @@ impl Chain {
     }
 }
 
+/// How many contact tolerances below (or off) a rigid line's level a slave lies at
+/// the start of a step when the line does not hold it: a slave the line holds lies
+/// within one (accepted steps penetrate at most the tolerance); two leave room for
+/// round-off. Both paths use it with [`beneath_rigid`] and [`held_rigid`].
+pub const RIGID_DEPTH_TOLERANCES: f64 = 2.0;
+
 /// The slaves of rigid lines that came around a line's end: at the geometry
 /// `x(node)` (committed: the start of a step) they lie below the line's level by
 /// more than `depth`, and either beyond its ends or already so in `previous` (the
@@ -269,6 +275,32 @@ where
     X: Fn(usize) -> [f64; 2],
 {
     let mut out = Vec::new();
+    rigid_slaves(pairs, x, |r| {
+        let beyond = !within_ends(r.xi);
+        if r.gap < -depth && (beyond || previous.binary_search(&r.key).is_ok()) {
+            out.push(r.key);
+        }
+    });
+    out
+}
+
+/// A slave of a rigid line at some geometry.
+struct RigidSlave {
+    /// `(pair, side, slave)`.
+    key: (usize, usize, usize),
+    /// Distance above the line's level.
+    gap: f64,
+    /// Position along the line (0 and 1 at its ends).
+    xi: f64,
+    /// The pair's radius in units of the line's length.
+    reach: f64,
+}
+
+/// Calls `f` for every slave of every rigid line, in key order.
+fn rigid_slaves<X>(pairs: &[ContactPair], x: X, mut f: impl FnMut(RigidSlave))
+where
+    X: Fn(usize) -> [f64; 2],
+{
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
             if let Master::Rigid { a, b, n } = &side.master {
@@ -276,17 +308,21 @@ where
                 let l2 = t[0] * t[0] + t[1] * t[1];
                 for &s in &side.slaves {
                     let p = x(s);
-                    let below = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1] < -depth;
-                    let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
-                    let beyond = !(-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi);
-                    if below && (beyond || previous.binary_search(&(pi, si, s)).is_ok()) {
-                        out.push((pi, si, s));
-                    }
+                    f(RigidSlave {
+                        key: (pi, si, s),
+                        gap: (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1],
+                        xi: ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2,
+                        reach: pair.radius / l2.sqrt(),
+                    });
                 }
             }
         }
     }
-    out
+}
+
+/// Whether `ξ` lies within a rigid line's ends (and [`RIGID_END_MARGIN`]).
+fn within_ends(xi: f64) -> bool {
+    (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi)
 }
 
 /// Candidates of every pair at the geometry `x(node)`, appended to `out` (cleared
@@ -314,28 +350,15 @@ where
     X: Fn(usize) -> [f64; 2],
 {
     let mut out = Vec::new();
-    for (pi, pair) in pairs.iter().enumerate() {
-        for (si, side) in pair.sides.iter().enumerate() {
-            if let Master::Rigid { a, b, n } = &side.master {
-                let t = [b[0] - a[0], b[1] - a[1]];
-                let l2 = t[0] * t[0] + t[1] * t[1];
-                for &s in &side.slaves {
-                    let p = x(s);
-                    let gap = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
-                    let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
-                    let within = (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi);
-                    let reach = pair.radius * pair.radius / l2;
-                    let near = xi * xi <= reach || (xi - 1.0) * (xi - 1.0) <= reach || within;
-                    if gap.abs() <= depth
-                        && near
-                        && (within || previous.binary_search(&(pi, si, s)).is_ok())
-                    {
-                        out.push((pi, si, s));
-                    }
-                }
-            }
+    rigid_slaves(pairs, x, |r| {
+        let near = (-r.reach..=1.0 + r.reach).contains(&r.xi);
+        if r.gap.abs() <= depth
+            && near
+            && (within_ends(r.xi) || previous.binary_search(&r.key).is_ok())
+        {
+            out.push(r.key);
         }
-    }
+    });
     out
 }
 
@@ -459,8 +482,8 @@ where
                         let p = x(s);
                         let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
                         let gap = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
-                        let within = (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi)
-                            || rigid.held.binary_search(&(pi, si, s)).is_ok();
+                        let within =
+                            within_ends(xi) || rigid.held.binary_search(&(pi, si, s)).is_ok();
                         if within && gap * gap <= r2 {
                             out.push(Candidate {
                                 pair: pi,

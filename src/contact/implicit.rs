@@ -148,12 +148,6 @@ pub struct ContactCorrection<'m> {
     push_entries: Vec<(usize, f64)>,
 }
 
-/// How many contact tolerances below a rigid line a slave lies at the start of a
-/// step when it came around the line's end ([`super::detect::beneath_rigid`]): a
-/// slave the line holds lies at most one below it (accepted steps penetrate at most
-/// the tolerance); two leave room for round-off.
-const BENEATH_TOLERANCES: f64 = 2.0;
-
 impl<'m> ContactCorrection<'m> {
     /// The correction for the contact pairs of `model`.
     pub fn new(model: &'m Model) -> Self {
@@ -207,7 +201,7 @@ impl<'m> ContactCorrection<'m> {
         self.rigid.beneath = super::detect::beneath_rigid(
             self.pairs,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            BENEATH_TOLERANCES * self.tol,
+            super::detect::RIGID_DEPTH_TOLERANCES * self.tol,
             &self.rigid.beneath,
         );
         // The displacement h v the step is expected to make, by which the first

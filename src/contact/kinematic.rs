@@ -108,10 +108,6 @@ pub struct KinematicStats {
     pub projected: usize,
 }
 
-/// Contact tolerances below a rigid line that mark a slave come around its end
-/// ([`super::detect::beneath_rigid`]).
-const BENEATH_TOLERANCES: f64 = 2.0;
-
 /// The kinematic contact of a model's pairs.
 pub struct KinematicContact<'m> {
     model: &'m Model,
@@ -182,7 +178,7 @@ impl<'m> KinematicContact<'m> {
         self.rigid.beneath = super::detect::beneath_rigid(
             &self.model.contacts,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            BENEATH_TOLERANCES * self.model.analysis.contact_tolerance,
+            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact_tolerance,
             &self.rigid.beneath,
         );
         // Slaves on a rigid line stay on it a little past its ends.
@@ -190,7 +186,7 @@ impl<'m> KinematicContact<'m> {
         self.rigid.held = super::detect::held_rigid(
             &self.model.contacts,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            BENEATH_TOLERANCES * self.model.analysis.contact_tolerance,
+            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact_tolerance,
             &previous,
         );
         self.collisions(u, v, h);

@@ -243,10 +243,7 @@ impl SymmetricSolver for FaerCholesky {
                 Ok(())
             }
             None => {
-                out.fill(0.0);
-                for &(i, v) in entries {
-                    out[i] += v;
-                }
+                super::scatter_entries(entries, out);
                 self.solve_with_faer(out, 1)
             }
         }

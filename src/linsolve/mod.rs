@@ -111,6 +111,14 @@ impl Backend {
     }
 }
 
+/// `out` zeroed, then the sparse entries (repeated indices summed) added.
+pub fn scatter_entries(entries: &[(usize, f64)], out: &mut [f64]) {
+    out.fill(0.0);
+    for &(i, v) in entries {
+        out[i] += v;
+    }
+}
+
 /// A sparse symmetric positive-definite direct solver.
 pub trait SymmetricSolver: Send {
     /// Backend name.
@@ -130,10 +138,7 @@ pub trait SymmetricSolver: Send {
     /// elimination-tree reach of the nonzeros in its forward sweep; the default is a
     /// dense solve.
     fn solve_sparse(&mut self, entries: &[(usize, f64)], out: &mut [f64]) -> Result<()> {
-        out.fill(0.0);
-        for &(i, v) in entries {
-            out[i] += v;
-        }
+        scatter_entries(entries, out);
         self.solve_in_place(out)
     }
     fn solve_block_in_place(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()>;

@@ -51,6 +51,8 @@ struct Workspace {
 /// What a block solve reads of the factor's structure.
 struct Structure<'a> {
     n: usize,
+    /// The longest supernode pattern.
+    max_pattern: usize,
     nodes: &'a [Supernode],
     rows: &'a [usize],
     perm: &'a [usize],
@@ -91,10 +93,7 @@ impl Structure<'_> {
                 w.x[i * K + c] = rhs[c * n + p];
             }
         }
-        let need = self.nodes.iter().map(|s| s.npattern).max().unwrap_or(0) * K;
-        if w.tmp.len() < need {
-            w.tmp.resize(need, 0.0);
-        }
+        w.tmp.resize(w.tmp.len().max(self.max_pattern * K), 0.0);
         sweeps_best::<K>(
             Sweeps::Both,
             self.nodes,
@@ -130,7 +129,8 @@ pub struct SupernodalSolver {
     work: [Workspace; 2],
     /// The sparse solves' copy of the right-hand side (elimination order).
     x: Vec<f64>,
-    /// Gathered or accumulated pattern rows of the sparse solves.
+    /// Gathered or accumulated pattern rows of the sparse solves (as long as the
+    /// longest supernode pattern).
     tmp: Vec<f64>,
     mark: Vec<bool>,
     reach: Vec<usize>,
@@ -245,6 +245,7 @@ impl SupernodalSolver {
         }
         let st = Structure {
             n,
+            max_pattern: self.tmp.len(),
             nodes: &self.nodes,
             rows: &self.rows,
             perm: &self.perm,
@@ -264,10 +265,6 @@ impl SupernodalSolver {
         }
     }
 
-    fn max_pattern(&self) -> usize {
-        self.nodes.iter().map(|s| s.npattern).max().unwrap_or(0)
-    }
-
     /// The forward solve of a sparse right-hand side: `y = L⁻¹ P b` for the `b`
     /// whose nonzeros are `entries` (original numbering), into `y` (length `n`, in
     /// elimination order; zero outside the reach). Only the supernodes on the
@@ -281,9 +278,6 @@ impl SupernodalSolver {
     ) -> usize {
         debug_assert_eq!(y.len(), self.n);
         y.fill(0.0);
-        if self.tmp.len() < self.max_pattern() {
-            self.tmp.resize(self.max_pattern(), 0.0);
-        }
         self.reach.clear();
         for &(p, v) in entries {
             let i = self.inverse[p];
@@ -332,9 +326,6 @@ impl SupernodalSolver {
     pub fn forward_dense(&mut self, values: &[f64], b: &[f64], y: &mut [f64]) {
         for i in 0..self.n {
             y[i] = b[self.perm[i]];
-        }
-        if self.tmp.len() < self.max_pattern() {
-            self.tmp.resize(self.max_pattern(), 0.0);
         }
         for sn in &self.nodes {
             forward_node::<1, Plain>(sn, &self.rows, values, y, &mut self.tmp);
@@ -434,8 +425,9 @@ fn forward_node<const K: usize, M: MulAdd>(
     }
 }
 
-/// Backward step of one supernode: `x_s ← L_ssᵀ⁻¹ (x_s − L_psᵀ x_p)`: the pattern
-/// rows of every column in memory order, then the small diagonal block backwards.
+/// Backward step of one supernode: `x_s ← L_ssᵀ⁻¹ (x_s − L_psᵀ x_p)`, last column
+/// first, each column from its last row up (the whole backward sweep reads the
+/// factor as one descending stream).
 #[inline(always)]
 fn backward_node<const K: usize, M: MulAdd>(
     sn: &Supernode,

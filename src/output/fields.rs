@@ -19,6 +19,7 @@ pub struct FieldWriter {
     path: PathBuf,
     out: BufWriter<File>,
     n: usize,
+    buf: Vec<u8>,
 }
 
 impl FieldWriter {
@@ -29,6 +30,7 @@ impl FieldWriter {
             path: path.into(),
             out: BufWriter::new(file),
             n,
+            buf: Vec::with_capacity(8 * (n + 1)),
         };
         w.out
             .write_all(MAGIC)
@@ -40,13 +42,13 @@ impl FieldWriter {
     /// Appends one state and flushes it.
     pub fn append(&mut self, t: f64, u: &[f64]) -> Result<()> {
         debug_assert_eq!(u.len(), self.n);
-        let mut buf = Vec::with_capacity(8 * (u.len() + 1));
-        buf.extend_from_slice(&t.to_le_bytes());
+        self.buf.clear();
+        self.buf.extend_from_slice(&t.to_le_bytes());
         for x in u {
-            buf.extend_from_slice(&x.to_le_bytes());
+            self.buf.extend_from_slice(&x.to_le_bytes());
         }
         self.out
-            .write_all(&buf)
+            .write_all(&self.buf)
             .and_then(|_| self.out.flush())
             .map_err(|e| Error::io(&self.path, e))
     }
