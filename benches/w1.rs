@@ -4,9 +4,10 @@
 //! CHOLMOD backend: `cargo run --release --example w1 -- NY [faer|cholmod]`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use rothe::assembly::internal::PointPass;
+use rothe::assembly::internal::{new_stores, PointPass};
 use rothe::assembly::Assembler;
 use rothe::linsolve::Backend;
+use rothe::model::ViscoelasticState;
 use rothe::time::backward_euler::BackwardEuler;
 use rothe::time::march::march_steps;
 use rothe::time::Integrator;
@@ -48,18 +49,30 @@ fn factorisation_and_step(c: &mut Criterion) {
 }
 
 fn sls(c: &mut Criterion) {
+    // The standard linear solid on nodal fields (the default) and at the Gauss
+    // points, and the Gauss-point pass the nodal fields save.
     let mut g = c.benchmark_group("w1_sls");
     g.sample_size(10);
     for ny in [25usize, 100] {
+        for state in [ViscoelasticState::Nodal, ViscoelasticState::Points] {
+            let mut model = rothe::workload::w1_with(ny, rothe::workload::W1_SLS).unwrap();
+            model.analysis.viscoelastic_state = state;
+            let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
+            let mut s = be.initial_state();
+            let name = format!("step_{state:?}").to_lowercase();
+            g.bench_with_input(BenchmarkId::new(name, ny), &ny, |b, _| {
+                b.iter(|| be.step_accepted(&mut s).unwrap())
+            });
+        }
         let model = rothe::workload::w1_with(ny, rothe::workload::W1_SLS).unwrap();
-        let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
-        let mut s = be.initial_state();
+        let asm = Assembler::new(&model.mesh);
+        let mut points = new_stores(&model.mesh, &model.materials);
         let n = model.mesh.n_dofs();
         let u: Vec<f64> = (0..n).map(|i| 1e-6 * (i % 7) as f64).collect();
         let (mut f, mut fp) = (vec![0.0; n], vec![0.0; n]);
         g.bench_with_input(BenchmarkId::new("gauss_point_loop", ny), &ny, |b, _| {
             b.iter(|| {
-                be.assembler().internal_force(
+                asm.internal_force(
                     &model.mesh,
                     &model.materials,
                     model.plane,
@@ -68,15 +81,12 @@ fn sls(c: &mut Criterion) {
                         dt: 1e-5,
                         at_rest: false,
                     },
-                    &mut s.points,
+                    &mut points,
                     &mut f,
                     Some(&mut fp),
                     None,
                 )
             })
-        });
-        g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| {
-            b.iter(|| be.step_accepted(&mut s).unwrap())
         });
     }
     g.finish();

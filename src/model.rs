@@ -198,6 +198,8 @@ pub struct Analysis {
     pub contact_tolerance: f64,
     /// How the contact QP is solved.
     pub contact_qp: ContactQp,
+    /// Where the implicit schemes keep the state of linear viscoelastic materials.
+    pub viscoelastic_state: ViscoelasticState,
 }
 
 /// Fill-reducing ordering of the effective matrix. Nested dissection is handed to
@@ -329,6 +331,21 @@ pub enum ContactQp {
     Condensed,
     /// The primal QP over all free dofs (reference).
     Full,
+}
+
+/// Where the implicit schemes keep the state of constant-tangent materials
+/// (elastic, Kelvin-Voigt, standard linear solid, Maxwell, Kelvin).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ViscoelasticState {
+    /// Nodal fields (the dashpot displacement `u_d`): a step costs matrix-vector
+    /// products only; the Gauss-point state is built from the fields for output,
+    /// without the cumulative dissipation density per point.
+    #[default]
+    Nodal,
+    /// The Gauss points (a pass per step), with every point's cumulative
+    /// dissipation density for output.
+    Points,
 }
 
 impl Model {

@@ -15,6 +15,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::energy::Ledger;
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;
+use crate::material::store::StateStore;
 use crate::model::{AnalysisKind, Model, TimeScheme};
 use crate::output::checks::Checks;
 use crate::output::recorder::{Recorder, Snapshot};
@@ -73,14 +74,21 @@ fn progress(n: usize, show: bool) -> ProgressBar {
     pb
 }
 
-fn snapshot(s: &State, iterations: usize, nl_residual: f64) -> Snapshot<'_> {
+/// The recorder's view of `s`, with the Gauss-point state `points` built for output
+/// when the state keeps it elsewhere.
+fn snapshot<'a>(
+    s: &'a State,
+    points: Option<&'a [StateStore]>,
+    iterations: usize,
+    nl_residual: f64,
+) -> Snapshot<'a> {
     Snapshot {
         step: s.step,
         t: s.t,
         u: &s.u,
         v: &s.v,
         ledger: &s.ledger,
-        points: &s.points,
+        points: points.unwrap_or(&s.points),
         contact: &s.contact,
         iterations,
         nl_residual,
@@ -189,13 +197,21 @@ fn integrate<I: Integrator>(
     summary: &mut Summary,
 ) -> Result<()> {
     let mut s = integrator.initial_state()?;
-    rec.record(model, &snapshot(&s, 0, 0.0))?;
+    let vtk_every = model.analysis.vtk_every;
+    // The Gauss-point state of a step the VTK series writes, when `s` keeps it in
+    // nodal fields.
+    let output_points = |integrator: &I, s: &State| {
+        (vtk_every > 0 && s.step % vtk_every == 0)
+            .then(|| integrator.output_points(s))
+            .flatten()
+    };
+    let built = output_points(integrator, &s);
+    rec.record(model, &snapshot(&s, built.as_deref(), 0, 0.0))?;
     let summary_path = opts.out.join("summary.json");
     fill(summary, &s, integrator, rec);
     summary.write(&summary_path)?;
     let mut last_write = Instant::now();
     let n_steps = model.analysis.n_steps();
-    let vtk_every = model.analysis.vtk_every;
     let pb = progress(n_steps, opts.progress);
     let t_end = model.analysis.t_end;
     let (mut iterations, mut step_cuts) = (0, 0);
@@ -204,7 +220,9 @@ fn integrate<I: Integrator>(
         match m {
             Marched::Step(report) => {
                 iterations += report.iterations;
-                rec.record(model, &snapshot(s, report.iterations, report.nl_residual))?;
+                let built = output_points(integrator, s);
+                let snap = snapshot(s, built.as_deref(), report.iterations, report.nl_residual);
+                rec.record(model, &snap)?;
                 pb.set_position(((s.t / t_end) * n_steps as f64) as u64);
                 let on_cadence = vtk_every > 0 && s.step % vtk_every == 0;
                 if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {

@@ -218,6 +218,12 @@ pub struct AnalysisSpec {
     /// free dofs, the reference).
     #[serde(default)]
     pub contact_qp: crate::model::ContactQp,
+    /// Where the implicit schemes keep the state of linear viscoelastic materials:
+    /// `nodal` (default: nodal fields, a step of matrix-vector products) or `points`
+    /// (the Gauss points, with each point's cumulative dissipation density in the
+    /// VTK output).
+    #[serde(default)]
+    pub viscoelastic_state: crate::model::ViscoelasticState,
 }
 
 fn default_displacement_tolerance() -> f64 {

@@ -125,6 +125,24 @@ impl StateStore {
         std::mem::swap(&mut self.committed, &mut self.trial);
     }
 
+    /// Sets the committed strain, stress, cumulative dissipation density and history
+    /// of point `g` (a state built from other fields, as for output).
+    pub fn set_committed(
+        &mut self,
+        g: usize,
+        eps: [f64; 3],
+        sigma: [f64; 3],
+        dissipated: f64,
+        history: &[f64],
+    ) {
+        let l = self.layout();
+        self.committed[l.eps() + 3 * g..l.eps() + 3 * g + 3].copy_from_slice(&eps);
+        self.committed[l.sigma() + 3 * g..l.sigma() + 3 * g + 3].copy_from_slice(&sigma);
+        self.committed[l.dissipated() + g] = dissipated;
+        let o = l.history() + g * self.n_state;
+        self.committed[o..o + history.len()].copy_from_slice(history);
+    }
+
     /// Copies the committed state into the trial buffer (after setting an initial
     /// state by hand).
     pub fn reset_trial(&mut self) {

@@ -100,7 +100,9 @@ pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64;
 }
 
 /// Element means of the point fields of materials with history: damage, equivalent
-/// plastic strain `κ_t + κ_c`, and cumulative dissipation density (J/m³).
+/// plastic strain `κ_t + κ_c`, and cumulative dissipation density (J/m³). A state
+/// built from nodal fields has no cumulative dissipation density (NaN at every
+/// point): that field is left out.
 pub fn cell_history_fields(model: &Model, points: &[StateStore]) -> Vec<(&'static str, Vec<f64>)> {
     let mesh = &model.mesh;
     let (mut damage, mut eqp, mut diss) = (Vec::new(), Vec::new(), Vec::new());
@@ -118,9 +120,9 @@ pub fn cell_history_fields(model: &Model, points: &[StateStore]) -> Vec<(&'stati
             diss.push(m[2]);
         }
     }
-    vec![
-        ("damage", damage),
-        ("equivalent_plastic_strain", eqp),
-        ("dissipation_density", diss),
-    ]
+    let mut fields = vec![("damage", damage), ("equivalent_plastic_strain", eqp)];
+    if !diss.iter().all(|x| x.is_nan()) {
+        fields.push(("dissipation_density", diss));
+    }
+    fields
 }

@@ -136,6 +136,10 @@ impl Integrator for BackwardEuler<'_> {
         self.core.timing()
     }
 
+    fn output_points(&self, s: &State) -> Option<Vec<crate::material::store::StateStore>> {
+        self.core.ops.output_points(self.core.model, s)
+    }
+
     fn solver(&self) -> SolverFacts {
         self.core.solver()
     }

@@ -256,6 +256,7 @@ impl Integrator for CentralDifference<'_> {
             f_pred: Vec::new(),
             f_pred_h: h,
             contact,
+            nodal: Default::default(),
         })
     }
 

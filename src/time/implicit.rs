@@ -17,6 +17,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::forces::{external_force, gravity_force};
+use super::nodal::{NodalLaws, NodalState};
 use super::{Rejection, State, StepOutcome, StepReport};
 use crate::assembly::internal::{new_stores, PointPass, PointTotals};
 use crate::assembly::{Assembler, Mass};
@@ -24,7 +25,8 @@ use crate::contact::ContactCorrection;
 use crate::energy::{work_integrands, Dissipation, Ledger, StepIncrements, StepWork};
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;
-use crate::model::{IterationMethod, Model};
+use crate::material::store::StateStore;
+use crate::model::{IterationMethod, Model, ViscoelasticState};
 use crate::nonlinear::{
     self, Convergence, Correction, Evaluation, LinearCorrection, Outcome, StepProblem,
 };
@@ -36,8 +38,12 @@ pub(crate) enum Response {
     /// Every material is linear elastic: `f_int = K u`, no Gauss-point state.
     Elastic,
     /// Materials with history whose tangent is constant for a fixed step (linear
-    /// viscoelasticity): factorised once per step size, affine step.
+    /// viscoelasticity), their state at the Gauss points: factorised once per step
+    /// size, affine step, a Gauss-point pass per evaluation.
     Constant,
+    /// The same materials with their state in nodal fields ([`super::nodal`]): a
+    /// step of matrix-vector products.
+    Nodal,
     /// A state-dependent tangent (damage, plasticity), followed as `iteration` says.
     StateDependent(IterationMethod),
 }
@@ -69,8 +75,11 @@ pub(crate) struct Operators {
     pub mass: Mass,
     pub gravity: Option<Vec<f64>>,
     pub response: Response,
-    /// The constant tangent of `Response::Constant` for the current step size.
+    /// The constant tangent of `Response::Constant` and `Response::Nodal` for the
+    /// current step size.
     pub kt: Vec<f64>,
+    /// The nodal-field laws of `Response::Nodal`.
+    pub nodal: Option<NodalLaws>,
     pub scheme: Scheme,
     /// 1 on free dofs, 0 on constrained ones (sums over the free dofs without a
     /// branch).
@@ -90,7 +99,10 @@ impl Operators {
         let response = if model.materials.iter().all(|m| m.is_linear_elastic()) {
             Response::Elastic
         } else if model.materials.iter().all(|m| m.has_constant_tangent()) {
-            Response::Constant
+            match a.viscoelastic_state {
+                ViscoelasticState::Nodal => Response::Nodal,
+                ViscoelasticState::Points => Response::Constant,
+            }
         } else {
             Response::StateDependent(a.iteration)
         };
@@ -105,6 +117,7 @@ impl Operators {
             gravity,
             response,
             kt: Vec::new(),
+            nodal: None,
             scheme,
             free_mask,
             test: Convergence {
@@ -115,6 +128,9 @@ impl Operators {
                 complementarity_tolerance: a.contact_tolerance,
             },
         };
+        if response == Response::Nodal {
+            ops.nodal = Some(NodalLaws::new(model, &ops.asm));
+        }
         ops.update_constant_tangent(model);
         ops
     }
@@ -139,7 +155,7 @@ impl Operators {
     /// The tangent of constant-tangent materials at the current step size (it does
     /// not depend on the state: evaluated at rest from fresh stores).
     fn update_constant_tangent(&mut self, model: &Model) {
-        if self.response == Response::Constant {
+        if matches!(self.response, Response::Constant | Response::Nodal) {
             let stores = new_stores(&model.mesh, &model.materials);
             let u0 = vec![0.0; model.mesh.n_dofs()];
             self.kt = self.asm.tangent(
@@ -282,9 +298,14 @@ impl Operators {
         } else {
             Vec::new()
         };
+        let mut nodal = NodalState::default();
         let (e_el0, points) = if self.response == Response::Elastic {
             self.asm.pattern.matvec(&self.k, &u, &mut f_int);
             (0.5 * super::dot(&u, &f_int), Vec::new())
+        } else if let Some(laws) = &self.nodal {
+            let (state, psi) = laws.initial(&self.asm.pattern, &self.k, &u, &mut f_int);
+            nodal = state;
+            (psi, Vec::new())
         } else {
             let mut points = new_stores(&model.mesh, &model.materials);
             let pred = (!f_pred.is_empty()).then_some(&mut f_pred[..]);
@@ -313,7 +334,17 @@ impl Operators {
             f_pred,
             f_pred_h: self.h(),
             contact,
+            nodal,
         }
+    }
+
+    /// The Gauss-point stores of `s` for output: built from the nodal fields on the
+    /// nodal path (see [`NodalLaws::materialise`]), `None` where `s.points` holds
+    /// them already.
+    pub fn output_points(&self, model: &Model, s: &State) -> Option<Vec<StateStore>> {
+        self.nodal
+            .as_ref()
+            .map(|laws| laws.materialise(model, &s.u, &s.nodal))
     }
 }
 
@@ -332,8 +363,10 @@ pub(crate) struct Scratch {
     f_int_np1: Vec<f64>,
     /// Applied external forces at `t_{n+1}`; the reactions are added once converged.
     f_ext_np1: Vec<f64>,
-    /// Predicted internal force of the following step.
+    /// Predicted internal force of the following step (nodal fields: of this step).
     f_pred_np1: Vec<f64>,
+    /// Trial nodal fields.
+    nodal: NodalState,
     /// `K Δu` (elastic) or `K v` (stiffness damping of history materials).
     kdu: Vec<f64>,
     /// `M Δu_c` in a prediction.
@@ -368,11 +401,12 @@ impl Scratch {
             mv_np1: z(),
             f_int_np1: z(),
             f_ext_np1: z(),
-            f_pred_np1: if ops.response == Response::Constant {
+            f_pred_np1: if matches!(ops.response, Response::Constant | Response::Nodal) {
                 z()
             } else {
                 Vec::new()
             },
+            nodal: NodalState::default(),
             kdu: z(),
             m_du: z(),
             kt_du: z(),
@@ -407,8 +441,12 @@ impl StepProblem for ImplicitStep<'_> {
 
     fn predict(&mut self, u: &[f64], free: &[usize], rhs: &mut Vec<f64>) -> bool {
         let (ops, s, w) = (self.ops, &*self.s, &mut *self.w);
+        if let Some(laws) = &ops.nodal {
+            laws.predicted_force(ops.h(), &s.nodal, &mut w.f_pred_np1);
+        }
         let base: &[f64] = match ops.response {
             Response::Elastic => &s.f_int,
+            Response::Nodal => &w.f_pred_np1,
             Response::Constant if s.f_pred_h == ops.h() && !s.f_pred.is_empty() => &s.f_pred,
             _ => return false,
         };
@@ -473,6 +511,29 @@ impl StepProblem for ImplicitStep<'_> {
                     ops.mass.matvec(p, &w.du, &mut w.mv_np1);
                 }
                 (_, false) => p.matvec(&ops.k, &w.du, &mut w.kdu),
+            }
+        } else if let Some(laws) = &ops.nodal {
+            if w.nodal.is_empty() {
+                w.nodal = NodalLaws::trial_like(&s.nodal);
+            }
+            let t = laws.evaluate(
+                p,
+                &ops.k,
+                h,
+                u,
+                &w.du,
+                &s.nodal,
+                &mut w.nodal,
+                &mut w.f_int_np1,
+                &mut w.kdu,
+            );
+            w.totals = PointTotals {
+                psi: t.psi,
+                dissipation: t.dissipation,
+                failure: None,
+            };
+            if dynamic.is_some() {
+                ops.mass.matvec(p, &w.du, &mut w.mv_np1);
             }
         } else {
             let pred = (!w.f_pred_np1.is_empty()).then_some(&mut w.f_pred_np1[..]);
@@ -875,11 +936,15 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
         std::mem::swap(&mut s.v, &mut w.v_np1);
         std::mem::swap(&mut s.mv, &mut w.mv_np1);
     }
-    if !w.f_pred_np1.is_empty() {
-        std::mem::swap(&mut s.f_pred, &mut w.f_pred_np1);
-        s.f_pred_h = ops.h();
+    if ops.response == Response::Nodal {
+        std::mem::swap(&mut s.nodal, &mut w.nodal);
+    } else {
+        if !w.f_pred_np1.is_empty() {
+            std::mem::swap(&mut s.f_pred, &mut w.f_pred_np1);
+            s.f_pred_h = ops.h();
+        }
+        s.points.iter_mut().for_each(|p| p.commit());
     }
-    s.points.iter_mut().for_each(|p| p.commit());
     s.t = t1;
     s.step += 1;
 }

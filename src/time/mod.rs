@@ -14,6 +14,7 @@ pub mod cfl;
 pub mod forces;
 mod implicit;
 pub mod march;
+pub mod nodal;
 pub use implicit::first_matrices;
 pub mod statics;
 
@@ -55,6 +56,9 @@ pub struct State {
     pub f_pred_h: f64,
     /// The contact state (multipliers, per-pair forces, gaps and pressures).
     pub contact: crate::contact::ContactState,
+    /// Nodal fields of linear viscoelastic materials (empty unless the implicit
+    /// schemes keep them there; then `points` is empty between outputs).
+    pub nodal: nodal::NodalState,
 }
 
 /// What an accepted step reports besides the new state.
@@ -126,6 +130,12 @@ pub trait Integrator {
     fn timing(&self) -> Timing;
     /// The linear solver's facts.
     fn solver(&self) -> SolverFacts;
+    /// The Gauss-point state of `s` for output when `s.points` does not hold it
+    /// (state kept in nodal fields); `None` otherwise.
+    fn output_points(&self, s: &State) -> Option<Vec<StateStore>> {
+        let _ = s;
+        None
+    }
 
     /// [`Integrator::step`] for callers that treat a rejected step as an error
     /// (tests, benches, fixed-step studies).

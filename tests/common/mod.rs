@@ -42,6 +42,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
             ordering: rothe::model::Ordering::Auto,
             contact_tolerance: 1e-6,
             contact_qp: rothe::model::ContactQp::Condensed,
+            viscoelastic_state: rothe::model::ViscoelasticState::Nodal,
         },
     }
 }

@@ -148,6 +148,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             ordering: a.ordering,
             contact_tolerance,
             contact_qp: a.contact_qp,
+            viscoelastic_state: a.viscoelastic_state,
         },
     };
     if explicit {
