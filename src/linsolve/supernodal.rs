@@ -33,11 +33,145 @@ struct Supernode {
     values: usize,
 }
 
-/// Blocks of at least this many right-hand sides are split over two threads.
-const PARALLEL_COLUMNS: usize = 8;
-
 /// Systems of at least this order are worth a second thread.
 const PARALLEL_ORDER: usize = 20_000;
+
+/// The cut of the elimination forest stops refining once its time (the heavier
+/// part plus the top, in values) is within this share of half the factor above it.
+const MAX_IMBALANCE: f64 = 0.04;
+
+/// The top of a cut holds at most this share of the factor.
+const MAX_TOP: f64 = 0.3;
+
+/// A cut is used only if its time is at most this share of the sequential one.
+const MIN_GAIN: f64 = 0.8;
+
+/// The elimination forest cut for two threads: two sets of whole subtrees, each
+/// over a contiguous range of columns (the supernodes are in postorder), and the
+/// supernodes above them (the top). A sweep runs the two parts at once, each on its
+/// own part of `x`, and the top alone: forward after the parts (their updates of
+/// top rows collected in a buffer per thread and added in), backward before them
+/// (the parts read the top rows from a copy).
+#[derive(Debug)]
+struct TreeSplit {
+    /// The first column of the second part.
+    mid: usize,
+    /// Each part's `(supernode, split)` in order: the pattern rows from position
+    /// `split` on lie above the supernode's subtree, in the top.
+    parts: [Vec<(u32, u32)>; 2],
+    /// The top's supernodes in order.
+    top: Vec<u32>,
+    /// The top's columns.
+    top_cols: Vec<u32>,
+}
+
+impl TreeSplit {
+    /// The split of the forest `parent` of `nodes`, if it is in postorder and has
+    /// two balanced parts below a small top.
+    fn new(nodes: &[Supernode], parent: &[usize], rows: &[usize]) -> Option<Self> {
+        let ns = nodes.len();
+        let mut children = vec![Vec::new(); ns];
+        let mut roots = Vec::new();
+        for (s, &p) in parent.iter().enumerate() {
+            if p == usize::MAX {
+                roots.push(s);
+            } else if p <= s {
+                return None;
+            } else {
+                children[p].push(s);
+            }
+        }
+        // Subtree weights (values stored) and first supernodes; postorder check.
+        let mut weight = vec![0.0f64; ns];
+        let mut first = (0..ns).collect::<Vec<_>>();
+        let mut size = vec![1usize; ns];
+        for s in 0..ns {
+            let sn = &nodes[s];
+            weight[s] += (sn.ncols * (sn.ncols + sn.npattern)) as f64;
+            if s + 1 < first[s] + size[s] {
+                return None;
+            }
+            if s + 1 - first[s] != size[s] {
+                return None;
+            }
+            let p = parent[s];
+            if p != usize::MAX {
+                weight[p] += weight[s];
+                first[p] = first[p].min(first[s]);
+                size[p] += size[s];
+            }
+        }
+        let total: f64 = roots.iter().map(|&r| weight[r]).sum();
+        let own = |t: usize| (nodes[t].ncols * (nodes[t].ncols + nodes[t].npattern)) as f64;
+        // Cut the heaviest subtree of the frontier while the top stays light; keep
+        // the cut whose time, the heavier part plus the top, is least.
+        let mut frontier = roots;
+        let mut top = Vec::new();
+        let mut top_weight = 0.0;
+        let mut best: Option<(f64, usize, Vec<usize>, Vec<usize>)> = None;
+        loop {
+            let mut prefix = 0.0;
+            let (mut cost, mut at) = (f64::INFINITY, 0);
+            for (i, &r) in frontier.iter().enumerate().take(frontier.len() - 1) {
+                prefix += weight[r];
+                let c = prefix.max(total - top_weight - prefix) + top_weight;
+                if c < cost {
+                    (cost, at) = (c, i + 1);
+                }
+            }
+            if at > 0 && best.as_ref().is_none_or(|b| cost < b.0) {
+                best = Some((cost, at, frontier.clone(), top.clone()));
+            }
+            if cost <= (0.5 + MAX_IMBALANCE) * total {
+                break;
+            }
+            let Some(heaviest) = frontier
+                .iter()
+                .enumerate()
+                .filter(|(_, &r)| !children[r].is_empty())
+                .max_by(|a, b| weight[*a.1].total_cmp(&weight[*b.1]))
+                .map(|(i, _)| i)
+            else {
+                break;
+            };
+            let r = frontier.remove(heaviest);
+            top.push(r);
+            top_weight += own(r);
+            if top_weight > MAX_TOP * total {
+                break;
+            }
+            frontier.splice(heaviest..heaviest, children[r].iter().copied());
+        }
+        let (cost, cut, frontier, mut top) = best?;
+        if cost > MIN_GAIN * total {
+            return None;
+        }
+        let mid = nodes[first[frontier[cut]]].begin;
+        let part = |roots: &[usize]| {
+            let mut out = Vec::new();
+            for &r in roots {
+                let hi = nodes[r].begin + nodes[r].ncols;
+                for s in first[r]..=r {
+                    let sn = &nodes[s];
+                    let pattern = &rows[sn.pattern..sn.pattern + sn.npattern];
+                    out.push((s as u32, pattern.partition_point(|&row| row < hi) as u32));
+                }
+            }
+            out
+        };
+        top.sort_unstable();
+        let top_cols = top
+            .iter()
+            .flat_map(|&t| (nodes[t].begin..nodes[t].begin + nodes[t].ncols).map(|c| c as u32))
+            .collect();
+        Some(TreeSplit {
+            mid,
+            parts: [part(&frontier[..cut]), part(&frontier[cut..])],
+            top: top.into_iter().map(|t| t as u32).collect(),
+            top_cols,
+        })
+    }
+}
 
 /// The buffers of one block solve.
 #[derive(Default)]
@@ -46,6 +180,8 @@ struct Workspace {
     x: Vec<f64>,
     /// Gathered or accumulated pattern rows (`max p_s × k`).
     tmp: Vec<f64>,
+    /// A thread's updates of the top rows (`n × k`, zero outside a solve).
+    far: Vec<f64>,
 }
 
 /// What a block solve reads of the factor's structure.
@@ -56,12 +192,14 @@ struct Structure<'a> {
     nodes: &'a [Supernode],
     rows: &'a [usize],
     perm: &'a [usize],
+    /// The two-thread cut of the elimination forest, where it pays.
+    split: Option<&'a TreeSplit>,
 }
 
 impl Structure<'_> {
     /// Solves the `k` column-major right-hand sides in `rhs`, `8, 4, 2, 1` at a
-    /// time, in the workspace `w`.
-    fn solve_cols(&self, values: &[f64], rhs: &mut [f64], k: usize, w: &mut Workspace) {
+    /// time, in the workspaces `w`.
+    fn solve_cols(&self, values: &[f64], rhs: &mut [f64], k: usize, w: &mut [Workspace; 2]) {
         let n = self.n;
         let mut col = 0;
         while col < k {
@@ -84,24 +222,50 @@ impl Structure<'_> {
 
     /// `K` right-hand sides: permute into the row-major work copy, solve, permute
     /// back.
-    fn solve_block<const K: usize>(&self, values: &[f64], rhs: &mut [f64], w: &mut Workspace) {
+    fn solve_block<const K: usize>(&self, values: &[f64], rhs: &mut [f64], w: &mut [Workspace; 2]) {
         let n = self.n;
-        w.x.resize(n * K, 0.0);
+        let [w0, w1] = w;
+        w0.x.resize(n * K, 0.0);
         for i in 0..n {
             let p = self.perm[i];
             for c in 0..K {
-                w.x[i * K + c] = rhs[c * n + p];
+                w0.x[i * K + c] = rhs[c * n + p];
             }
         }
-        w.tmp.resize(w.tmp.len().max(self.max_pattern * K), 0.0);
-        sweeps_best::<K>(
-            Sweeps::Both,
-            self.nodes,
-            self.rows,
+        let f = Factor {
+            nodes: self.nodes,
+            rows: self.rows,
             values,
-            &mut w.x,
-            &mut w.tmp,
-        );
+        };
+        for wk in [&mut *w0, &mut *w1] {
+            wk.tmp.resize(wk.tmp.len().max(self.max_pattern * K), 0.0);
+        }
+        match self.split {
+            Some(split) => {
+                for wk in [&mut *w0, &mut *w1] {
+                    wk.far.resize(n * K, 0.0);
+                }
+                split_sweeps::<K>(
+                    &f,
+                    split,
+                    &mut w0.x,
+                    [w0.tmp.as_mut(), w1.tmp.as_mut()],
+                    [w0.far.as_mut(), w1.far.as_mut()],
+                );
+            }
+            None => {
+                f.sweep::<K>(Dir::Forward, Run::All, &mut w0.x, &mut w0.tmp, &mut [], &[]);
+                f.sweep::<K>(
+                    Dir::Backward,
+                    Run::All,
+                    &mut w0.x,
+                    &mut w0.tmp,
+                    &mut [],
+                    &[],
+                );
+            }
+        }
+        let w = w0;
         for i in 0..n {
             let p = self.perm[i];
             for c in 0..K {
@@ -125,8 +289,10 @@ pub struct SupernodalSolver {
     perm: Vec<usize>,
     /// `inverse[perm[i]] = i`.
     inverse: Vec<usize>,
-    /// Workspaces of the block solves (two: a wide block runs as two halves).
+    /// Workspaces of the block solves (one per thread of a split solve).
     work: [Workspace; 2],
+    /// The two-thread cut of the elimination forest (large systems).
+    split: Option<TreeSplit>,
     /// The sparse solves' copy of the right-hand side (elimination order).
     x: Vec<f64>,
     /// Gathered or accumulated pattern rows of the sparse solves (as long as the
@@ -198,7 +364,7 @@ impl SupernodalSolver {
         for (s, sn) in nodes.iter().enumerate() {
             node_of[sn.begin..sn.begin + sn.ncols].fill(s);
         }
-        let parent = nodes
+        let parent: Vec<usize> = nodes
             .iter()
             .map(|sn| {
                 if sn.npattern == 0 {
@@ -214,8 +380,14 @@ impl SupernodalSolver {
         for (i, &p) in perm.iter().enumerate() {
             inverse[p] = i;
         }
+        let split = if n >= PARALLEL_ORDER {
+            TreeSplit::new(&nodes, &parent, &rows)
+        } else {
+            None
+        };
         SupernodalSolver {
             n,
+            split,
             nodes,
             rows,
             node_of,
@@ -249,20 +421,12 @@ impl SupernodalSolver {
             nodes: &self.nodes,
             rows: &self.rows,
             perm: &self.perm,
+            split: self
+                .split
+                .as_ref()
+                .filter(|_| rayon::current_num_threads() > 1),
         };
-        if k >= PARALLEL_COLUMNS && n >= PARALLEL_ORDER && rayon::current_num_threads() > 1 {
-            // Two halves of the block on two threads, each with its own workspace:
-            // wide blocks are bound by the multiply-adds, not by the factor's stream.
-            let half = k / 2;
-            let (left, right) = rhs.split_at_mut(half * n);
-            let (w0, w1) = self.work.split_at_mut(1);
-            rayon::join(
-                || st.solve_cols(values, left, half, &mut w0[0]),
-                || st.solve_cols(values, right, k - half, &mut w1[0]),
-            );
-        } else {
-            st.solve_cols(values, rhs, k, &mut self.work[0]);
-        }
+        st.solve_cols(values, rhs, k, &mut self.work);
     }
 
     /// The forward solve of a sparse right-hand side: `y = L⁻¹ P b` for the `b`
@@ -291,7 +455,12 @@ impl SupernodalSolver {
         }
         self.reach.sort_unstable();
         for &s in &self.reach {
-            forward_node::<1, Plain>(&self.nodes[s], &self.rows, values, y, &mut self.tmp);
+            let sn = &self.nodes[s];
+            let at = Place {
+                lo: 0,
+                split: sn.npattern,
+            };
+            forward_node::<1, Plain>(sn, &self.rows, values, y, &mut self.tmp, at, &mut []);
             self.mark[s] = false;
         }
         self.reach.len()
@@ -307,13 +476,18 @@ impl SupernodalSolver {
         let mut y = std::mem::take(&mut self.x);
         y.resize(n, 0.0);
         self.forward_sparse(values, entries, &mut y[..n]);
-        sweeps_best::<1>(
-            Sweeps::Backward,
-            &self.nodes,
-            &self.rows,
+        let f = Factor {
+            nodes: &self.nodes,
+            rows: &self.rows,
             values,
+        };
+        f.sweep::<1>(
+            Dir::Backward,
+            Run::All,
             &mut y[..n],
             &mut self.tmp,
+            &mut [],
+            &[],
         );
         for i in 0..n {
             out[self.perm[i]] = y[i];
@@ -327,12 +501,38 @@ impl SupernodalSolver {
         for i in 0..self.n {
             y[i] = b[self.perm[i]];
         }
-        for sn in &self.nodes {
-            forward_node::<1, Plain>(sn, &self.rows, values, y, &mut self.tmp);
-        }
+        let f = Factor {
+            nodes: &self.nodes,
+            rows: &self.rows,
+            values,
+        };
+        f.sweep::<1>(Dir::Forward, Run::All, y, &mut self.tmp, &mut [], &[]);
     }
 
-    /// The number of supernodes.
+    /// The shares of the factor's values in the two parts and the top of the
+    /// two-thread cut of the elimination forest, if the solves use one.
+    pub fn split_shares(&self) -> Option<[f64; 3]> {
+        let split = self.split.as_ref()?;
+        let w = |s: usize| {
+            let sn = &self.nodes[s];
+            (sn.ncols * (sn.ncols + sn.npattern)) as f64
+        };
+        let part = |p: &[(u32, u32)]| p.iter().map(|&(s, _)| w(s as usize)).sum::<f64>();
+        let shares = [
+            part(&split.parts[0]),
+            part(&split.parts[1]),
+            split.top.iter().map(|&s| w(s as usize)).sum(),
+        ];
+        let total: f64 = shares.iter().sum();
+        Some(shares.map(|x| x / total))
+    }
+
+    /// The shape `(columns, pattern rows)` of every supernode.
+    pub fn shapes(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.nodes.iter().map(|s| (s.ncols, s.npattern))
+    }
+
+    /// Number of supernodes.
     pub fn supernodes(&self) -> usize {
         self.nodes.len()
     }
@@ -367,6 +567,17 @@ impl MulAdd for Fused {
 /// of dependent additions would wait on the adder's latency instead of memory.
 const LANES: usize = 4;
 
+/// Where a supernode's step reads and writes `x`: the rows from `lo` on are in `x`
+/// (row `r` at `(r − lo) K`), and the pattern rows from position `split` on (rows
+/// above the subtree a thread owns) are in `far` instead (row `r` at `r K`): the
+/// forward step adds its updates of them there, the backward step reads them there.
+/// A sequential sweep has `lo = 0`, `split = p_s` and an empty `far`.
+#[derive(Clone, Copy)]
+struct Place {
+    lo: usize,
+    split: usize,
+}
+
 /// Forward step of one supernode on `K` row-major right-hand sides:
 /// `x_s ← L_ss⁻¹ x_s`, `x_p ← x_p − L_ps x_s`, one pass over each column, in memory
 /// order.
@@ -377,18 +588,30 @@ fn forward_node<const K: usize, M: MulAdd>(
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
+    at: Place,
+    far: &mut [f64],
 ) {
-    let (b, ns, np) = (sn.begin, sn.ncols, sn.npattern);
+    let (ns, np) = (sn.ncols, sn.npattern);
+    let b = sn.begin - at.lo;
     let ld = ns + np;
+    let pattern = &rows[sn.pattern..sn.pattern + np];
+    let (near_rows, far_rows) = pattern.split_at(at.split);
     if ns == 1 {
         // One column (a simplicial factor's): straight into x, no buffer.
         let col = &values[sn.values..sn.values + ld];
         let inv = 1.0 / col[0];
         let xj: [f64; K] = std::array::from_fn(|c| x[b * K + c] * inv);
         x[b * K..(b + 1) * K].copy_from_slice(&xj);
-        for (&l, &row) in col[1..].iter().zip(&rows[sn.pattern..sn.pattern + np]) {
+        let (near, rest) = col[1..].split_at(at.split);
+        for (&l, &row) in near.iter().zip(near_rows) {
+            let r = row - at.lo;
             for c in 0..K {
-                x[row * K + c] = M::mul_add(l, -xj[c], x[row * K + c]);
+                x[r * K + c] = M::mul_add(l, -xj[c], x[r * K + c]);
+            }
+        }
+        for (&l, &row) in rest.iter().zip(far_rows) {
+            for c in 0..K {
+                far[row * K + c] = M::mul_add(l, -xj[c], far[row * K + c]);
             }
         }
         return;
@@ -418,9 +641,16 @@ fn forward_node<const K: usize, M: MulAdd>(
             }
         }
     }
-    for (t, &row) in tmp.chunks_exact(K).zip(&rows[sn.pattern..sn.pattern + np]) {
+    let (near, rest) = tmp.split_at(at.split * K);
+    for (t, &row) in near.chunks_exact(K).zip(near_rows) {
+        let r = row - at.lo;
         for c in 0..K {
-            x[row * K + c] -= t[c];
+            x[r * K + c] -= t[c];
+        }
+    }
+    for (t, &row) in rest.chunks_exact(K).zip(far_rows) {
+        for c in 0..K {
+            far[row * K + c] -= t[c];
         }
     }
 }
@@ -435,17 +665,29 @@ fn backward_node<const K: usize, M: MulAdd>(
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
+    at: Place,
+    far: &[f64],
 ) {
-    let (b, ns, np) = (sn.begin, sn.ncols, sn.npattern);
+    let (ns, np) = (sn.ncols, sn.npattern);
+    let b = sn.begin - at.lo;
     let ld = ns + np;
+    let pattern = &rows[sn.pattern..sn.pattern + np];
+    let (near_rows, far_rows) = pattern.split_at(at.split);
     if ns == 1 {
         let col = &values[sn.values..sn.values + ld];
+        let (near, rest) = col[1..].split_at(at.split);
         let mut acc = [[0.0; K]; LANES];
-        let pattern = &rows[sn.pattern..sn.pattern + np];
-        for (k, (&l, &row)) in col[1..].iter().zip(pattern).enumerate().rev() {
+        for (k, (&l, &row)) in rest.iter().zip(far_rows).enumerate().rev() {
             let lane = k % LANES;
             for c in 0..K {
-                acc[lane][c] = M::mul_add(l, x[row * K + c], acc[lane][c]);
+                acc[lane][c] = M::mul_add(l, far[row * K + c], acc[lane][c]);
+            }
+        }
+        for (k, (&l, &row)) in near.iter().zip(near_rows).enumerate().rev() {
+            let lane = k % LANES;
+            let r = row - at.lo;
+            for c in 0..K {
+                acc[lane][c] = M::mul_add(l, x[r * K + c], acc[lane][c]);
             }
         }
         let inv = 1.0 / col[0];
@@ -456,11 +698,13 @@ fn backward_node<const K: usize, M: MulAdd>(
         return;
     }
     let tmp = &mut tmp[..np * K];
-    for (t, &row) in tmp
-        .chunks_exact_mut(K)
-        .zip(&rows[sn.pattern..sn.pattern + np])
-    {
-        t.copy_from_slice(&x[row * K..(row + 1) * K]);
+    let (near_t, far_t) = tmp.split_at_mut(at.split * K);
+    for (t, &row) in near_t.chunks_exact_mut(K).zip(near_rows) {
+        let r = row - at.lo;
+        t.copy_from_slice(&x[r * K..(r + 1) * K]);
+    }
+    for (t, &row) in far_t.chunks_exact_mut(K).zip(far_rows) {
+        t.copy_from_slice(&far[row * K..(row + 1) * K]);
     }
     let block = &values[sn.values..sn.values + ld * ns];
     // Last column first, each column from its last row up: the whole backward sweep
@@ -498,68 +742,232 @@ fn dot_rows_rev<const K: usize, M: MulAdd>(l: &[f64], y: &[f64], acc: &mut [[f64
     }
 }
 
-/// Which sweeps a solve makes.
+/// The direction of a sweep.
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Sweeps {
-    /// Forward and backward: `A⁻¹`.
-    Both,
-    /// Backward only (after a sparse forward solve).
+enum Dir {
+    /// `L⁻¹`, supernodes in order.
+    Forward,
+    /// `L⁻ᵀ`, supernodes in reverse.
     Backward,
 }
 
-/// The sweeps over all supernodes, for one kernel flavour.
+/// The supernodes a sweep visits.
+#[derive(Clone, Copy)]
+enum Run<'a> {
+    /// All of them, on the whole `x`.
+    All,
+    /// The listed ones, on the whole `x`.
+    Listed(&'a [u32]),
+    /// One thread's subtrees: `(supernode, split)` in order, on the part of `x` from
+    /// column `lo` on, rows above the subtrees in `far` (see [`Place`]).
+    Part { lo: usize, nodes: &'a [(u32, u32)] },
+}
+
+/// A sweep over `run`, for one kernel flavour: a forward sweep adds its updates of
+/// far rows to `far_out`, a backward sweep reads them from `far_in`.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn sweeps<const K: usize, M: MulAdd>(
-    which: Sweeps,
+fn sweep<const K: usize, M: MulAdd>(
+    dir: Dir,
+    run: Run,
     nodes: &[Supernode],
     rows: &[usize],
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
+    far_out: &mut [f64],
+    far_in: &[f64],
 ) {
-    if which == Sweeps::Both {
-        for sn in nodes {
-            forward_node::<K, M>(sn, rows, values, x, tmp);
+    let whole = |sn: &Supernode| Place {
+        lo: 0,
+        split: sn.npattern,
+    };
+    let fwd = |sn: &Supernode, at: Place, x: &mut [f64], tmp: &mut [f64], far: &mut [f64]| {
+        forward_node::<K, M>(sn, rows, values, x, tmp, at, far)
+    };
+    let bwd = |sn: &Supernode, at: Place, x: &mut [f64], tmp: &mut [f64]| {
+        backward_node::<K, M>(sn, rows, values, x, tmp, at, far_in)
+    };
+    match (dir, run) {
+        (Dir::Forward, Run::All) => {
+            for sn in nodes {
+                fwd(sn, whole(sn), x, tmp, &mut []);
+            }
         }
-    }
-    for sn in nodes.iter().rev() {
-        backward_node::<K, M>(sn, rows, values, x, tmp);
+        (Dir::Backward, Run::All) => {
+            for sn in nodes.iter().rev() {
+                bwd(sn, whole(sn), x, tmp);
+            }
+        }
+        (Dir::Forward, Run::Listed(ids)) => {
+            for &s in ids {
+                let sn = &nodes[s as usize];
+                fwd(sn, whole(sn), x, tmp, &mut []);
+            }
+        }
+        (Dir::Backward, Run::Listed(ids)) => {
+            for &s in ids.iter().rev() {
+                let sn = &nodes[s as usize];
+                bwd(sn, whole(sn), x, tmp);
+            }
+        }
+        (Dir::Forward, Run::Part { lo, nodes: ids }) => {
+            for &(s, split) in ids {
+                let at = Place {
+                    lo,
+                    split: split as usize,
+                };
+                fwd(&nodes[s as usize], at, x, tmp, far_out);
+            }
+        }
+        (Dir::Backward, Run::Part { lo, nodes: ids }) => {
+            for &(s, split) in ids.iter().rev() {
+                let at = Place {
+                    lo,
+                    split: split as usize,
+                };
+                bwd(&nodes[s as usize], at, x, tmp);
+            }
+        }
     }
 }
 
-/// [`sweeps`] compiled for AVX2 with FMA.
+/// Both sweeps of a block of `K` row-major right-hand sides `x` on two threads, cut
+/// by `split`, with one `tmp` and one `far` buffer per thread (`far` zero on entry
+/// and on return).
+fn split_sweeps<const K: usize>(
+    f: &Factor,
+    split: &TreeSplit,
+    x: &mut [f64],
+    tmp: [&mut [f64]; 2],
+    far: [&mut [f64]; 2],
+) {
+    let [t0, t1] = tmp;
+    let [f0, f1] = far;
+    let mid = split.mid;
+    {
+        let (x0, x1) = x.split_at_mut(mid * K);
+        let (p0, p1) = (&split.parts[0], &split.parts[1]);
+        rayon::join(
+            || {
+                f.sweep::<K>(
+                    Dir::Forward,
+                    Run::Part { lo: 0, nodes: p0 },
+                    x0,
+                    t0,
+                    f0,
+                    &[],
+                )
+            },
+            || {
+                f.sweep::<K>(
+                    Dir::Forward,
+                    Run::Part { lo: mid, nodes: p1 },
+                    x1,
+                    t1,
+                    f1,
+                    &[],
+                )
+            },
+        );
+    }
+    for &c in &split.top_cols {
+        let i = c as usize * K;
+        for j in i..i + K {
+            x[j] += f0[j] + f1[j];
+            f1[j] = 0.0;
+        }
+    }
+    let top = Run::Listed(&split.top);
+    f.sweep::<K>(Dir::Forward, top, x, t0, &mut [], &[]);
+    f.sweep::<K>(Dir::Backward, top, x, t0, &mut [], &[]);
+    // The parts read the top rows from `f0`.
+    for &c in &split.top_cols {
+        let i = c as usize * K;
+        f0[i..i + K].copy_from_slice(&x[i..i + K]);
+    }
+    {
+        let far: &[f64] = f0;
+        let (x0, x1) = x.split_at_mut(mid * K);
+        let (p0, p1) = (&split.parts[0], &split.parts[1]);
+        rayon::join(
+            || {
+                f.sweep::<K>(
+                    Dir::Backward,
+                    Run::Part { lo: 0, nodes: p0 },
+                    x0,
+                    t0,
+                    &mut [],
+                    far,
+                )
+            },
+            || {
+                f.sweep::<K>(
+                    Dir::Backward,
+                    Run::Part { lo: mid, nodes: p1 },
+                    x1,
+                    t1,
+                    &mut [],
+                    far,
+                )
+            },
+        );
+    }
+    for &c in &split.top_cols {
+        let i = c as usize * K;
+        f0[i..i + K].fill(0.0);
+    }
+}
+
+/// [`sweep`] compiled for AVX2 with FMA.
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA (checked by the caller).
+#[allow(clippy::too_many_arguments)]
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn sweeps_avx2<const K: usize>(
-    which: Sweeps,
+unsafe fn sweep_avx2<const K: usize>(
+    dir: Dir,
+    run: Run,
     nodes: &[Supernode],
     rows: &[usize],
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
+    far_out: &mut [f64],
+    far_in: &[f64],
 ) {
-    sweeps::<K, Fused>(which, nodes, rows, values, x, tmp)
+    sweep::<K, Fused>(dir, run, nodes, rows, values, x, tmp, far_out, far_in)
 }
 
-/// [`sweeps`] with the fastest kernels this CPU runs.
-fn sweeps_best<const K: usize>(
-    which: Sweeps,
-    nodes: &[Supernode],
-    rows: &[usize],
-    values: &[f64],
-    x: &mut [f64],
-    tmp: &mut [f64],
-) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-            // SAFETY: both features were just detected.
-            unsafe { sweeps_avx2::<K>(which, nodes, rows, values, x, tmp) };
-            return;
+/// What one sweep reads besides `x` and its buffers.
+#[derive(Clone, Copy)]
+struct Factor<'a> {
+    nodes: &'a [Supernode],
+    rows: &'a [usize],
+    values: &'a [f64],
+}
+
+impl Factor<'_> {
+    /// [`sweep`] with the fastest kernels this CPU runs.
+    fn sweep<const K: usize>(
+        &self,
+        dir: Dir,
+        run: Run,
+        x: &mut [f64],
+        tmp: &mut [f64],
+        far_out: &mut [f64],
+        far_in: &[f64],
+    ) {
+        let (nodes, rows, values) = (self.nodes, self.rows, self.values);
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                // SAFETY: both features were just detected.
+                unsafe { sweep_avx2::<K>(dir, run, nodes, rows, values, x, tmp, far_out, far_in) };
+                return;
+            }
         }
+        sweep::<K, Plain>(dir, run, nodes, rows, values, x, tmp, far_out, far_in)
     }
-    sweeps::<K, Plain>(which, nodes, rows, values, x, tmp)
 }
