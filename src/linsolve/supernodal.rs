@@ -778,37 +778,36 @@ fn sweep<const K: usize, M: MulAdd>(
     far_out: &mut [f64],
     far_in: &[f64],
 ) {
-    let whole = |sn: &Supernode| Place {
-        lo: 0,
-        split: sn.npattern,
-    };
-    let fwd = |sn: &Supernode, at: Place, x: &mut [f64], tmp: &mut [f64], far: &mut [f64]| {
-        forward_node::<K, M>(sn, rows, values, x, tmp, at, far)
-    };
-    let bwd = |sn: &Supernode, at: Place, x: &mut [f64], tmp: &mut [f64]| {
-        backward_node::<K, M>(sn, rows, values, x, tmp, at, far_in)
-    };
+    #[inline(always)]
+    fn whole(sn: &Supernode) -> Place {
+        Place {
+            lo: 0,
+            split: sn.npattern,
+        }
+    }
+    // Direct calls (no closures): every kernel must inline into the caller compiled
+    // for AVX2 and FMA, or `mul_add` becomes a call to the software `fma`.
     match (dir, run) {
         (Dir::Forward, Run::All) => {
             for sn in nodes {
-                fwd(sn, whole(sn), x, tmp, &mut []);
+                forward_node::<K, M>(sn, rows, values, x, tmp, whole(sn), &mut []);
             }
         }
         (Dir::Backward, Run::All) => {
             for sn in nodes.iter().rev() {
-                bwd(sn, whole(sn), x, tmp);
+                backward_node::<K, M>(sn, rows, values, x, tmp, whole(sn), far_in);
             }
         }
         (Dir::Forward, Run::Listed(ids)) => {
             for &s in ids {
                 let sn = &nodes[s as usize];
-                fwd(sn, whole(sn), x, tmp, &mut []);
+                forward_node::<K, M>(sn, rows, values, x, tmp, whole(sn), &mut []);
             }
         }
         (Dir::Backward, Run::Listed(ids)) => {
             for &s in ids.iter().rev() {
                 let sn = &nodes[s as usize];
-                bwd(sn, whole(sn), x, tmp);
+                backward_node::<K, M>(sn, rows, values, x, tmp, whole(sn), far_in);
             }
         }
         (Dir::Forward, Run::Part { lo, nodes: ids }) => {
@@ -817,7 +816,8 @@ fn sweep<const K: usize, M: MulAdd>(
                     lo,
                     split: split as usize,
                 };
-                fwd(&nodes[s as usize], at, x, tmp, far_out);
+                let sn = &nodes[s as usize];
+                forward_node::<K, M>(sn, rows, values, x, tmp, at, far_out);
             }
         }
         (Dir::Backward, Run::Part { lo, nodes: ids }) => {
@@ -826,7 +826,8 @@ fn sweep<const K: usize, M: MulAdd>(
                     lo,
                     split: split as usize,
                 };
-                bwd(&nodes[s as usize], at, x, tmp);
+                let sn = &nodes[s as usize];
+                backward_node::<K, M>(sn, rows, values, x, tmp, at, far_in);
             }
         }
     }
