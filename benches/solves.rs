@@ -29,6 +29,21 @@ fn triad(c: &mut Criterion) {
             black_box(&a);
         })
     });
+    // On all cores (STREAM's convention): the two-thread solve draws on this.
+    let chunk = n.div_ceil(rayon::current_num_threads());
+    g.bench_function("triad_all_cores", |bench| {
+        use rayon::prelude::*;
+        bench.iter(|| {
+            a.par_chunks_mut(chunk)
+                .zip(b.par_chunks(chunk).zip(cc.par_chunks(chunk)))
+                .for_each(|(a, (b, c))| {
+                    for ((x, y), z) in a.iter_mut().zip(b).zip(c) {
+                        *x = y + 3.0 * z;
+                    }
+                });
+            black_box(&a);
+        })
+    });
     g.finish();
 }
 

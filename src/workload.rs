@@ -130,18 +130,30 @@ pub fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> crate::linsolve::L
 }
 
 /// The memory bandwidth of a STREAM-triad-like kernel `a = b + s c` over three
-/// arrays of `n` doubles (bytes/s, 24 bytes per element, best of `reps`), so that a
-/// solve's achieved bandwidth can be set beside the machine's in the same run.
-pub fn triad_bandwidth(n: usize, reps: usize) -> f64 {
+/// arrays of `n` doubles (bytes/s, 24 bytes per element, best of `reps`), on one
+/// thread or, with `all_cores`, split over the rayon pool's threads (STREAM's
+/// convention, and what a solve on both cores can draw on), so that a solve's
+/// achieved bandwidth can be set beside the machine's in the same run.
+pub fn triad_bandwidth(n: usize, reps: usize, all_cores: bool) -> f64 {
+    use rayon::prelude::*;
     let b = vec![1.0f64; n];
     let c = vec![2.0f64; n];
     let mut a = vec![0.0f64; n];
+    let chunk = if all_cores {
+        n.div_ceil(rayon::current_num_threads()).max(1)
+    } else {
+        n.max(1)
+    };
     let mut best = f64::INFINITY;
     for _ in 0..reps.max(1) {
         let t = std::time::Instant::now();
-        for ((x, y), z) in a.iter_mut().zip(&b).zip(&c) {
-            *x = y + 3.0 * z;
-        }
+        a.par_chunks_mut(chunk)
+            .zip(b.par_chunks(chunk).zip(c.par_chunks(chunk)))
+            .for_each(|(a, (b, c))| {
+                for ((x, y), z) in a.iter_mut().zip(b).zip(c) {
+                    *x = y + 3.0 * z;
+                }
+            });
         std::hint::black_box(&a);
         best = best.min(t.elapsed().as_secs_f64());
     }
