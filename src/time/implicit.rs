@@ -17,7 +17,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::forces::{external_force, gravity_force};
-use super::nodal::{NodalLaws, NodalState};
+use super::nodal::{MassProduct, NodalLaws, NodalState};
 use super::{Rejection, State, StepOutcome, StepReport};
 use crate::assembly::internal::{new_stores, PointPass, PointTotals};
 use crate::assembly::{Assembler, Mass};
@@ -526,13 +526,20 @@ impl StepProblem for ImplicitStep<'_> {
                 &mut w.nodal,
                 &mut w.f_int_np1,
                 &mut w.kdu,
+                match (&ops.mass, dynamic.is_some()) {
+                    (Mass::Consistent(m), true) => Some(MassProduct {
+                        m,
+                        out: &mut w.mv_np1,
+                    }),
+                    _ => None,
+                },
             );
             w.totals = PointTotals {
                 psi: t.psi,
                 dissipation: t.dissipation,
                 failure: None,
             };
-            if dynamic.is_some() {
+            if let (Mass::Lumped(_), true) = (&ops.mass, dynamic.is_some()) {
                 ops.mass.matvec(p, &w.du, &mut w.mv_np1);
             }
         } else {

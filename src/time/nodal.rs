@@ -94,6 +94,15 @@ impl NodalState {
     }
 }
 
+/// A consistent mass matrix and where `M Δu` goes, for [`NodalLaws::evaluate`] to
+/// form in the same pass as the first stiffness product.
+pub(crate) struct MassProduct<'a> {
+    /// `M` on the shared pattern.
+    pub m: &'a [f64],
+    /// `M Δu`.
+    pub out: &'a mut [f64],
+}
+
 /// The energy terms of one evaluation.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct NodalTotals {
@@ -285,6 +294,7 @@ impl NodalLaws {
         trial: &mut NodalState,
         f: &mut [f64],
         kdu: &mut [f64],
+        mut mass: Option<MassProduct>,
     ) -> NodalTotals {
         let mut totals = NodalTotals::default();
         for (gi, (g, (old, new))) in self
@@ -293,7 +303,13 @@ impl NodalLaws {
             .zip(s.groups.iter().zip(trial.groups.iter_mut()))
             .enumerate()
         {
-            p.matvec(self.stiffness(g, k), u, &mut new.ku);
+            match mass.take() {
+                // The first group's product and `M Δu` in one pass over the pattern.
+                Some(MassProduct { m, out }) => {
+                    p.matvec2(self.stiffness(g, k), u, &mut new.ku, m, du, out)
+                }
+                None => p.matvec(self.stiffness(g, k), u, &mut new.ku),
+            }
             if g.law == GroupLaw::MatrixVoigt {
                 p.matvec(&g.v, u, &mut new.vu);
             }
