@@ -129,7 +129,12 @@ impl Operators {
             },
         };
         if response == Response::Nodal {
-            ops.nodal = Some(NodalLaws::new(model, &ops.asm));
+            ops.nodal = NodalLaws::new(model, &ops.asm);
+            if ops.nodal.is_none() {
+                // A constant-tangent material without a nodal-field form: its state
+                // stays at the Gauss points.
+                ops.response = Response::Constant;
+            }
         }
         ops.update_constant_tangent(model);
         ops

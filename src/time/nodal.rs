@@ -113,18 +113,19 @@ pub(crate) struct NodalTotals {
 }
 
 impl NodalLaws {
-    /// The groups of `model` (every material must have a constant tangent); `k` is
-    /// the elastic stiffness on the shared pattern.
-    pub fn new(model: &Model, asm: &Assembler) -> Self {
+    /// The groups of `model`, or `None` if one of its materials has no nodal-field
+    /// form (damage, plasticity: their state is not a linear image of nodal
+    /// fields).
+    pub fn new(model: &Model, asm: &Assembler) -> Option<Self> {
         let mesh = &model.mesh;
-        let law_of = |block: usize| -> (GroupLaw, Option<usize>) {
+        let law_of = |block: usize| -> Option<(GroupLaw, Option<usize>)> {
             let b = &mesh.blocks[block];
             let m = &model.materials[b.material];
             if b.elements.kind == ElementKind::Bar2 {
-                return (GroupLaw::Elastic, None);
+                return Some((GroupLaw::Elastic, None));
             }
             let law = match m.model {
-                Law::Elastic => return (GroupLaw::Elastic, None),
+                Law::Elastic => return Some((GroupLaw::Elastic, None)),
                 Law::KelvinVoigt(Viscosity::Proportional(alpha)) => {
                     GroupLaw::ProportionalVoigt { alpha }
                 }
@@ -138,17 +139,15 @@ impl NodalLaws {
                     beta,
                     p: if parallel { 1.0 } else { 0.0 },
                 },
-                Law::Mazars(_) | Law::RankineHill(_) => {
-                    unreachable!("nodal fields hold constant-tangent materials only")
-                }
+                Law::Mazars(_) | Law::RankineHill(_) => return None,
             };
-            (law, Some(b.material))
+            Some((law, Some(b.material)))
         };
         // One group per viscoelastic material, one for everything elastic.
         let mut keys: Vec<(GroupLaw, Option<usize>)> = Vec::new();
         let mut block_group = Vec::with_capacity(mesh.blocks.len());
         for bi in 0..mesh.blocks.len() {
-            let key = law_of(bi);
+            let key = law_of(bi)?;
             let g = match keys.iter().position(|k| k.1 == key.1) {
                 Some(g) => g,
                 None => {
@@ -190,10 +189,10 @@ impl NodalLaws {
                 GroupLaw::ProportionalVoigt { .. } | GroupLaw::MatrixVoigt
             )
         });
-        NodalLaws {
+        Some(NodalLaws {
             groups,
             keeps_increment,
-        }
+        })
     }
 
     fn stiffness<'a>(&'a self, g: &'a Group, k: &'a [f64]) -> &'a [f64] {
