@@ -309,8 +309,96 @@ impl Ctx<'_> {
     }
 }
 
+/// The most substeps a strain increment is split into when its return fails.
+const MAX_SUBSTEPS: usize = 64;
+
 /// Rankine-Hill update. State: `[εᵖ_xx, εᵖ_yy, γᵖ_xy, κ_t, κ_c]`.
+///
+/// When the return of the whole increment finds no admissible state (the active-set
+/// Newton projection fails on a large increment), the increment is split into 2, 4,
+/// …, [`MAX_SUBSTEPS`] equal substeps, each returned from the state the last left;
+/// the step's plastic dissipation is the substeps' sum, its stress and tangent the
+/// last substep's, and `D_num` closes the step's split `σ¹:Δε = Δψ + D_plastic +
+/// D_num` as for a single return. A strength that is exhausted fails at every
+/// split and the failure is reported (theory/plasticity.md).
 pub fn update(
+    p: &RankineHillParams,
+    c: &[[f64; 3]; 3],
+    e: f64,
+    nu: f64,
+    step: &StrainStep,
+    state_n: &[f64],
+    state: &mut [f64],
+) -> PointResponse {
+    let whole = update_once(p, c, e, nu, step, state_n, state);
+    if whole.status == PointStatus::Ok {
+        return whole;
+    }
+    let mut n = 2;
+    while n <= MAX_SUBSTEPS {
+        if let Some(r) = substepped(p, c, e, nu, step, state_n, state, n) {
+            return r;
+        }
+        n *= 2;
+    }
+    state.copy_from_slice(state_n);
+    whole
+}
+
+/// The increment of `step` in `n` equal substeps; `None` if one of them fails.
+#[allow(clippy::too_many_arguments)]
+fn substepped(
+    p: &RankineHillParams,
+    c: &[[f64; 3]; 3],
+    e: f64,
+    nu: f64,
+    step: &StrainStep,
+    state_n: &[f64],
+    state: &mut [f64],
+    n: usize,
+) -> Option<PointResponse> {
+    let mut cur = [0.0; 5];
+    cur.copy_from_slice(&state_n[..5]);
+    let mut next = [0.0; 5];
+    let mut plastic = 0.0;
+    let mut eps_a = step.eps_n;
+    let mut last = None;
+    for k in 1..=n {
+        let f = k as f64 / n as f64;
+        let eps_b: [f64; 3] =
+            std::array::from_fn(|i| step.eps_n[i] + f * (step.eps[i] - step.eps_n[i]));
+        let sub = StrainStep {
+            eps_n: eps_a,
+            eps: if k == n { step.eps } else { eps_b },
+            ..*step
+        };
+        let r = update_once(p, c, e, nu, &sub, &cur, &mut next);
+        if r.status != PointStatus::Ok {
+            return None;
+        }
+        plastic += r.dissipation.plastic;
+        cur = next;
+        eps_a = sub.eps;
+        last = Some(r);
+    }
+    let r = last?;
+    state[..5].copy_from_slice(&cur);
+    let ee_n: [f64; 3] = std::array::from_fn(|i| step.eps_n[i] - state_n[i]);
+    let psi_n = 0.5 * dot3(&ee_n, &mul3(c, &ee_n));
+    let de: [f64; 3] = std::array::from_fn(|i| step.eps[i] - step.eps_n[i]);
+    let work = dot3(&r.sigma, &de);
+    Some(PointResponse {
+        dissipation: Dissipation {
+            plastic,
+            numerical: work - (r.psi - psi_n) - plastic,
+            ..Default::default()
+        },
+        ..r
+    })
+}
+
+/// One return of the whole increment (see [`update`]).
+fn update_once(
     p: &RankineHillParams,
     c: &[[f64; 3]; 3],
     e: f64,
