@@ -519,7 +519,7 @@ impl StepProblem for ImplicitStep<'_> {
             }
         } else if let Some(laws) = &ops.nodal {
             if w.nodal.is_empty() {
-                w.nodal = NodalLaws::trial_like(&s.nodal);
+                w.nodal = s.nodal.clone();
             }
             let t = laws.evaluate(
                 p,

@@ -246,11 +246,6 @@ impl NodalLaws {
         (state, psi)
     }
 
-    /// A trial state shaped like `s` (scratch for [`NodalLaws::evaluate`]).
-    pub fn trial_like(s: &NodalState) -> NodalState {
-        s.clone()
-    }
-
     /// The internal force of a step of size `h` at the start displacement `u_n`
     /// (`Δu = 0`): `f_int(u) = this + K_t (u − u_n)`.
     pub fn predicted_force(&self, h: f64, s: &NodalState, f: &mut [f64]) {
