@@ -542,11 +542,14 @@ impl SupernodalSolver {
 /// (`mul_add`, one rounding; only where the CPU has FMA, where it is one
 /// instruction).
 trait MulAdd {
+    /// Whether this is the fused flavour (AVX2 and FMA are available).
+    const FUSED: bool;
     fn mul_add(a: f64, b: f64, c: f64) -> f64;
 }
 
 struct Plain;
 impl MulAdd for Plain {
+    const FUSED: bool = false;
     #[inline(always)]
     fn mul_add(a: f64, b: f64, c: f64) -> f64 {
         a * b + c
@@ -557,6 +560,7 @@ impl MulAdd for Plain {
 struct Fused;
 #[cfg(target_arch = "x86_64")]
 impl MulAdd for Fused {
+    const FUSED: bool = true;
     #[inline(always)]
     fn mul_add(a: f64, b: f64, c: f64) -> f64 {
         a.mul_add(b, c)
@@ -726,10 +730,22 @@ fn backward_node<const K: usize, M: MulAdd>(
 /// `acc[lane][c] += Σ_r l[r] · y[r K + c]`, from the last row to the first.
 #[inline(always)]
 fn dot_rows_rev<const K: usize, M: MulAdd>(l: &[f64], y: &[f64], acc: &mut [[f64; K]; LANES]) {
+    #[cfg(target_arch = "x86_64")]
+    if K == 8 && M::FUSED {
+        // Eight columns: explicit vectors (LLVM kept the generic loop's 32
+        // accumulators in half registers and spilled them every row).
+        assert!(y.len() >= l.len() * 8);
+        let acc8 = acc.as_mut_ptr().cast::<[[f64; 8]; LANES]>();
+        // SAFETY: `K == 8`, so `acc` is a `[[f64; 8]; LANES]`; `M::FUSED` is only
+        // used inside functions compiled with AVX2 and FMA, after they were
+        // detected; `y` holds 8 values per row of `l` (asserted).
+        unsafe { dot8_rows_rev(l, y, &mut *acc8) };
+        return;
+    }
     let mut lc = l.rchunks_exact(LANES);
     let mut yc = y.rchunks_exact(LANES * K);
     for (ls, ys) in (&mut lc).zip(&mut yc) {
-        for lane in (0..LANES).rev() {
+        for lane in 0..LANES {
             for c in 0..K {
                 acc[lane][c] = M::mul_add(ls[lane], ys[lane * K + c], acc[lane][c]);
             }
@@ -739,6 +755,49 @@ fn dot_rows_rev<const K: usize, M: MulAdd>(l: &[f64], y: &[f64], acc: &mut [[f64
         for c in 0..K {
             acc[0][c] = M::mul_add(lv, yc.remainder()[r * K + c], acc[0][c]);
         }
+    }
+}
+
+/// [`dot_rows_rev`] for eight right-hand sides with AVX2 vectors: the same
+/// products in the same order per lane (bit-identical).
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA, and `y.len() >= 8 l.len()`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn dot8_rows_rev(l: &[f64], y: &[f64], acc: &mut [[f64; 8]; LANES]) {
+    use std::arch::x86_64::{
+        __m256d, _mm256_fmadd_pd, _mm256_loadu_pd, _mm256_set1_pd, _mm256_storeu_pd,
+    };
+    let (lp, yp) = (l.as_ptr(), y.as_ptr());
+    let mut a: [[__m256d; 2]; LANES] = std::array::from_fn(|q| {
+        [
+            _mm256_loadu_pd(acc[q].as_ptr()),
+            _mm256_loadu_pd(acc[q].as_ptr().add(4)),
+        ]
+    });
+    // Rows in chunks of `LANES` from the end, row `r + q` of a chunk into lane `q`;
+    // the first `len % LANES` rows, last first, into lane 0.
+    let mut r = l.len();
+    while r >= LANES {
+        r -= LANES;
+        for (q, aq) in a.iter_mut().enumerate() {
+            let lv = _mm256_set1_pd(*lp.add(r + q));
+            let row = yp.add((r + q) * 8);
+            aq[0] = _mm256_fmadd_pd(lv, _mm256_loadu_pd(row), aq[0]);
+            aq[1] = _mm256_fmadd_pd(lv, _mm256_loadu_pd(row.add(4)), aq[1]);
+        }
+    }
+    while r > 0 {
+        r -= 1;
+        let lv = _mm256_set1_pd(*lp.add(r));
+        let row = yp.add(r * 8);
+        a[0][0] = _mm256_fmadd_pd(lv, _mm256_loadu_pd(row), a[0][0]);
+        a[0][1] = _mm256_fmadd_pd(lv, _mm256_loadu_pd(row.add(4)), a[0][1]);
+    }
+    for (q, aq) in a.iter().enumerate() {
+        _mm256_storeu_pd(acc[q].as_mut_ptr(), aq[0]);
+        _mm256_storeu_pd(acc[q].as_mut_ptr().add(4), aq[1]);
     }
 }
 
