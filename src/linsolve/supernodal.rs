@@ -527,11 +527,6 @@ impl SupernodalSolver {
         Some(shares.map(|x| x / total))
     }
 
-    /// The shape `(columns, pattern rows)` of every supernode.
-    pub fn shapes(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
-        self.nodes.iter().map(|s| (s.ncols, s.npattern))
-    }
-
     /// Number of supernodes.
     pub fn supernodes(&self) -> usize {
         self.nodes.len()
