@@ -819,19 +819,17 @@ enum Run<'a> {
 
 /// A sweep over `run`, for one kernel flavour: a forward sweep adds its updates of
 /// far rows to `far_out`, a backward sweep reads them from `far_in`.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn sweep<const K: usize, M: MulAdd>(
     dir: Dir,
     run: Run,
-    nodes: &[Supernode],
-    rows: &[usize],
-    values: &[f64],
+    f: &Factor,
     x: &mut [f64],
     tmp: &mut [f64],
     far_out: &mut [f64],
     far_in: &[f64],
 ) {
+    let (nodes, rows, values) = (f.nodes, f.rows, f.values);
     #[inline(always)]
     fn whole(sn: &Supernode) -> Place {
         Place {
@@ -978,21 +976,18 @@ fn split_sweeps<const K: usize>(
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA (checked by the caller).
-#[allow(clippy::too_many_arguments)]
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn sweep_avx2<const K: usize>(
     dir: Dir,
     run: Run,
-    nodes: &[Supernode],
-    rows: &[usize],
-    values: &[f64],
+    f: &Factor,
     x: &mut [f64],
     tmp: &mut [f64],
     far_out: &mut [f64],
     far_in: &[f64],
 ) {
-    sweep::<K, Fused>(dir, run, nodes, rows, values, x, tmp, far_out, far_in)
+    sweep::<K, Fused>(dir, run, f, x, tmp, far_out, far_in)
 }
 
 /// What one sweep reads besides `x` and its buffers.
@@ -1014,15 +1009,14 @@ impl Factor<'_> {
         far_out: &mut [f64],
         far_in: &[f64],
     ) {
-        let (nodes, rows, values) = (self.nodes, self.rows, self.values);
         #[cfg(target_arch = "x86_64")]
         {
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
                 // SAFETY: both features were just detected.
-                unsafe { sweep_avx2::<K>(dir, run, nodes, rows, values, x, tmp, far_out, far_in) };
+                unsafe { sweep_avx2::<K>(dir, run, self, x, tmp, far_out, far_in) };
                 return;
             }
         }
-        sweep::<K, Plain>(dir, run, nodes, rows, values, x, tmp, far_out, far_in)
+        sweep::<K, Plain>(dir, run, self, x, tmp, far_out, far_in)
     }
 }

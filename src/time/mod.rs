@@ -57,7 +57,8 @@ pub struct State {
     /// The contact state (multipliers, per-pair forces, gaps and pressures).
     pub contact: crate::contact::ContactState,
     /// Nodal fields of linear viscoelastic materials (empty unless the implicit
-    /// schemes keep them there; then `points` is empty between outputs).
+    /// schemes keep them there; then `points` is empty and the integrator builds
+    /// the Gauss-point state for output, `Integrator::output_points`).
     pub nodal: nodal::NodalState,
 }
 

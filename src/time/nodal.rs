@@ -66,7 +66,7 @@ pub(crate) struct NodalLaws {
 
 /// The fields of one group.
 #[derive(Clone, Debug, Default)]
-pub struct GroupFields {
+pub(crate) struct GroupFields {
     /// `K_g u`.
     ku: Vec<f64>,
     /// The dashpot displacement `u_d` (standard linear solid).
@@ -215,10 +215,12 @@ impl NodalLaws {
                 };
                 p.matvec(self.stiffness(g, k), u, &mut fields.ku);
                 let scale = match g.law {
-                    GroupLaw::Sls { alpha, p, .. } => {
+                    GroupLaw::Sls {
+                        alpha, p: parallel, ..
+                    } => {
                         fields.ud = vec![0.0; n];
                         fields.kud = vec![0.0; n];
-                        p + alpha
+                        parallel + alpha
                     }
                     GroupLaw::MatrixVoigt => {
                         fields.vu = vec![0.0; n];
