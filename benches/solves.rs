@@ -1,5 +1,5 @@
-//! The triangular solves at the memory bound: a STREAM-triad probe of this
-//! machine's bandwidth, and one solve, a block of 8 and the sparse forward solve on
+//! The triangular solves at the memory bound: STREAM-triad and plain-read probes
+//! of this machine's bandwidth, and one solve, a block of 8 and the sparse forward solve on
 //! W1's effective matrix, rothe's own supernodal solves against faer's. Each group
 //! prints the bytes the factor streams (`2 nnz(L) · 8 B` per solve) so the ratio to
 //! the triad bandwidth can be read off the same run.
@@ -12,8 +12,11 @@ use rothe::linsolve::SymmetricSolver;
 
 /// `a = b + s c` over arrays far larger than the caches: 24 bytes moved per element
 /// (two loads, one store; a write-allocate adds 8 more on machines without
-/// streaming stores, which this counts as the STREAM convention does not).
+/// streaming stores, which this counts as the STREAM convention does not), and a
+/// plain read of one array (one sequential stream per thread, as a triangular
+/// solve reads its factor).
 fn triad(c: &mut Criterion) {
+    use rothe::workload::{read_sum, triad};
     let n = 1 << 24; // 3 arrays of 128 MB
     let b = vec![1.0f64; n];
     let cc = vec![2.0f64; n];
@@ -21,28 +24,20 @@ fn triad(c: &mut Criterion) {
     let mut g = c.benchmark_group("stream");
     g.sample_size(10);
     g.throughput(Throughput::Bytes(24 * n as u64));
-    g.bench_function("triad", |bench| {
-        bench.iter(|| {
-            for ((x, y), z) in a.iter_mut().zip(&b).zip(&cc) {
-                *x = y + 3.0 * z;
-            }
-            black_box(&a);
-        })
-    });
+    g.bench_function("triad", |bench| bench.iter(|| triad(&mut a, &b, &cc, n)));
     // On all cores (STREAM's convention): the two-thread solve draws on this.
     let chunk = n.div_ceil(rayon::current_num_threads());
     g.bench_function("triad_all_cores", |bench| {
-        use rayon::prelude::*;
-        bench.iter(|| {
-            a.par_chunks_mut(chunk)
-                .zip(b.par_chunks(chunk).zip(cc.par_chunks(chunk)))
-                .for_each(|(a, (b, c))| {
-                    for ((x, y), z) in a.iter_mut().zip(b).zip(c) {
-                        *x = y + 3.0 * z;
-                    }
-                });
-            black_box(&a);
-        })
+        bench.iter(|| triad(&mut a, &b, &cc, chunk))
+    });
+    let long: Vec<f64> = (0..4 * n).map(|i| (i % 7) as f64).collect();
+    g.throughput(Throughput::Bytes(8 * long.len() as u64));
+    g.bench_function("read", |bench| {
+        bench.iter(|| black_box(read_sum(&long, long.len())))
+    });
+    let chunk = long.len().div_ceil(rayon::current_num_threads());
+    g.bench_function("read_all_cores", |bench| {
+        bench.iter(|| black_box(read_sum(&long, chunk)))
     });
     g.finish();
 }

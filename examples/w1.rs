@@ -102,30 +102,45 @@ fn main() -> rothe::Result<()> {
     println!("  total                {total_s:.3} s");
     // The machine's bandwidth, measured now (outside the run's total) on one core
     // and on all (the solve runs on both cores; the bound uses the all-core figure),
-    // and the solve's and the step's shares of it.
+    // and the solve's and the step's shares of it; beside it the bandwidth of
+    // reading one stream per core, which is how a solve reads its factor.
     let triad_one = rothe::workload::triad_bandwidth(1 << 24, 10, false);
     let triad = rothe::workload::triad_bandwidth(1 << 24, 10, true);
+    let read_one = rothe::workload::read_bandwidth(1 << 26, 5, false);
+    let read = rothe::workload::read_bandwidth(1 << 26, 5, true);
     let bytes = 2.0 * nnz_l as f64 * 8.0;
     let bound = bytes / triad;
+    let read_bound = bytes / read;
     let solve_per = timing.solve_s / solves.max(1) as f64;
     let step_per = steps_s / n.max(1) as f64;
+    let cores = rayon::current_num_threads();
     println!(
-        "  triad bandwidth      {:.1} GB/s on one core, {:.1} GB/s on all {}",
+        "  triad bandwidth      {:.1} GB/s on one core, {:.1} GB/s on all {cores}",
         triad_one / 1e9,
         triad / 1e9,
-        rayon::current_num_threads()
     );
     println!(
-        "  factor stream bound  {:.2} ms per solve (2 x nnz(L) x 8 B at {:.1} GB/s)",
+        "  read bandwidth       {:.1} GB/s on one core, {:.1} GB/s on all {cores}",
+        read_one / 1e9,
+        read / 1e9,
+    );
+    println!(
+        "  factor stream bound  {:.2} ms per solve (2 x nnz(L) x 8 B at {:.1} GB/s; {:.2} ms at the read bandwidth)",
         1e3 * bound,
-        triad / 1e9
+        triad / 1e9,
+        1e3 * read_bound
     );
     println!(
-        "  solve achieved       {:.2} ms per solve, {:.1} GB/s ({:.2} x the bound)",
+        "  solve achieved       {:.2} ms per solve, {:.1} GB/s ({:.2} x the bound, {:.2} x the read bound)",
         1e3 * solve_per,
         bytes / solve_per / 1e9,
-        solve_per / bound
+        solve_per / bound,
+        solve_per / read_bound
     );
-    println!("  step                 {:.2} x the bound", step_per / bound);
+    println!(
+        "  step                 {:.2} x the bound, {:.2} x the read bound",
+        step_per / bound,
+        step_per / read_bound
+    );
     Ok(())
 }

@@ -87,13 +87,14 @@ impl Estimate {
     ) -> Estimate {
         // A node of a Q4 or T3 mesh has about 9 neighbours (itself included): 36 values
         // per node in each full-storage matrix, about half plus a diagonal in the
-        // reduced lower triangle (value, row index, source position).
+        // reduced lower triangle (value, row index, source position); the consistent
+        // mass also keeps one value per node pair (9 per node) for its products.
         let per_node_matrix = 36 * 8;
         let n_matrices = if tangent { 3 } else { 2 };
         let dofs = 2 * nodes;
         Estimate {
             mesh: nodes * (16 + 8 + 9 * 4 + 8) + elements * (4 * 8 + 16),
-            matrices: nodes * (n_matrices * per_node_matrix + 20 * 24),
+            matrices: nodes * (n_matrices * per_node_matrix + 9 * 8 + 20 * 24),
             factor: factor_nnz * 8 + dofs * 64,
             state: dofs * 8 * 30 + points * (7 + history) * 8 * 2,
         }

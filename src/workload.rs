@@ -135,27 +135,74 @@ pub fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> crate::linsolve::L
 /// convention, and what a solve on both cores can draw on), so that a solve's
 /// achieved bandwidth can be set beside the machine's in the same run.
 pub fn triad_bandwidth(n: usize, reps: usize, all_cores: bool) -> f64 {
-    use rayon::prelude::*;
     let b = vec![1.0f64; n];
     let c = vec![2.0f64; n];
     let mut a = vec![0.0f64; n];
-    let chunk = if all_cores {
+    let chunk = probe_chunk(n, all_cores);
+    let best = best_time(reps, || triad(&mut a, &b, &c, chunk));
+    24.0 * n as f64 / best
+}
+
+/// `a = b + 3 c`, each thread of the rayon pool on `chunk` elements at a time.
+pub fn triad(a: &mut [f64], b: &[f64], c: &[f64], chunk: usize) {
+    use rayon::prelude::*;
+    a.par_chunks_mut(chunk)
+        .zip(b.par_chunks(chunk).zip(c.par_chunks(chunk)))
+        .for_each(|(a, (b, c))| {
+            for ((x, y), z) in a.iter_mut().zip(b).zip(c) {
+                *x = y + 3.0 * z;
+            }
+        });
+    std::hint::black_box(a);
+}
+
+/// The bandwidth of reading one array of `n` doubles front to back (bytes/s, best
+/// of `reps`; each thread's part one sequential stream, summed in 16 independent
+/// partial sums), on one thread or split over the rayon pool's threads: the access
+/// a triangular solve makes of its factor, which on some machines streams slower
+/// than the triad's mix of two reads and a write.
+pub fn read_bandwidth(n: usize, reps: usize, all_cores: bool) -> f64 {
+    let a: Vec<f64> = (0..n).map(|i| (i % 7) as f64).collect();
+    let chunk = probe_chunk(n, all_cores);
+    let best = best_time(reps, || {
+        std::hint::black_box(read_sum(&a, chunk));
+    });
+    8.0 * n as f64 / best
+}
+
+/// The sum of `a` (its whole 16-value chunks), each thread of the rayon pool
+/// reading `chunk` elements front to back.
+pub fn read_sum(a: &[f64], chunk: usize) -> f64 {
+    use rayon::prelude::*;
+    a.par_chunks(chunk)
+        .map(|part| {
+            let mut acc = [0.0f64; 16];
+            for c in part.chunks_exact(16) {
+                for (s, v) in acc.iter_mut().zip(c) {
+                    *s += v;
+                }
+            }
+            acc.iter().sum::<f64>()
+        })
+        .sum()
+}
+
+/// The part of `n` values each thread of a bandwidth probe takes.
+fn probe_chunk(n: usize, all_cores: bool) -> usize {
+    if all_cores {
         n.div_ceil(rayon::current_num_threads()).max(1)
     } else {
         n.max(1)
-    };
-    let mut best = f64::INFINITY;
-    for _ in 0..reps.max(1) {
-        let t = std::time::Instant::now();
-        a.par_chunks_mut(chunk)
-            .zip(b.par_chunks(chunk).zip(c.par_chunks(chunk)))
-            .for_each(|(a, (b, c))| {
-                for ((x, y), z) in a.iter_mut().zip(b).zip(c) {
-                    *x = y + 3.0 * z;
-                }
-            });
-        std::hint::black_box(&a);
-        best = best.min(t.elapsed().as_secs_f64());
     }
-    24.0 * n as f64 / best
+}
+
+/// The shortest of `reps` (at least one) timings of `run`, in seconds.
+fn best_time(reps: usize, mut run: impl FnMut()) -> f64 {
+    (0..reps.max(1))
+        .map(|_| {
+            let t = std::time::Instant::now();
+            run();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
 }

@@ -110,17 +110,79 @@ impl Pattern {
     pub fn matvec(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
         y.par_chunks_mut(2).enumerate().for_each(|(n, yn)| {
             let nbrs = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
-            for (j, out) in yn.iter_mut().enumerate() {
-                let c = self.col_start(n, j);
-                let col = &a[c..c + 2 * nbrs.len()];
-                let mut acc = 0.0;
-                for (k, &m) in nbrs.iter().enumerate() {
-                    let m = m as usize;
-                    acc += col[2 * k] * x[2 * m] + col[2 * k + 1] * x[2 * m + 1];
-                }
-                *out = acc;
+            let (c0, c1) = self.node_columns(a, n);
+            let (mut s0, mut s1) = (0.0, 0.0);
+            // Both columns of the node in one pass: each neighbour's two values of
+            // `x` are loaded once (the sums are the column-by-column ones).
+            for (k, &m) in nbrs.iter().enumerate() {
+                let (x0, x1) = (x[2 * m as usize], x[2 * m as usize + 1]);
+                s0 += c0[2 * k] * x0 + c0[2 * k + 1] * x1;
+                s1 += c1[2 * k] * x0 + c1[2 * k + 1] * x1;
             }
+            yn[0] = s0;
+            yn[1] = s1;
         });
+    }
+
+    /// `y = M x` for a matrix whose 2×2 node blocks are `m_k I`, `m` holding one
+    /// value per node pair in adjacency order (the sums of [`Self::matvec`] on the
+    /// full values, whose zero entries add nothing).
+    pub fn matvec_pairs(&self, m: &[f64], x: &[f64], y: &mut [f64]) {
+        y.par_chunks_mut(2).enumerate().for_each(|(n, yn)| {
+            let (s0, s1) = self.pair_sums(m, x, n);
+            yn[0] = s0;
+            yn[1] = s1;
+        });
+    }
+
+    /// `y = A x` and `z = M w` in one pass, `M` in node-pair form as in
+    /// [`Self::matvec_pairs`].
+    pub fn matvec_and_pairs(
+        &self,
+        a: &[f64],
+        x: &[f64],
+        y: &mut [f64],
+        m: &[f64],
+        w: &[f64],
+        z: &mut [f64],
+    ) {
+        y.par_chunks_mut(2)
+            .zip(z.par_chunks_mut(2))
+            .enumerate()
+            .for_each(|(n, (yn, zn))| {
+                let (lo, hi) = (self.adj_ptr[n], self.adj_ptr[n + 1]);
+                let (a0, a1) = self.node_columns(a, n);
+                let (mut s0, mut s1, mut t0, mut t1) = (0.0, 0.0, 0.0, 0.0);
+                for (k, (&j, &mk)) in self.adj[lo..hi].iter().zip(&m[lo..hi]).enumerate() {
+                    let j = 2 * j as usize;
+                    let (x0, x1, w0, w1) = (x[j], x[j + 1], w[j], w[j + 1]);
+                    s0 += a0[2 * k] * x0 + a0[2 * k + 1] * x1;
+                    s1 += a1[2 * k] * x0 + a1[2 * k + 1] * x1;
+                    t0 += mk * w0;
+                    t1 += mk * w1;
+                }
+                (yn[0], yn[1], zn[0], zn[1]) = (s0, s1, t0, t1);
+            });
+    }
+
+    /// Both rows of node `n` of `M x`, `M` in node-pair form.
+    #[inline]
+    fn pair_sums(&self, m: &[f64], x: &[f64], n: usize) -> (f64, f64) {
+        let (lo, hi) = (self.adj_ptr[n], self.adj_ptr[n + 1]);
+        let (mut s0, mut s1) = (0.0, 0.0);
+        for (&mk, &j) in m[lo..hi].iter().zip(&self.adj[lo..hi]) {
+            s0 += mk * x[2 * j as usize];
+            s1 += mk * x[2 * j as usize + 1];
+        }
+        (s0, s1)
+    }
+
+    /// The two columns of node `n` of a matrix `a` stored on this pattern.
+    #[inline]
+    pub(crate) fn node_columns<'a>(&self, a: &'a [f64], n: usize) -> (&'a [f64], &'a [f64]) {
+        let len = 2 * (self.adj_ptr[n + 1] - self.adj_ptr[n]);
+        let c = 4 * self.adj_ptr[n];
+        (&a[c..c + len], &a[c + len..c + 2 * len])
     }
 
     /// `y = A x` and `z = B w` in one pass over the pattern (saves reading the
@@ -139,19 +201,21 @@ impl Pattern {
             .enumerate()
             .for_each(|(n, (yn, zn))| {
                 let nbrs = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
-                for j in 0..2 {
-                    let c = self.col_start(n, j);
-                    let ca = &a[c..c + 2 * nbrs.len()];
-                    let cb = &b[c..c + 2 * nbrs.len()];
-                    let (mut s, mut t) = (0.0, 0.0);
-                    for (k, &m) in nbrs.iter().enumerate() {
-                        let m = m as usize;
-                        s += ca[2 * k] * x[2 * m] + ca[2 * k + 1] * x[2 * m + 1];
-                        t += cb[2 * k] * w[2 * m] + cb[2 * k + 1] * w[2 * m + 1];
-                    }
-                    yn[j] = s;
-                    zn[j] = t;
+                let (a0, a1) = self.node_columns(a, n);
+                let (b0, b1) = self.node_columns(b, n);
+                let (mut s0, mut s1, mut t0, mut t1) = (0.0, 0.0, 0.0, 0.0);
+                for (k, &m) in nbrs.iter().enumerate() {
+                    let m = 2 * m as usize;
+                    let (x0, x1, w0, w1) = (x[m], x[m + 1], w[m], w[m + 1]);
+                    s0 += a0[2 * k] * x0 + a0[2 * k + 1] * x1;
+                    s1 += a1[2 * k] * x0 + a1[2 * k + 1] * x1;
+                    t0 += b0[2 * k] * w0 + b0[2 * k + 1] * w1;
+                    t1 += b1[2 * k] * w0 + b1[2 * k + 1] * w1;
                 }
+                yn[0] = s0;
+                yn[1] = s1;
+                zn[0] = t0;
+                zn[1] = t1;
             });
     }
 }

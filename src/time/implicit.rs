@@ -507,15 +507,11 @@ impl StepProblem for ImplicitStep<'_> {
         let elastic = ops.response == Response::Elastic;
         if elastic {
             // K Δu (and M Δu with a consistent mass) in one pass over the pattern.
-            match (&ops.mass, dynamic.is_some()) {
-                (Mass::Consistent(m), true) => {
-                    p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.du, &mut w.mv_np1)
-                }
-                (_, true) => {
-                    p.matvec(&ops.k, &w.du, &mut w.kdu);
-                    ops.mass.matvec(p, &w.du, &mut w.mv_np1);
-                }
-                (_, false) => p.matvec(&ops.k, &w.du, &mut w.kdu),
+            if dynamic.is_some() {
+                ops.mass
+                    .with_product(p, &ops.k, &w.du, &mut w.kdu, &w.du, &mut w.mv_np1);
+            } else {
+                p.matvec(&ops.k, &w.du, &mut w.kdu);
             }
         } else if let Some(laws) = &ops.nodal {
             if w.nodal.is_empty() {
@@ -558,15 +554,11 @@ impl StepProblem for ImplicitStep<'_> {
             w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int_np1, pred, kt);
             failure = w.totals.failure;
             if let Some((_, _, damp_k)) = dynamic {
-                match (&ops.mass, damp_k != 0.0) {
-                    (Mass::Consistent(m), true) => {
-                        p.matvec2(&ops.k, &w.du, &mut w.kdu, m, &w.du, &mut w.mv_np1)
-                    }
-                    (_, true) => {
-                        p.matvec(&ops.k, &w.du, &mut w.kdu);
-                        ops.mass.matvec(p, &w.du, &mut w.mv_np1);
-                    }
-                    (_, false) => ops.mass.matvec(p, &w.du, &mut w.mv_np1),
+                if damp_k != 0.0 {
+                    ops.mass
+                        .with_product(p, &ops.k, &w.du, &mut w.kdu, &w.du, &mut w.mv_np1);
+                } else {
+                    ops.mass.matvec(p, &w.du, &mut w.mv_np1);
                 }
             }
         }

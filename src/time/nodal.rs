@@ -21,7 +21,7 @@
 use rayon::prelude::*;
 
 use crate::assembly::internal::{new_stores, points_per_element};
-use crate::assembly::{Assembler, Pattern};
+use crate::assembly::{Assembler, ConsistentMass, Pattern};
 use crate::energy::Dissipation;
 use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind};
 use crate::material::store::StateStore;
@@ -97,8 +97,8 @@ impl NodalState {
 /// A consistent mass matrix and where `M Δu` goes, for [`NodalLaws::evaluate`] to
 /// form in the same pass as the first stiffness product.
 pub(crate) struct MassProduct<'a> {
-    /// `M` on the shared pattern.
-    pub m: &'a [f64],
+    /// The consistent mass.
+    pub m: &'a ConsistentMass,
     /// `M Δu`.
     pub out: &'a mut [f64],
 }
@@ -302,7 +302,7 @@ impl NodalLaws {
             match mass.take() {
                 // The first group's product and `M Δu` in one pass over the pattern.
                 Some(MassProduct { m, out }) => {
-                    p.matvec2(self.stiffness(g, k), u, &mut new.ku, m, du, out)
+                    m.with_product(p, self.stiffness(g, k), u, &mut new.ku, du, out)
                 }
                 None => p.matvec(self.stiffness(g, k), u, &mut new.ku),
             }
