@@ -598,6 +598,7 @@ fn forward_node<const K: usize, M: MulAdd>(
     if ns == 1 {
         // One column (a simplicial factor's): straight into x, no buffer.
         let col = &values[sn.values..sn.values + ld];
+        prefetch_ahead(col, Dir::Forward);
         let inv = 1.0 / col[0];
         let xj: [f64; K] = std::array::from_fn(|c| x[b * K + c] * inv);
         x[b * K..(b + 1) * K].copy_from_slice(&xj);
@@ -620,6 +621,7 @@ fn forward_node<const K: usize, M: MulAdd>(
     let block = &values[sn.values..sn.values + ld * ns];
     for j in 0..ns {
         let col = &block[j * ld..(j + 1) * ld];
+        prefetch_ahead(col, Dir::Forward);
         let inv = 1.0 / col[j];
         let mut xj = [0.0; K];
         for c in 0..K {
@@ -674,6 +676,7 @@ fn backward_node<const K: usize, M: MulAdd>(
     let (near_rows, far_rows) = pattern.split_at(at.split);
     if ns == 1 {
         let col = &values[sn.values..sn.values + ld];
+        prefetch_ahead(col, Dir::Backward);
         let (near, rest) = col[1..].split_at(at.split);
         let mut acc = [[0.0; K]; LANES];
         for (k, (&l, &row)) in rest.iter().zip(far_rows).enumerate().rev() {
@@ -711,6 +714,7 @@ fn backward_node<const K: usize, M: MulAdd>(
     // follows (columns read upwards one by one would make a saw-tooth it does not).
     for j in (0..ns).rev() {
         let col = &block[j * ld..(j + 1) * ld];
+        prefetch_ahead(col, Dir::Backward);
         let mut acc = [[0.0; K]; LANES];
         dot_rows_rev::<K, M>(&col[ns..], tmp, &mut acc);
         dot_rows_rev::<K, M>(&col[j + 1..ns], &x[(b + j + 1) * K..(b + ns) * K], &mut acc);
@@ -720,6 +724,37 @@ fn backward_node<const K: usize, M: MulAdd>(
             x[(b + j) * K + c] = (x[(b + j) * K + c] - sum) * inv;
         }
     }
+}
+
+/// How far ahead of the column being read, in values (16 KiB), a sweep asks for
+/// the factor's cache lines.
+const PREFETCH_AHEAD: usize = 2048;
+
+/// Asks for the cache lines `PREFETCH_AHEAD` values past `col` in the sweep's
+/// direction to be brought into the level-2 cache (not level 1, whose few miss
+/// buffers the demand loads need: prefetching into it measured slower, as did
+/// non-temporal prefetches). Measured on W1 with alternating solves in one
+/// process (medians of 20): a block of 8 10–15 % faster (ny = 100: 17.0 → 14.3–15.2
+/// ms, ny = 250: 131.5 → 117–119 ms at distances of 512 to 8192 values); one
+/// right-hand side within the noise (−4 % to +10 % over three such runs).
+#[inline(always)]
+fn prefetch_ahead(col: &[f64], dir: Dir) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T1};
+        let start = match dir {
+            Dir::Forward => col.as_ptr().wrapping_add(PREFETCH_AHEAD),
+            Dir::Backward => col.as_ptr().wrapping_sub(PREFETCH_AHEAD),
+        }
+        .cast::<i8>();
+        for line in (0..std::mem::size_of_val(col)).step_by(64) {
+            // SAFETY: a prefetch is a hint that never faults, whatever the address
+            // (which `wrapping_*` computed without dereferencing).
+            unsafe { _mm_prefetch::<_MM_HINT_T1>(start.wrapping_add(line)) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (col, dir);
 }
 
 /// `acc[lane][c] += Σ_r l[r] · y[r K + c]`, from the last row to the first.
