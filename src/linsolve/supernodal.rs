@@ -225,11 +225,10 @@ impl Structure<'_> {
     fn solve_block<const K: usize>(&self, values: &[f64], rhs: &mut [f64], w: &mut [Workspace; 2]) {
         let n = self.n;
         let [w0, w1] = w;
-        w0.x.resize(n * K, 0.0);
-        for i in 0..n {
-            let p = self.perm[i];
+        let x = aligned(&mut w0.x, n * K);
+        for (i, &p) in self.perm.iter().enumerate() {
             for c in 0..K {
-                w0.x[i * K + c] = rhs[c * n + p];
+                x[i * K + c] = rhs[c * n + p];
             }
         }
         let f = Factor {
@@ -237,42 +236,36 @@ impl Structure<'_> {
             rows: self.rows,
             values,
         };
-        for wk in [&mut *w0, &mut *w1] {
-            wk.tmp.resize(wk.tmp.len().max(self.max_pattern * K), 0.0);
-        }
+        let t0 = aligned(&mut w0.tmp, self.max_pattern * K);
+        let t1 = aligned(&mut w1.tmp, self.max_pattern * K);
         match self.split {
             Some(split) => {
-                for wk in [&mut *w0, &mut *w1] {
-                    wk.far.resize(n * K, 0.0);
-                }
-                split_sweeps::<K>(
-                    &f,
-                    split,
-                    &mut w0.x,
-                    [w0.tmp.as_mut(), w1.tmp.as_mut()],
-                    [w0.far.as_mut(), w1.far.as_mut()],
-                );
+                let far = [aligned(&mut w0.far, n * K), aligned(&mut w1.far, n * K)];
+                split_sweeps::<K>(&f, split, x, [t0, t1], far);
             }
             None => {
-                f.sweep::<K>(Dir::Forward, Run::All, &mut w0.x, &mut w0.tmp, &mut [], &[]);
-                f.sweep::<K>(
-                    Dir::Backward,
-                    Run::All,
-                    &mut w0.x,
-                    &mut w0.tmp,
-                    &mut [],
-                    &[],
-                );
+                f.sweep::<K>(Dir::Forward, Run::All, x, t0, &mut [], &[]);
+                f.sweep::<K>(Dir::Backward, Run::All, x, t0, &mut [], &[]);
             }
         }
-        let w = w0;
-        for i in 0..n {
-            let p = self.perm[i];
+        for (i, &p) in self.perm.iter().enumerate() {
             for c in 0..K {
-                rhs[c * n + p] = w.x[i * K + c];
+                rhs[c * n + p] = x[i * K + c];
             }
         }
     }
+}
+
+/// `len` values of `buf` from a 64-byte boundary on (the buffer grown as needed,
+/// new values zero; a buffer that is zero stays zero wherever the window lands):
+/// a row of eight right-hand sides is then one cache line, not two.
+fn aligned(buf: &mut Vec<f64>, len: usize) -> &mut [f64] {
+    const LINE: usize = 64 / std::mem::size_of::<f64>();
+    if buf.len() < len + LINE {
+        buf.resize(len + LINE, 0.0);
+    }
+    let off = buf.as_ptr().align_offset(64).min(LINE);
+    &mut buf[off..off + len]
 }
 
 /// A supernodal factor's structure prepared for solves, and the workspace.
