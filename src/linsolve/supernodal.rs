@@ -192,6 +192,8 @@ struct Structure<'a> {
     nodes: &'a [Supernode],
     rows: &'a [usize],
     perm: &'a [usize],
+    /// `inverse[perm[i]] = i`.
+    inverse: &'a [usize],
     /// The two-thread cut of the elimination forest, where it pays.
     split: Option<&'a TreeSplit>,
 }
@@ -226,11 +228,8 @@ impl Structure<'_> {
         let n = self.n;
         let [w0, w1] = w;
         let x = aligned(&mut w0.x, n * K);
-        for (i, &p) in self.perm.iter().enumerate() {
-            for c in 0..K {
-                x[i * K + c] = rhs[c * n + p];
-            }
-        }
+        let threads = self.split.is_some();
+        permute_in::<K>(self.perm, rhs, x, threads);
         let f = Factor {
             nodes: self.nodes,
             rows: self.rows,
@@ -248,11 +247,73 @@ impl Structure<'_> {
                 f.sweep::<K>(Dir::Backward, Run::All, x, t0, &mut [], &[]);
             }
         }
-        for (i, &p) in self.perm.iter().enumerate() {
+        permute_out::<K>(self.perm, self.inverse, x, rhs, threads);
+    }
+}
+
+/// Rows of the work copy per parallel chunk of a permutation.
+const PERMUTE_CHUNK: usize = 16_384;
+
+/// `x[i K + c] = rhs[c n + perm[i]]`: the `K` column-major right-hand sides into
+/// the row-major work copy in elimination order, on the rayon pool's threads if
+/// `threads` (each on its own rows of `x`).
+fn permute_in<const K: usize>(perm: &[usize], rhs: &[f64], x: &mut [f64], threads: bool) {
+    use rayon::prelude::*;
+    let n = perm.len();
+    let rows = |(k, xs): (usize, &mut [f64])| {
+        let lo = k * PERMUTE_CHUNK;
+        for (r, &p) in xs.chunks_exact_mut(K).zip(&perm[lo..]) {
+            for (c, v) in r.iter_mut().enumerate() {
+                *v = rhs[c * n + p];
+            }
+        }
+    };
+    if threads {
+        x.par_chunks_mut(PERMUTE_CHUNK * K)
+            .enumerate()
+            .for_each(rows);
+    } else {
+        x.chunks_mut(PERMUTE_CHUNK * K).enumerate().for_each(rows);
+    }
+}
+
+/// `rhs[c n + perm[i]] = x[i K + c]`, the inverse of [`permute_in`]: one right-hand
+/// side in chunks of the original order (`inverse[p]` the row of `x` to read), more
+/// in two halves of the columns, each walking `x` in order.
+fn permute_out<const K: usize>(
+    perm: &[usize],
+    inverse: &[usize],
+    x: &[f64],
+    rhs: &mut [f64],
+    threads: bool,
+) {
+    use rayon::prelude::*;
+    let n = perm.len();
+    if !threads {
+        for (i, &p) in perm.iter().enumerate() {
             for c in 0..K {
                 rhs[c * n + p] = x[i * K + c];
             }
         }
+    } else if K == 1 {
+        rhs.par_chunks_mut(PERMUTE_CHUNK)
+            .zip(inverse.par_chunks(PERMUTE_CHUNK))
+            .for_each(|(out, inv)| {
+                for (o, &i) in out.iter_mut().zip(inv) {
+                    *o = x[i];
+                }
+            });
+    } else {
+        let half = K / 2;
+        rhs.par_chunks_mut(n * half)
+            .enumerate()
+            .for_each(|(h, cols)| {
+                for (i, &p) in perm.iter().enumerate() {
+                    for c in 0..half {
+                        cols[c * n + p] = x[i * K + h * half + c];
+                    }
+                }
+            });
     }
 }
 
@@ -414,6 +475,7 @@ impl SupernodalSolver {
             nodes: &self.nodes,
             rows: &self.rows,
             perm: &self.perm,
+            inverse: &self.inverse,
             split: self
                 .split
                 .as_ref()
