@@ -106,8 +106,8 @@ fn main() -> rothe::Result<()> {
     // reading one stream per core, which is how a solve reads its factor.
     let triad_one = rothe::workload::triad_bandwidth(1 << 24, 10, false);
     let triad = rothe::workload::triad_bandwidth(1 << 24, 10, true);
-    let read_one = rothe::workload::read_bandwidth(1 << 26, 5, false);
-    let read = rothe::workload::read_bandwidth(1 << 26, 5, true);
+    let read_one = rothe::workload::read_bandwidth(1 << 25, 5, false);
+    let read = rothe::workload::read_bandwidth(1 << 25, 5, true);
     let bytes = 2.0 * nnz_l as f64 * 8.0;
     let bound = bytes / triad;
     let read_bound = bytes / read;
