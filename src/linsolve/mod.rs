@@ -131,8 +131,6 @@ pub trait SymmetricSolver: Send {
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<()> {
         self.solve_block_in_place(rhs, 1)
     }
-    /// Overwrites the `n x ncols` column-major block `rhs` with `A⁻¹ rhs`, reading
-    /// the factor once for all columns.
     /// `out = A⁻¹ b` for the sparse `b` whose nonzeros are `entries` (repeated
     /// indices summed). The faer backend's supernodal solve visits only the
     /// elimination-tree reach of the nonzeros in its forward sweep; the default is a
@@ -141,6 +139,8 @@ pub trait SymmetricSolver: Send {
         scatter_entries(entries, out);
         self.solve_in_place(out)
     }
+    /// Overwrites the `n x ncols` column-major block `rhs` with `A⁻¹ rhs`, reading
+    /// the factor once for all columns.
     fn solve_block_in_place(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()>;
     /// Number of nonzeros of the factor `L`, once analysed.
     fn factor_nnz(&self) -> Option<usize>;
