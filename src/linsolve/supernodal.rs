@@ -672,7 +672,6 @@ fn forward_node<const K: usize, M: MulAdd>(
         return;
     }
     let tmp = &mut tmp[..np * K];
-    tmp.fill(0.0);
     let block = &values[sn.values..sn.values + ld * ns];
     for j in 0..ns {
         let col = &block[j * ld..(j + 1) * ld];
@@ -691,9 +690,18 @@ fn forward_node<const K: usize, M: MulAdd>(
                 xi[c] = M::mul_add(l, neg[c], xi[c]);
             }
         }
-        for (t, &l) in tmp.chunks_exact_mut(K).zip(&col[ns..]) {
-            for c in 0..K {
-                t[c] = M::mul_add(l, xj[c], t[c]);
+        if j == 0 {
+            // The first column sets the buffer (`l x_j` is `fma(l, x_j, 0)` exactly).
+            for (t, &l) in tmp.chunks_exact_mut(K).zip(&col[ns..]) {
+                for c in 0..K {
+                    t[c] = l * xj[c];
+                }
+            }
+        } else {
+            for (t, &l) in tmp.chunks_exact_mut(K).zip(&col[ns..]) {
+                for c in 0..K {
+                    t[c] = M::mul_add(l, xj[c], t[c]);
+                }
             }
         }
     }
