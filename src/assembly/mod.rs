@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use crate::fe::{element, Plane};
 use crate::material::Material;
 use crate::mesh::{ElementKind, Mesh};
-pub use pattern::Pattern;
+pub use pattern::{Pattern, Stored};
 
 /// Mass matrix: consistent (on the shared pattern) or lumped (a diagonal).
 #[derive(Clone, Debug)]
@@ -79,10 +79,11 @@ impl ConsistentMass {
         w: &[f64],
         z: &mut [f64],
     ) {
-        match &self.pairs {
-            Some(m) => pattern.matvec_and_pairs(a, x, y, m, w, z),
-            None => pattern.matvec2(a, x, y, &self.values, w, z),
-        }
+        let b = match &self.pairs {
+            Some(m) => Stored::Pairs(m),
+            None => Stored::Full(&self.values),
+        };
+        pattern.matvec2(a, x, y, b, w, z)
     }
 }
 
@@ -303,7 +304,7 @@ mod tests {
             assert_eq!(full, pairs, "{scenario}: M x");
             let (mut y_full, mut z_full) = (vec![0.0; n], vec![0.0; n]);
             let (mut y, mut z) = (vec![0.0; n], vec![0.0; n]);
-            p.matvec2(&a, &x, &mut y_full, &m, &w, &mut z_full);
+            p.matvec2(&a, &x, &mut y_full, Stored::Full(&m), &w, &mut z_full);
             m.with_product(p, &a, &x, &mut y, &w, &mut z);
             assert_eq!(y_full, y, "{scenario}: A x beside M w");
             assert_eq!(z_full, z, "{scenario}: M w beside A x");

@@ -109,18 +109,14 @@ impl Pattern {
     /// in parallel over nodes.
     pub fn matvec(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
         y.par_chunks_mut(2).enumerate().for_each(|(n, yn)| {
-            let nbrs = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
             let (c0, c1) = self.node_columns(a, n);
             let (mut s0, mut s1) = (0.0, 0.0);
-            // Both columns of the node in one pass: each neighbour's two values of
-            // `x` are loaded once (the sums are the column-by-column ones).
-            for (k, &m) in nbrs.iter().enumerate() {
-                let (x0, x1) = (x[2 * m as usize], x[2 * m as usize + 1]);
-                s0 += c0[2 * k] * x0 + c0[2 * k + 1] * x1;
-                s1 += c1[2 * k] * x0 + c1[2 * k + 1] * x1;
+            for (k, &m) in self.neighbours(n).iter().enumerate() {
+                let (p, q) = block_terms(c0, c1, k, x, m);
+                s0 += p;
+                s1 += q;
             }
-            yn[0] = s0;
-            yn[1] = s1;
+            (yn[0], yn[1]) = (s0, s1);
         });
     }
 
@@ -129,65 +125,36 @@ impl Pattern {
     /// full values, whose zero entries add nothing).
     pub fn matvec_pairs(&self, m: &[f64], x: &[f64], y: &mut [f64]) {
         y.par_chunks_mut(2).enumerate().for_each(|(n, yn)| {
-            let (s0, s1) = self.pair_sums(m, x, n);
-            yn[0] = s0;
-            yn[1] = s1;
+            let lo = self.adj_ptr[n];
+            let (mut s0, mut s1) = (0.0, 0.0);
+            for (k, &j) in self.neighbours(n).iter().enumerate() {
+                let (p, q) = pair_terms(m[lo + k], x, j);
+                s0 += p;
+                s1 += q;
+            }
+            (yn[0], yn[1]) = (s0, s1);
         });
     }
 
-    /// `y = A x` and `z = M w` in one pass, `M` in node-pair form as in
-    /// [`Self::matvec_pairs`].
-    pub fn matvec_and_pairs(
+    /// `y = A x` and `z = B w` in one pass over the pattern (the adjacency and each
+    /// neighbour read once for both), `B` on the pattern or in node-pair form.
+    pub fn matvec2(
         &self,
         a: &[f64],
         x: &[f64],
         y: &mut [f64],
-        m: &[f64],
+        b: Stored,
         w: &[f64],
         z: &mut [f64],
     ) {
-        y.par_chunks_mut(2)
-            .zip(z.par_chunks_mut(2))
-            .enumerate()
-            .for_each(|(n, (yn, zn))| {
-                let (lo, hi) = (self.adj_ptr[n], self.adj_ptr[n + 1]);
-                let (a0, a1) = self.node_columns(a, n);
-                let (mut s0, mut s1, mut t0, mut t1) = (0.0, 0.0, 0.0, 0.0);
-                for (k, (&j, &mk)) in self.adj[lo..hi].iter().zip(&m[lo..hi]).enumerate() {
-                    let j = 2 * j as usize;
-                    let (x0, x1, w0, w1) = (x[j], x[j + 1], w[j], w[j + 1]);
-                    s0 += a0[2 * k] * x0 + a0[2 * k + 1] * x1;
-                    s1 += a1[2 * k] * x0 + a1[2 * k + 1] * x1;
-                    t0 += mk * w0;
-                    t1 += mk * w1;
-                }
-                (yn[0], yn[1], zn[0], zn[1]) = (s0, s1, t0, t1);
-            });
-    }
-
-    /// Both rows of node `n` of `M x`, `M` in node-pair form.
-    #[inline]
-    fn pair_sums(&self, m: &[f64], x: &[f64], n: usize) -> (f64, f64) {
-        let (lo, hi) = (self.adj_ptr[n], self.adj_ptr[n + 1]);
-        let (mut s0, mut s1) = (0.0, 0.0);
-        for (&mk, &j) in m[lo..hi].iter().zip(&self.adj[lo..hi]) {
-            s0 += mk * x[2 * j as usize];
-            s1 += mk * x[2 * j as usize + 1];
+        match b {
+            Stored::Full(b) => self.fused::<false>(a, x, y, b, w, z),
+            Stored::Pairs(m) => self.fused::<true>(a, x, y, m, w, z),
         }
-        (s0, s1)
     }
 
-    /// The two columns of node `n` of a matrix `a` stored on this pattern.
-    #[inline]
-    pub(crate) fn node_columns<'a>(&self, a: &'a [f64], n: usize) -> (&'a [f64], &'a [f64]) {
-        let len = 2 * (self.adj_ptr[n + 1] - self.adj_ptr[n]);
-        let c = 4 * self.adj_ptr[n];
-        (&a[c..c + len], &a[c + len..c + 2 * len])
-    }
-
-    /// `y = A x` and `z = B w` in one pass over the pattern (saves reading the
-    /// adjacency twice when both products are needed each step).
-    pub fn matvec2(
+    /// [`Self::matvec2`] with `b` in node-pair form if `PAIRS`, else on the pattern.
+    fn fused<const PAIRS: bool>(
         &self,
         a: &[f64],
         x: &[f64],
@@ -200,24 +167,71 @@ impl Pattern {
             .zip(z.par_chunks_mut(2))
             .enumerate()
             .for_each(|(n, (yn, zn))| {
-                let nbrs = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
+                let lo = self.adj_ptr[n];
                 let (a0, a1) = self.node_columns(a, n);
-                let (b0, b1) = self.node_columns(b, n);
+                let (b0, b1) = if PAIRS {
+                    (&[][..], &[][..])
+                } else {
+                    self.node_columns(b, n)
+                };
                 let (mut s0, mut s1, mut t0, mut t1) = (0.0, 0.0, 0.0, 0.0);
-                for (k, &m) in nbrs.iter().enumerate() {
-                    let m = 2 * m as usize;
-                    let (x0, x1, w0, w1) = (x[m], x[m + 1], w[m], w[m + 1]);
-                    s0 += a0[2 * k] * x0 + a0[2 * k + 1] * x1;
-                    s1 += a1[2 * k] * x0 + a1[2 * k + 1] * x1;
-                    t0 += b0[2 * k] * w0 + b0[2 * k + 1] * w1;
-                    t1 += b1[2 * k] * w0 + b1[2 * k + 1] * w1;
+                for (k, &j) in self.neighbours(n).iter().enumerate() {
+                    let (p, q) = block_terms(a0, a1, k, x, j);
+                    s0 += p;
+                    s1 += q;
+                    let (p, q) = if PAIRS {
+                        pair_terms(b[lo + k], w, j)
+                    } else {
+                        block_terms(b0, b1, k, w, j)
+                    };
+                    t0 += p;
+                    t1 += q;
                 }
-                yn[0] = s0;
-                yn[1] = s1;
-                zn[0] = t0;
-                zn[1] = t1;
+                (yn[0], yn[1], zn[0], zn[1]) = (s0, s1, t0, t1);
             });
     }
+
+    /// The neighbours of node `n` (itself included), ascending.
+    #[inline]
+    fn neighbours(&self, n: usize) -> &[u32] {
+        &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]]
+    }
+
+    /// The two columns of node `n` of a matrix `a` stored on this pattern.
+    #[inline]
+    pub(crate) fn node_columns<'a>(&self, a: &'a [f64], n: usize) -> (&'a [f64], &'a [f64]) {
+        let len = 2 * (self.adj_ptr[n + 1] - self.adj_ptr[n]);
+        let c = 4 * self.adj_ptr[n];
+        (&a[c..c + len], &a[c + len..c + 2 * len])
+    }
+}
+
+/// How the second matrix of [`Pattern::matvec2`] is stored.
+#[derive(Clone, Copy, Debug)]
+pub enum Stored<'a> {
+    /// Values on the pattern.
+    Full(&'a [f64]),
+    /// One value per node pair (2×2 blocks `m_k I`), in adjacency order.
+    Pairs(&'a [f64]),
+}
+
+/// The contributions of neighbour `m` (its `k`-th) to both rows of a node: the
+/// node's columns `c0, c1` times `x` at `m` (both of `x`'s values loaded once).
+#[inline(always)]
+fn block_terms(c0: &[f64], c1: &[f64], k: usize, x: &[f64], m: u32) -> (f64, f64) {
+    let m = 2 * m as usize;
+    let (x0, x1) = (x[m], x[m + 1]);
+    (
+        c0[2 * k] * x0 + c0[2 * k + 1] * x1,
+        c1[2 * k] * x0 + c1[2 * k + 1] * x1,
+    )
+}
+
+/// The contributions of neighbour `m` to both rows of a node for a block `mk I`.
+#[inline(always)]
+fn pair_terms(mk: f64, x: &[f64], m: u32) -> (f64, f64) {
+    let m = 2 * m as usize;
+    (mk * x[m], mk * x[m + 1])
 }
 
 /// Greedy colouring of the elements of one block so that no two elements of a colour
