@@ -304,12 +304,12 @@ fn permute_out<const K: usize>(
                 }
             });
     } else {
-        let half = K / 2;
+        let half = K.div_ceil(2);
         rhs.par_chunks_mut(n * half)
             .enumerate()
             .for_each(|(h, cols)| {
                 for (i, &p) in perm.iter().enumerate() {
-                    for c in 0..half {
+                    for c in 0..cols.len() / n {
                         cols[c * n + p] = x[i * K + h * half + c];
                     }
                 }
