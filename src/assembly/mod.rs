@@ -68,23 +68,6 @@ impl ConsistentMass {
             None => pattern.matvec(&self.values, x, y),
         }
     }
-
-    /// `y = A x` and `z = M w` in one pass over the pattern, for `A` on it.
-    pub fn with_product(
-        &self,
-        pattern: &Pattern,
-        a: &[f64],
-        x: &[f64],
-        y: &mut [f64],
-        w: &[f64],
-        z: &mut [f64],
-    ) {
-        let b = match &self.pairs {
-            Some(m) => Stored::Pairs(m),
-            None => Stored::Full(&self.values),
-        };
-        pattern.matvec2(a, x, y, b, w, z)
-    }
 }
 
 impl std::ops::Deref for ConsistentMass {
@@ -106,7 +89,8 @@ impl Mass {
         }
     }
 
-    /// `y = A x` and `z = M w`, in one pass over the pattern for a consistent mass.
+    /// `y = A x` and `z = M w`, in one pass over the pattern for a consistent mass
+    /// (its node-pair form where it has one).
     pub fn with_product(
         &self,
         pattern: &Pattern,
@@ -117,7 +101,13 @@ impl Mass {
         z: &mut [f64],
     ) {
         match self {
-            Mass::Consistent(m) => m.with_product(pattern, a, x, y, w, z),
+            Mass::Consistent(m) => {
+                let b = match &m.pairs {
+                    Some(pairs) => Stored::Pairs(pairs),
+                    None => Stored::Full(&m.values),
+                };
+                pattern.matvec2(a, x, y, b, w, z)
+            }
             Mass::Lumped(_) => {
                 pattern.matvec(a, x, y);
                 self.matvec(pattern, w, z);
@@ -305,7 +295,7 @@ mod tests {
             let (mut y_full, mut z_full) = (vec![0.0; n], vec![0.0; n]);
             let (mut y, mut z) = (vec![0.0; n], vec![0.0; n]);
             p.matvec2(&a, &x, &mut y_full, Stored::Full(&m), &w, &mut z_full);
-            m.with_product(p, &a, &x, &mut y, &w, &mut z);
+            Mass::Consistent(m.clone()).with_product(p, &a, &x, &mut y, &w, &mut z);
             assert_eq!(y_full, y, "{scenario}: A x beside M w");
             assert_eq!(z_full, z, "{scenario}: M w beside A x");
         }

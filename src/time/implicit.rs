@@ -527,22 +527,16 @@ impl StepProblem for ImplicitStep<'_> {
                 &mut w.nodal,
                 &mut w.f_int_np1,
                 &mut w.kdu,
-                match (&ops.mass, dynamic.is_some()) {
-                    (Mass::Consistent(m), true) => Some(MassProduct {
-                        m,
-                        out: &mut w.mv_np1,
-                    }),
-                    _ => None,
-                },
+                dynamic.is_some().then_some(MassProduct {
+                    m: &ops.mass,
+                    out: &mut w.mv_np1,
+                }),
             );
             w.totals = PointTotals {
                 psi: t.psi,
                 dissipation: t.dissipation,
                 failure: None,
             };
-            if let (Mass::Lumped(_), true) = (&ops.mass, dynamic.is_some()) {
-                ops.mass.matvec(p, &w.du, &mut w.mv_np1);
-            }
         } else {
             let pred = (!w.f_pred_np1.is_empty()).then_some(&mut w.f_pred_np1[..]);
             let kt = tangent.then_some(&mut w.kt[..]);

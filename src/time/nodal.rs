@@ -21,7 +21,7 @@
 use rayon::prelude::*;
 
 use crate::assembly::internal::{new_stores, points_per_element};
-use crate::assembly::{Assembler, ConsistentMass, Pattern};
+use crate::assembly::{Assembler, Mass, Pattern};
 use crate::energy::Dissipation;
 use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind};
 use crate::material::store::StateStore;
@@ -94,11 +94,11 @@ impl NodalState {
     }
 }
 
-/// A consistent mass matrix and where `M Δu` goes, for [`NodalLaws::evaluate`] to
-/// form in the same pass as the first stiffness product.
+/// The mass matrix and where `M Δu` goes, for [`NodalLaws::evaluate`] to form in
+/// the same pass as the first stiffness product.
 pub(crate) struct MassProduct<'a> {
-    /// The consistent mass.
-    pub m: &'a ConsistentMass,
+    /// The mass.
+    pub m: &'a Mass,
     /// `M Δu`.
     pub out: &'a mut [f64],
 }
