@@ -23,9 +23,12 @@
 
 mod convergence;
 mod correction;
+mod halves;
 
 pub use convergence::{ConstraintStatus, Convergence};
 pub use correction::{Corrected, Correction, LinearCorrection};
+
+pub(crate) use halves::{add_on_free, fill_free, in_halves};
 
 use crate::assembly::internal::PointFailure;
 use crate::error::Result;
@@ -83,12 +86,7 @@ pub trait StepProblem {
     /// the iterate `u` and returns `|delta|²`. A problem that keeps quantities of the
     /// iterate (the increment `u − u_n`) updates them here in the same pass.
     fn apply_correction(&mut self, u: &mut [f64], free: &[usize], delta: &[f64]) -> f64 {
-        let mut c2 = 0.0;
-        for (&d, &x) in free.iter().zip(delta) {
-            u[d] += x;
-            c2 += x * x;
-        }
-        c2
+        add_on_free(free, delta, u, None)
     }
 }
 
@@ -176,20 +174,30 @@ fn relative(r2: f64, scale2: f64) -> f64 {
 }
 
 /// Gathers `−r` on the free dofs into `rhs`; returns `Σ r²` and the free dof with
-/// the largest `|r|`.
+/// the largest `|r|` (the first of equal ones; the last NaN if there is one).
 fn gather(r: &[f64], free: &[usize], rhs: &mut Vec<f64>) -> (f64, Option<(usize, f64)>) {
-    rhs.clear();
-    let mut r2 = 0.0;
-    let mut worst: Option<(usize, f64)> = None;
-    for &d in free {
-        let x = r[d];
-        r2 += x * x;
-        if worst.is_none_or(|w| x.abs() > w.1.abs() || x.is_nan()) {
-            worst = Some((d, x));
-        }
-        rhs.push(-x);
+    /// Whether `b` (later) takes the place of `a` as the worst residual.
+    fn worse(a: Option<(usize, f64)>, b: (usize, f64)) -> bool {
+        a.is_none_or(|a| b.1.abs() > a.1.abs() || b.1.is_nan())
     }
-    (r2, worst)
+    fill_free(
+        free,
+        rhs,
+        |d| -r[d],
+        (0.0, None),
+        |(r2, worst), d, minus_x| {
+            let x = -minus_x;
+            (
+                r2 + x * x,
+                if worse(worst, (d, x)) {
+                    Some((d, x))
+                } else {
+                    worst
+                },
+            )
+        },
+        |(a2, a), (b2, b)| (a2 + b2, if b.is_some_and(|b| worse(a, b)) { b } else { a }),
+    )
 }
 
 /// Iterates `u` to equilibrium: see the module docs. On any outcome but
@@ -271,5 +279,67 @@ where
         let c2 = problem.apply_correction(u, &sys.dofs().free, &scratch.rhs);
         last_correction = Some(c2.sqrt());
         iterations += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sequential rule `gather` keeps on the pool: the first of the largest
+    /// `|r|`, unless there is a NaN, then the last NaN.
+    fn worst_in_order(r: &[f64], free: &[usize]) -> Option<(usize, f64)> {
+        let mut worst: Option<(usize, f64)> = None;
+        for &d in free {
+            let x = r[d];
+            if worst.is_none_or(|w| x.abs() > w.1.abs() || x.is_nan()) {
+                worst = Some((d, x));
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn the_gather_names_the_worst_dof_as_one_pass_in_order_would() {
+        let n = 9 * halves::LEAF + 5;
+        let free: Vec<usize> = (0..n).filter(|d| d % 5 != 2).collect();
+        let base: Vec<f64> = (0..n).map(|d| ((d * 7919) % 1000) as f64 * 1e-3).collect();
+        let cases: [&[(usize, f64)]; 4] = [
+            &[],
+            // Equal peaks in different pieces: the first one counts.
+            &[(3 * halves::LEAF + 1, -7.0), (8 * halves::LEAF, 7.0)],
+            // A NaN beats every number; of two NaNs the later one counts.
+            &[(100, f64::NAN), (6 * halves::LEAF + 3, 9.0)],
+            &[
+                (100, f64::NAN),
+                (5 * halves::LEAF + 4, f64::NAN),
+                (n - 1, 1e9),
+            ],
+        ];
+        for changes in cases {
+            let mut r = base.clone();
+            for &(d, x) in changes {
+                r[d] = x;
+            }
+            let mut rhs = Vec::new();
+            let (r2, worst) = gather(&r, &free, &mut rhs);
+            let expected = worst_in_order(&r, &free);
+            assert_eq!(
+                worst.map(|w| (w.0, w.1.to_bits())),
+                expected.map(|w| (w.0, w.1.to_bits())),
+                "{changes:?}"
+            );
+            let rhs_expected: Vec<f64> = free.iter().map(|&d| -r[d]).collect();
+            assert_eq!(
+                rhs.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                rhs_expected.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+            );
+            let r2_seq: f64 = free.iter().map(|&d| r[d] * r[d]).sum();
+            if r2_seq.is_nan() {
+                assert!(r2.is_nan());
+            } else {
+                assert!((r2 - r2_seq).abs() <= 1e-12 * r2_seq, "{r2} vs {r2_seq}");
+            }
+        }
     }
 }

@@ -14,8 +14,6 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
-
 use super::forces::{external_force, gravity_force};
 use super::nodal::{MassProduct, NodalLaws, NodalState};
 use super::{Rejection, State, StepOutcome, StepReport};
@@ -469,8 +467,7 @@ impl StepProblem for ImplicitStep<'_> {
         let inv_h = ops.dynamic().map(|(h, _, _)| 1.0 / h);
         let moving = self.moving;
         let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext_np1, &w.m_du, &w.kdu, &w.kt_du);
-        rhs.clear();
-        rhs.extend(free.iter().map(|&i| {
+        let value = |i: usize| {
             let mut r = base[i] - f_ext[i];
             if let Some(inv_h) = inv_h {
                 r -= mv_n[i] * inv_h;
@@ -482,7 +479,8 @@ impl StepProblem for ImplicitStep<'_> {
                 }
             }
             -r
-        }));
+        };
+        nonlinear::fill_free(free, rhs, value, (), |_, _, _| (), |_, _| ());
         true
     }
 
@@ -576,27 +574,27 @@ impl StepProblem for ImplicitStep<'_> {
             f_ext_n: &s.f_ext,
             free: &ops.free_mask,
         };
-        let sums =
-            w.r.par_chunks_mut(PASS_CHUNK)
-                .zip(w.f_int_np1.par_chunks_mut(PASS_CHUNK))
-                .zip(
-                    w.mv_np1
-                        .par_chunks_mut(PASS_CHUNK)
-                        .zip(w.v_np1.par_chunks_mut(PASS_CHUNK)),
-                )
-                .enumerate()
-                .map(|(k, ((r, f_int), (mv, v)))| {
-                    let lo = k * PASS_CHUNK;
-                    let inp = inputs.range(lo, lo + r.len());
-                    let out = PassOutputs { r, f_int, mv, v };
-                    match (dynamic.is_some(), elastic) {
-                        (true, true) => residual_chunk::<true, true>(&inp, out, &c),
-                        (true, false) => residual_chunk::<true, false>(&inp, out, &c),
-                        (false, true) => residual_chunk::<false, true>(&inp, out, &c),
-                        (false, false) => residual_chunk::<false, false>(&inp, out, &c),
-                    }
-                })
-                .reduce(|| [0.0; 11], |a, b| std::array::from_fn(|k| a[k] + b[k]));
+        // In halves of a fixed tree (`nonlinear::in_halves`): the same sums in every
+        // run, on any number of threads.
+        let outputs = PassOutputs {
+            r: &mut w.r,
+            f_int: &mut w.f_int_np1,
+            mv: &mut w.mv_np1,
+            v: &mut w.v_np1,
+        };
+        let n = outputs.r.len();
+        let leaf = |(lo, out): (usize, PassOutputs)| {
+            let inp = inputs.range(lo, lo + out.r.len());
+            match (dynamic.is_some(), elastic) {
+                (true, true) => residual_chunk::<true, true>(&inp, out, &c),
+                (true, false) => residual_chunk::<true, false>(&inp, out, &c),
+                (false, true) => residual_chunk::<false, true>(&inp, out, &c),
+                (false, false) => residual_chunk::<false, false>(&inp, out, &c),
+            }
+        };
+        let sums = nonlinear::in_halves((0, outputs), n, &PassOutputs::split, &leaf, &|a, b| {
+            std::array::from_fn(|k| a[k] + b[k])
+        });
         w.ledger_sums.copy_from_slice(&sums[3..]);
         Evaluation {
             force_scale2: sums[0],
@@ -620,19 +618,9 @@ impl StepProblem for ImplicitStep<'_> {
     }
 
     fn apply_correction(&mut self, u: &mut [f64], free: &[usize], delta: &[f64]) -> f64 {
-        let du = &mut self.w.du;
-        let mut c2 = 0.0;
-        for (&d, &x) in free.iter().zip(delta) {
-            u[d] += x;
-            du[d] += x;
-            c2 += x * x;
-        }
-        c2
+        nonlinear::add_on_free(free, delta, u, Some(&mut self.w.du))
     }
 }
-
-/// Dofs per parallel chunk of the residual pass.
-const PASS_CHUNK: usize = 8192;
 
 /// Coefficients of the residual pass.
 struct PassCoefficients {
@@ -672,13 +660,36 @@ impl<'a> PassInputs<'a> {
     }
 }
 
-/// What the residual pass writes (one chunk of each vector).
+/// What the residual pass writes (one piece of each vector).
 struct PassOutputs<'a> {
     r: &'a mut [f64],
     f_int: &'a mut [f64],
     /// `M Δu` on entry, `M v` on exit (dynamic).
     mv: &'a mut [f64],
     v: &'a mut [f64],
+}
+
+impl<'a> PassOutputs<'a> {
+    /// The piece from dof `lo` on, cut at `mid` dofs into two pieces.
+    fn split((lo, out): (usize, Self), mid: usize) -> ((usize, Self), (usize, Self)) {
+        let (r0, r1) = out.r.split_at_mut(mid);
+        let (f0, f1) = out.f_int.split_at_mut(mid);
+        let (m0, m1) = out.mv.split_at_mut(mid);
+        let (v0, v1) = out.v.split_at_mut(mid);
+        let first = PassOutputs {
+            r: r0,
+            f_int: f0,
+            mv: m0,
+            v: v0,
+        };
+        let second = PassOutputs {
+            r: r1,
+            f_int: f1,
+            mv: m1,
+            v: v1,
+        };
+        ((lo, first), (lo + mid, second))
+    }
 }
 
 /// The residual pass over one chunk of dofs, specialised for inertia (`DYN`) and
