@@ -168,15 +168,11 @@ impl SymmetricSolver for FaerCholesky {
                 message: format!("out of memory allocating the {what}"),
             };
             let len = sym.len_val();
-            let mut values = Vec::new();
-            values
-                .try_reserve_exact(len)
-                .map_err(|_| oom("factor values"))?;
-            values.resize(len, 0.0);
-            self.l_values = values;
+            self.l_values = crate::memory::try_zeroed(len).ok_or_else(|| oom("factor values"))?;
             let freq = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
-            self.factor_scratch =
-                Some(MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?);
+            let mut scratch = MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?;
+            crate::memory::touch(&mut scratch);
+            self.factor_scratch = Some(scratch);
         }
         let mat = SparseColMatRef::new(Self::pattern(a), &a.values);
         let stack = MemStack::new(self.factor_scratch.as_mut().expect("set by analyze"));
