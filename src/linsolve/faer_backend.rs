@@ -139,10 +139,9 @@ impl SymmetricSolver for FaerCholesky {
         self.l_values = Vec::new();
         self.factor_scratch = None;
         self.own = match sym.raw() {
-            SymbolicCholeskyRaw::Supernodal(sn) => Some(super::supernodal::SupernodalSolver::new(
-                sn,
-                sym.perm().map(|p| p.arrays().0),
-            )),
+            SymbolicCholeskyRaw::Supernodal(sn) => {
+                super::supernodal::SupernodalSolver::new(sn, sym.perm().map(|p| p.arrays().0))
+            }
             SymbolicCholeskyRaw::Simplicial(sm) => {
                 super::supernodal::SupernodalSolver::from_simplicial(
                     sm.col_ptr(),

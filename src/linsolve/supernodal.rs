@@ -18,6 +18,11 @@
 
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 
+/// A row index of the factor's pattern: 4 bytes, so that the sweeps stream half the
+/// index bytes a `usize` would (systems of up to `u32::MAX` unknowns; larger ones
+/// solve with faer's own code).
+type Row = u32;
+
 /// The geometry of one supernode.
 #[derive(Clone, Copy, Debug)]
 struct Supernode {
@@ -31,6 +36,11 @@ struct Supernode {
     npattern: usize,
     /// Offset of its values.
     values: usize,
+}
+
+/// The row indices as [`Row`]s, `None` if one does not fit.
+fn narrow(rows: &[usize]) -> Option<Vec<Row>> {
+    rows.iter().map(|&r| Row::try_from(r).ok()).collect()
 }
 
 /// Systems of at least this order are worth a second thread.
@@ -68,7 +78,7 @@ struct TreeSplit {
 impl TreeSplit {
     /// The split of the forest `parent` of `nodes`, if it is in postorder and has
     /// two balanced parts below a small top.
-    fn new(nodes: &[Supernode], parent: &[usize], rows: &[usize]) -> Option<Self> {
+    fn new(nodes: &[Supernode], parent: &[usize], rows: &[Row]) -> Option<Self> {
         let ns = nodes.len();
         let mut children = vec![Vec::new(); ns];
         let mut roots = Vec::new();
@@ -154,7 +164,10 @@ impl TreeSplit {
                 for s in first[r]..=r {
                     let sn = &nodes[s];
                     let pattern = &rows[sn.pattern..sn.pattern + sn.npattern];
-                    out.push((s as u32, pattern.partition_point(|&row| row < hi) as u32));
+                    out.push((
+                        s as u32,
+                        pattern.partition_point(|&row| (row as usize) < hi) as u32,
+                    ));
                 }
             }
             out
@@ -190,7 +203,7 @@ struct Structure<'a> {
     /// The longest supernode pattern.
     max_pattern: usize,
     nodes: &'a [Supernode],
-    rows: &'a [usize],
+    rows: &'a [Row],
     perm: &'a [usize],
     /// `inverse[perm[i]] = i`.
     inverse: &'a [usize],
@@ -333,7 +346,7 @@ fn aligned(buf: &mut Vec<f64>, len: usize) -> &mut [f64] {
 pub struct SupernodalSolver {
     n: usize,
     nodes: Vec<Supernode>,
-    rows: Vec<usize>,
+    rows: Vec<Row>,
     /// The supernode holding each column.
     node_of: Vec<usize>,
     /// The parent supernode in the supernodal elimination tree (`usize::MAX` at a
@@ -358,8 +371,8 @@ pub struct SupernodalSolver {
 
 impl SupernodalSolver {
     /// The solver of the factor with structure `sym` and elimination order `perm`
-    /// (`None`: the identity).
-    pub fn new(sym: &SymbolicSupernodalCholesky<usize>, perm: Option<&[usize]>) -> Self {
+    /// (`None`: the identity); `None` for a system of more than `u32::MAX` unknowns.
+    pub fn new(sym: &SymbolicSupernodalCholesky<usize>, perm: Option<&[usize]>) -> Option<Self> {
         let ns = sym.n_supernodes();
         let begin = sym.supernode_begin();
         let end = sym.supernode_end();
@@ -375,7 +388,8 @@ impl SupernodalSolver {
                 values: cp_vals[s],
             })
             .collect();
-        Self::from_nodes(sym.nrows(), nodes, sym.row_idx().to_vec(), perm)
+        let rows = narrow(sym.row_idx())?;
+        Some(Self::from_nodes(sym.nrows(), nodes, rows, perm))
     }
 
     /// The solver of a simplicial factor (compressed columns `col_ptr`, `row_idx`,
@@ -404,15 +418,10 @@ impl SupernodalSolver {
             });
             pattern_rows.extend_from_slice(&row_idx[a + 1..b]);
         }
-        Some(Self::from_nodes(n, nodes, pattern_rows, perm))
+        Some(Self::from_nodes(n, nodes, narrow(&pattern_rows)?, perm))
     }
 
-    fn from_nodes(
-        n: usize,
-        nodes: Vec<Supernode>,
-        rows: Vec<usize>,
-        perm: Option<&[usize]>,
-    ) -> Self {
+    fn from_nodes(n: usize, nodes: Vec<Supernode>, rows: Vec<Row>, perm: Option<&[usize]>) -> Self {
         let ns = nodes.len();
         let mut node_of = vec![0; n];
         for (s, sn) in nodes.iter().enumerate() {
@@ -424,7 +433,7 @@ impl SupernodalSolver {
                 if sn.npattern == 0 {
                     usize::MAX
                 } else {
-                    node_of[rows[sn.pattern]]
+                    node_of[rows[sn.pattern] as usize]
                 }
             })
             .collect();
@@ -638,7 +647,7 @@ struct Place {
 #[inline(always)]
 fn forward_node<const K: usize, M: MulAdd>(
     sn: &Supernode,
-    rows: &[usize],
+    rows: &[Row],
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
@@ -659,12 +668,13 @@ fn forward_node<const K: usize, M: MulAdd>(
         x[b * K..(b + 1) * K].copy_from_slice(&xj);
         let (near, rest) = col[1..].split_at(at.split);
         for (&l, &row) in near.iter().zip(near_rows) {
-            let r = row - at.lo;
+            let r = row as usize - at.lo;
             for c in 0..K {
                 x[r * K + c] = M::mul_add(l, -xj[c], x[r * K + c]);
             }
         }
         for (&l, &row) in rest.iter().zip(far_rows) {
+            let row = row as usize;
             for c in 0..K {
                 far[row * K + c] = M::mul_add(l, -xj[c], far[row * K + c]);
             }
@@ -707,12 +717,13 @@ fn forward_node<const K: usize, M: MulAdd>(
     }
     let (near, rest) = tmp.split_at(at.split * K);
     for (t, &row) in near.chunks_exact(K).zip(near_rows) {
-        let r = row - at.lo;
+        let r = row as usize - at.lo;
         for c in 0..K {
             x[r * K + c] -= t[c];
         }
     }
     for (t, &row) in rest.chunks_exact(K).zip(far_rows) {
+        let row = row as usize;
         for c in 0..K {
             far[row * K + c] -= t[c];
         }
@@ -725,7 +736,7 @@ fn forward_node<const K: usize, M: MulAdd>(
 #[inline(always)]
 fn backward_node<const K: usize, M: MulAdd>(
     sn: &Supernode,
-    rows: &[usize],
+    rows: &[Row],
     values: &[f64],
     x: &mut [f64],
     tmp: &mut [f64],
@@ -743,6 +754,7 @@ fn backward_node<const K: usize, M: MulAdd>(
         let (near, rest) = col[1..].split_at(at.split);
         let mut acc = [[0.0; K]; LANES];
         for (k, (&l, &row)) in rest.iter().zip(far_rows).enumerate().rev() {
+            let row = row as usize;
             let lane = k % LANES;
             for c in 0..K {
                 acc[lane][c] = M::mul_add(l, far[row * K + c], acc[lane][c]);
@@ -750,7 +762,7 @@ fn backward_node<const K: usize, M: MulAdd>(
         }
         for (k, (&l, &row)) in near.iter().zip(near_rows).enumerate().rev() {
             let lane = k % LANES;
-            let r = row - at.lo;
+            let r = row as usize - at.lo;
             for c in 0..K {
                 acc[lane][c] = M::mul_add(l, x[r * K + c], acc[lane][c]);
             }
@@ -765,10 +777,11 @@ fn backward_node<const K: usize, M: MulAdd>(
     let tmp = &mut tmp[..np * K];
     let (near_t, far_t) = tmp.split_at_mut(at.split * K);
     for (t, &row) in near_t.chunks_exact_mut(K).zip(near_rows) {
-        let r = row - at.lo;
+        let r = row as usize - at.lo;
         t.copy_from_slice(&x[r * K..(r + 1) * K]);
     }
     for (t, &row) in far_t.chunks_exact_mut(K).zip(far_rows) {
+        let row = row as usize;
         t.copy_from_slice(&far[row * K..(row + 1) * K]);
     }
     let block = &values[sn.values..sn.values + ld * ns];
@@ -1092,7 +1105,7 @@ unsafe fn sweep_avx2<const K: usize>(
 #[derive(Clone, Copy)]
 struct Factor<'a> {
     nodes: &'a [Supernode],
-    rows: &'a [usize],
+    rows: &'a [Row],
     values: &'a [f64],
 }
 
@@ -1116,5 +1129,26 @@ impl Factor<'_> {
             }
         }
         sweep::<K, Plain>(dir, run, self, x, tmp, far_out, far_in)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_indices_beyond_u32_leave_the_solve_to_faer() {
+        let fits = [0usize, 7, Row::MAX as usize];
+        assert_eq!(narrow(&fits), Some(vec![0, 7, Row::MAX]));
+        assert_eq!(narrow(&[3, Row::MAX as usize + 1]), None);
+        // A simplicial factor whose pattern does not fit: no own solver.
+        let col_ptr = [0usize, 2, 3];
+        let too_far = [0usize, Row::MAX as usize + 1, 1];
+        assert!(SupernodalSolver::from_simplicial(&col_ptr, &too_far, None).is_none());
+        let fine = [0usize, 1, 1];
+        assert_eq!(
+            SupernodalSolver::from_simplicial(&col_ptr, &fine, None).map(|s| s.n()),
+            Some(2)
+        );
     }
 }
