@@ -32,6 +32,7 @@ pub mod contact;
 pub mod energy;
 pub mod error;
 pub mod fe;
+pub mod halves;
 pub mod linsolve;
 pub mod material;
 pub mod memory;

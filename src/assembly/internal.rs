@@ -5,11 +5,10 @@
 //! nothing is allocated per pass (element buffers live on the stack, trial states in
 //! the stores).
 
-use rayon::prelude::*;
-
 use super::{Assembler, SharedValues};
 use crate::energy::Dissipation;
 use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind, Plane};
+use crate::halves::in_halves;
 use crate::material::store::{Committed, Layout, StateStore};
 use crate::material::{Material, PointResponse, PointStatus, StrainStep, MAX_STATE};
 use crate::mesh::Mesh;
@@ -51,6 +50,9 @@ impl PointTotals {
         self
     }
 }
+
+/// Elements per leaf of the Gauss-point pass over one colour.
+const ELEMENT_LEAF: usize = 128;
 
 /// Number of material points of an element kind (bars: one).
 pub fn points_per_element(kind: ElementKind) -> usize {
@@ -367,69 +369,70 @@ impl Assembler {
             );
             let ng = points_per_element(block.elements.kind);
             for colour in &self.colours[bi] {
-                let part = colour
-                    .par_chunks(128)
-                    .map(|chunk| {
-                        let mut acc = PointTotals::default();
-                        for &e in chunk {
-                            let nodes = block.elements.element(e);
-                            let mut fe = [0.0; 8];
-                            let mut fe_pred = [0.0; 8];
-                            let mut ke = [0.0; 64];
-                            let mut q = 0;
-                            element_points(
-                                &cx,
-                                committed,
-                                nodes,
-                                u,
-                                e,
-                                Some(trial),
-                                |w, r, k, x, sp| {
-                                    acc.psi += w * r.psi;
-                                    acc.dissipation += r.dissipation.scaled(w);
-                                    if r.status != PointStatus::Ok && acc.failure.is_none() {
-                                        acc.failure = Some(PointFailure {
-                                            block: bi,
-                                            element: e,
-                                            point: e * ng + q,
-                                        });
-                                    }
-                                    q += 1;
-                                    add_bt_sigma(k, x, nodes.len(), w, &r.sigma, &mut fe);
-                                    if predict {
-                                        add_bt_sigma(k, x, nodes.len(), w, &sp, &mut fe_pred);
-                                    }
-                                    if kp.is_some() {
-                                        add_point_tangent(
-                                            k,
-                                            x,
-                                            nodes.len(),
-                                            w,
-                                            &r.tangent,
-                                            &mut ke,
-                                        );
-                                    }
-                                },
-                            );
-                            if let Some(kp) = kp {
-                                self.scatter(nodes, &ke, kp);
-                            }
-                            for (a, &n) in nodes.iter().enumerate() {
-                                // SAFETY: no two elements of this colour share node n.
-                                let fn_ = unsafe { fp.slice(2 * n, 2) };
-                                fn_[0] += fe[2 * a];
-                                fn_[1] += fe[2 * a + 1];
-                                if let Some(pp) = pp {
-                                    // SAFETY: as above, for the predicted force.
-                                    let pn = unsafe { pp.slice(2 * n, 2) };
-                                    pn[0] += fe_pred[2 * a];
-                                    pn[1] += fe_pred[2 * a + 1];
+                // In halves of a fixed tree (`crate::halves`): the same totals in
+                // every run.
+                let leaf = |chunk: &[usize]| {
+                    let mut acc = PointTotals::default();
+                    for &e in chunk {
+                        let nodes = block.elements.element(e);
+                        let mut fe = [0.0; 8];
+                        let mut fe_pred = [0.0; 8];
+                        let mut ke = [0.0; 64];
+                        let mut q = 0;
+                        element_points(
+                            &cx,
+                            committed,
+                            nodes,
+                            u,
+                            e,
+                            Some(trial),
+                            |w, r, k, x, sp| {
+                                acc.psi += w * r.psi;
+                                acc.dissipation += r.dissipation.scaled(w);
+                                if r.status != PointStatus::Ok && acc.failure.is_none() {
+                                    acc.failure = Some(PointFailure {
+                                        block: bi,
+                                        element: e,
+                                        point: e * ng + q,
+                                    });
                                 }
+                                q += 1;
+                                add_bt_sigma(k, x, nodes.len(), w, &r.sigma, &mut fe);
+                                if predict {
+                                    add_bt_sigma(k, x, nodes.len(), w, &sp, &mut fe_pred);
+                                }
+                                if kp.is_some() {
+                                    add_point_tangent(k, x, nodes.len(), w, &r.tangent, &mut ke);
+                                }
+                            },
+                        );
+                        if let Some(kp) = kp {
+                            self.scatter(nodes, &ke, kp);
+                        }
+                        for (a, &n) in nodes.iter().enumerate() {
+                            // SAFETY: no two elements of this colour share node n.
+                            let fn_ = unsafe { fp.slice(2 * n, 2) };
+                            fn_[0] += fe[2 * a];
+                            fn_[1] += fe[2 * a + 1];
+                            if let Some(pp) = pp {
+                                // SAFETY: as above, for the predicted force.
+                                let pn = unsafe { pp.slice(2 * n, 2) };
+                                pn[0] += fe_pred[2 * a];
+                                pn[1] += fe_pred[2 * a + 1];
                             }
                         }
-                        acc
-                    })
-                    .reduce(PointTotals::default, PointTotals::merge);
+                    }
+                    acc
+                };
+                let (n, split) = (colour.len(), <[usize]>::split_at);
+                let part = in_halves(
+                    &colour[..],
+                    n,
+                    ELEMENT_LEAF,
+                    &split,
+                    &leaf,
+                    &PointTotals::merge,
+                );
                 totals = totals.merge(part);
             }
         }

@@ -9,8 +9,6 @@
 //!   into the numerical loss (`theory/energy.md`),
 //! - the damping work `Δu·f_damp,n+1` with `f_damp = C v_{n+1}` (`D_mass`).
 
-use rayon::prelude::*;
-
 /// A step's vectors, all over every dof.
 #[derive(Clone, Copy, Debug)]
 pub struct StepVectors<'a> {
@@ -81,24 +79,25 @@ pub fn step_work(v: &StepVectors) -> StepWork {
     debug_assert!([v.f_int_n, v.f_int_np1, v.f_ext_n, v.f_ext_np1]
         .iter()
         .all(|x| x.len() == n));
-    let sums = (0..n)
-        .into_par_iter()
-        .with_min_len(4096)
-        .fold(
-            || [0.0f64; 4],
-            |acc, i| {
-                let w = work_integrands(
-                    v.du[i],
-                    v.f_int_n[i],
-                    v.f_int_np1[i],
-                    v.f_ext_n[i],
-                    v.f_ext_np1[i],
-                    v.f_damp_np1.map_or(0.0, |c| c[i]),
-                );
-                std::array::from_fn(|k| acc[k] + w[k])
-            },
-        )
-        .reduce(|| [0.0; 4], |a, b| std::array::from_fn(|k| a[k] + b[k]));
+    // In halves of a fixed tree (`crate::halves`): the same sums in every run.
+    let leaf = |r: std::ops::Range<usize>| {
+        let mut acc = [0.0f64; 4];
+        for i in r {
+            let w = work_integrands(
+                v.du[i],
+                v.f_int_n[i],
+                v.f_int_np1[i],
+                v.f_ext_n[i],
+                v.f_ext_np1[i],
+                v.f_damp_np1.map_or(0.0, |c| c[i]),
+            );
+            for k in 0..4 {
+                acc[k] += w[k];
+            }
+        }
+        acc
+    };
+    let sums = crate::halves::in_ranges(n, crate::halves::VECTOR_LEAF, &leaf, &crate::halves::add);
     StepWork::from_sums(sums)
 }
 

@@ -23,12 +23,12 @@
 
 mod convergence;
 mod correction;
-mod halves;
+mod free_dofs;
 
 pub use convergence::{ConstraintStatus, Convergence};
 pub use correction::{Corrected, Correction, LinearCorrection};
 
-pub(crate) use halves::{add_on_free, fill_free, in_halves};
+pub(crate) use free_dofs::{add_on_free, fill_free};
 
 use crate::assembly::internal::PointFailure;
 use crate::error::Result;
@@ -301,18 +301,21 @@ mod tests {
 
     #[test]
     fn the_gather_names_the_worst_dof_as_one_pass_in_order_would() {
-        let n = 9 * halves::LEAF + 5;
+        let n = 9 * crate::halves::VECTOR_LEAF + 5;
         let free: Vec<usize> = (0..n).filter(|d| d % 5 != 2).collect();
         let base: Vec<f64> = (0..n).map(|d| ((d * 7919) % 1000) as f64 * 1e-3).collect();
         let cases: [&[(usize, f64)]; 4] = [
             &[],
             // Equal peaks in different pieces: the first one counts.
-            &[(3 * halves::LEAF + 1, -7.0), (8 * halves::LEAF, 7.0)],
+            &[
+                (3 * crate::halves::VECTOR_LEAF + 1, -7.0),
+                (8 * crate::halves::VECTOR_LEAF, 7.0),
+            ],
             // A NaN beats every number; of two NaNs the later one counts.
-            &[(100, f64::NAN), (6 * halves::LEAF + 3, 9.0)],
+            &[(100, f64::NAN), (6 * crate::halves::VECTOR_LEAF + 3, 9.0)],
             &[
                 (100, f64::NAN),
-                (5 * halves::LEAF + 4, f64::NAN),
+                (5 * crate::halves::VECTOR_LEAF + 4, f64::NAN),
                 (n - 1, 1e9),
             ],
         ];

@@ -22,6 +22,7 @@ use crate::assembly::{Assembler, Mass};
 use crate::contact::ContactCorrection;
 use crate::energy::{work_integrands, Dissipation, Ledger, StepIncrements, StepWork};
 use crate::error::{Error, Result};
+use crate::halves;
 use crate::linsolve::Backend;
 use crate::material::store::StateStore;
 use crate::model::{IterationMethod, Model, ViscoelasticState};
@@ -574,17 +575,18 @@ impl StepProblem for ImplicitStep<'_> {
             f_ext_n: &s.f_ext,
             free: &ops.free_mask,
         };
-        // In halves of a fixed tree (`nonlinear::in_halves`): the same sums in every
-        // run, on any number of threads.
-        let outputs = PassOutputs {
-            r: &mut w.r,
-            f_int: &mut w.f_int_np1,
-            mv: &mut w.mv_np1,
-            v: &mut w.v_np1,
-        };
-        let n = outputs.r.len();
-        let leaf = |(lo, out): (usize, PassOutputs)| {
-            let inp = inputs.range(lo, lo + out.r.len());
+        // In halves of a fixed tree (`crate::halves`): the same sums in every run, on
+        // any number of threads.
+        let n = w.r.len();
+        let outputs = [
+            &mut w.r[..],
+            &mut w.f_int_np1[..],
+            &mut w.mv_np1[..],
+            &mut w.v_np1[..],
+        ];
+        let leaf = |(lo, [r, f_int, mv, v]): halves::Slices<4>| {
+            let inp = inputs.range(lo, lo + r.len());
+            let out = PassOutputs { r, f_int, mv, v };
             match (dynamic.is_some(), elastic) {
                 (true, true) => residual_chunk::<true, true>(&inp, out, &c),
                 (true, false) => residual_chunk::<true, false>(&inp, out, &c),
@@ -592,9 +594,14 @@ impl StepProblem for ImplicitStep<'_> {
                 (false, false) => residual_chunk::<false, false>(&inp, out, &c),
             }
         };
-        let sums = nonlinear::in_halves((0, outputs), n, &PassOutputs::split, &leaf, &|a, b| {
-            std::array::from_fn(|k| a[k] + b[k])
-        });
+        let sums = halves::in_halves(
+            (0, outputs),
+            n,
+            halves::VECTOR_LEAF,
+            &halves::split_slices,
+            &leaf,
+            &halves::add,
+        );
         w.ledger_sums.copy_from_slice(&sums[3..]);
         Evaluation {
             force_scale2: sums[0],
@@ -667,29 +674,6 @@ struct PassOutputs<'a> {
     /// `M Δu` on entry, `M v` on exit (dynamic).
     mv: &'a mut [f64],
     v: &'a mut [f64],
-}
-
-impl<'a> PassOutputs<'a> {
-    /// The piece from dof `lo` on, cut at `mid` dofs into two pieces.
-    fn split((lo, out): (usize, Self), mid: usize) -> ((usize, Self), (usize, Self)) {
-        let (r0, r1) = out.r.split_at_mut(mid);
-        let (f0, f1) = out.f_int.split_at_mut(mid);
-        let (m0, m1) = out.mv.split_at_mut(mid);
-        let (v0, v1) = out.v.split_at_mut(mid);
-        let first = PassOutputs {
-            r: r0,
-            f_int: f0,
-            mv: m0,
-            v: v0,
-        };
-        let second = PassOutputs {
-            r: r1,
-            f_int: f1,
-            mv: m1,
-            v: v1,
-        };
-        ((lo, first), (lo + mid, second))
-    }
 }
 
 /// The residual pass over one chunk of dofs, specialised for inertia (`DYN`) and

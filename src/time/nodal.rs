@@ -24,6 +24,7 @@ use crate::assembly::internal::{new_stores, points_per_element};
 use crate::assembly::{Assembler, Mass, Pattern};
 use crate::energy::Dissipation;
 use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind};
+use crate::halves::{add, in_halves, split_slices, Slices, VECTOR_LEAF};
 use crate::material::store::StateStore;
 use crate::material::{mul3, Model as Law, Viscosity};
 use crate::model::Model;
@@ -451,11 +452,6 @@ struct GroupPass<'a> {
     old: &'a GroupFields,
 }
 
-/// `[ψ, D_viscous, D_numerical]` summed over chunks.
-fn add3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
 impl GroupPass<'_> {
     /// Completes the trial fields `new` (whose `ku`, `vu` hold the products at `u`),
     /// adds the group's force to `f` and `K_g Δu` to `kdu`, and sums its energies.
@@ -483,29 +479,26 @@ impl GroupPass<'_> {
     fn voigt(&self, new: &GroupFields, f: &mut [f64], kdu: &mut [f64], law: GroupLaw) -> [f64; 3] {
         let inv_h = 1.0 / self.h;
         let (ku, vu, old) = (&new.ku, &new.vu, self.old);
-        f.par_chunks_mut(CHUNK)
-            .zip(kdu.par_chunks_mut(CHUNK))
-            .enumerate()
-            .map(|(c, (fc, kc))| {
-                let lo = c * CHUNK;
-                let mut acc = [0.0; 3];
-                for (j, (fo, ko)) in fc.iter_mut().zip(kc.iter_mut()).enumerate() {
-                    let i = lo + j;
-                    let dy = ku[i] - old.ku[i];
-                    let visc = match law {
-                        GroupLaw::ProportionalVoigt { alpha } => alpha * inv_h * dy,
-                        GroupLaw::MatrixVoigt => (vu[i] - old.vu[i]) * inv_h,
-                        _ => 0.0,
-                    };
-                    self.put(fo, ku[i] + visc);
-                    self.put(ko, dy);
-                    acc[0] += 0.5 * self.u[i] * ku[i];
-                    acc[1] += self.du[i] * visc;
-                    acc[2] += 0.5 * self.du[i] * dy;
-                }
-                acc
-            })
-            .reduce(|| [0.0; 3], add3)
+        let n = f.len();
+        let leaf = |(lo, [fc, kc]): Slices<2>| {
+            let mut acc = [0.0; 3];
+            for (j, (fo, ko)) in fc.iter_mut().zip(kc.iter_mut()).enumerate() {
+                let i = lo + j;
+                let dy = ku[i] - old.ku[i];
+                let visc = match law {
+                    GroupLaw::ProportionalVoigt { alpha } => alpha * inv_h * dy,
+                    GroupLaw::MatrixVoigt => (vu[i] - old.vu[i]) * inv_h,
+                    _ => 0.0,
+                };
+                self.put(fo, ku[i] + visc);
+                self.put(ko, dy);
+                acc[0] += 0.5 * self.u[i] * ku[i];
+                acc[1] += self.du[i] * visc;
+                acc[2] += 0.5 * self.du[i] * dy;
+            }
+            acc
+        };
+        in_halves((0, [f, kdu]), n, VECTOR_LEAF, &split_slices, &leaf, &add)
     }
 
     /// Standard linear solid groups: `u_d`, `K_g u_d` by the recursion, then
@@ -524,34 +517,27 @@ impl GroupPass<'_> {
         let inv = 1.0 / (1.0 + k);
         let visc = beta / self.h;
         let (ku, old) = (&new.ku, self.old);
-        f.par_chunks_mut(CHUNK)
-            .zip(kdu.par_chunks_mut(CHUNK))
-            .zip(
-                new.ud
-                    .par_chunks_mut(CHUNK)
-                    .zip(new.kud.par_chunks_mut(CHUNK)),
-            )
-            .enumerate()
-            .map(|(c, ((fc, kc), (udc, kudc)))| {
-                let lo = c * CHUNK;
-                let mut acc = [0.0; 3];
-                for j in 0..fc.len() {
-                    let i = lo + j;
-                    let (u, du, y) = (self.u[i], self.du[i], ku[i]);
-                    let ud = (old.ud[i] + k * u) * inv;
-                    let yd = (old.kud[i] + k * y) * inv;
-                    udc[j] = ud;
-                    kudc[j] = yd;
-                    let dy = y - old.ku[i];
-                    let (dud, dyd) = (ud - old.ud[i], yd - old.kud[i]);
-                    self.put(&mut fc[j], p * y + alpha * (y - yd));
-                    self.put(&mut kc[j], dy);
-                    acc[0] += 0.5 * p * u * y + 0.5 * alpha * (u - ud) * (y - yd);
-                    acc[1] += visc * dud * dyd;
-                    acc[2] += 0.5 * p * du * dy + 0.5 * alpha * (du - dud) * (dy - dyd);
-                }
-                acc
-            })
-            .reduce(|| [0.0; 3], add3)
+        let n = f.len();
+        let leaf = |(lo, [fc, kc, udc, kudc]): Slices<4>| {
+            let mut acc = [0.0; 3];
+            for j in 0..fc.len() {
+                let i = lo + j;
+                let (u, du, y) = (self.u[i], self.du[i], ku[i]);
+                let ud = (old.ud[i] + k * u) * inv;
+                let yd = (old.kud[i] + k * y) * inv;
+                udc[j] = ud;
+                kudc[j] = yd;
+                let dy = y - old.ku[i];
+                let (dud, dyd) = (ud - old.ud[i], yd - old.kud[i]);
+                self.put(&mut fc[j], p * y + alpha * (y - yd));
+                self.put(&mut kc[j], dy);
+                acc[0] += 0.5 * p * u * y + 0.5 * alpha * (u - ud) * (y - yd);
+                acc[1] += visc * dud * dyd;
+                acc[2] += 0.5 * p * du * dy + 0.5 * alpha * (du - dud) * (dy - dyd);
+            }
+            acc
+        };
+        let pieces = (0, [f, kdu, &mut new.ud[..], &mut new.kud[..]]);
+        in_halves(pieces, n, VECTOR_LEAF, &split_slices, &leaf, &add)
     }
 }

@@ -1,37 +1,8 @@
-//! Passes over the dofs on the thread pool: the equilibrium loop's prediction of
-//! the right-hand side, gather of the residual and update of the iterate by the
-//! correction (over the free dofs), and the integrators' residual pass (over all
-//! dofs). Each pass is split in halves down to [`LEAF`] entries, two halves at a
-//! time on the pool; the halves and the order their sums are combined in depend on
-//! the number of entries only, so a pass gives the same sums to the last bit in
-//! every run and on any number of threads, whichever thread takes which half (a
-//! reduction split where the pool's work stealing happens to split would not).
+//! The equilibrium loop's passes over the free dofs on the thread pool, in halves
+//! of a fixed tree ([`crate::halves`]): the prediction of the right-hand side, the
+//! gather of the residual and the update of the iterate by the correction.
 
-/// Passes over at most this many equations run on one thread (a few microseconds).
-pub(crate) const LEAF: usize = 8192;
-
-/// Runs `leaf` on the pieces of `parts` (`n` equations), halved by `split` down to
-/// [`LEAF`] equations, and combines their results left to right in the fixed tree
-/// of the halving.
-pub(crate) fn in_halves<S, R, Sp, L, C>(parts: S, n: usize, split: &Sp, leaf: &L, combine: &C) -> R
-where
-    S: Send,
-    R: Send,
-    Sp: Fn(S, usize) -> (S, S) + Sync,
-    L: Fn(S) -> R + Sync,
-    C: Fn(R, R) -> R + Sync,
-{
-    if n <= LEAF {
-        return leaf(parts);
-    }
-    let mid = n / 2;
-    let (a, b) = split(parts, mid);
-    let (ra, rb) = rayon::join(
-        || in_halves(a, mid, split, leaf, combine),
-        || in_halves(b, n - mid, split, leaf, combine),
-    );
-    combine(ra, rb)
-}
+use crate::halves::{in_halves, VECTOR_LEAF as LEAF};
 
 /// Writes `value(d)` for every free dof `d = free[eq]` into `out[eq]` (sized to
 /// `free` first) and folds `(d, value)` into a result per piece with `fold` from
@@ -70,7 +41,14 @@ where
         }
         acc
     };
-    in_halves((free, &mut out[..]), free.len(), &split, &leaf, &combine)
+    in_halves(
+        (free, &mut out[..]),
+        free.len(),
+        LEAF,
+        &split,
+        &leaf,
+        &combine,
+    )
 }
 
 /// Adds `delta[eq]` to `u` (and to `du` when given) at the free dof `free[eq]`
@@ -131,6 +109,7 @@ pub(crate) fn add_on_free(
     in_halves(
         (&free[..n], &delta[..n], u, du, 0),
         n,
+        LEAF,
         &split,
         &leaf,
         &|a: f64, b: f64| a + b,
