@@ -259,6 +259,13 @@ impl SymmetricSolver for FaerCholesky {
         })
     }
 
+    fn factor_lower_entries(&self) -> Option<usize> {
+        match &self.own {
+            Some(own) => Some(own.lower_entries()),
+            None => self.factor_nnz(),
+        }
+    }
+
     fn factor_nnz(&self) -> Option<usize> {
         let sym = self.symbolic.as_ref()?;
         Some(match sym.raw() {
@@ -320,6 +327,22 @@ mod tests {
             row_idx,
             values,
         }
+    }
+
+    #[test]
+    fn a_dense_factor_counts_its_lower_triangle_without_the_padding() {
+        // Dense: L has n (n + 1) / 2 nonzeros whatever the supernodes; faer also
+        // stores the upper triangles of their diagonal blocks.
+        let n = 120;
+        let a = dense_with_bad_diagonal(n, n); // no bad pivot: `bad` out of range
+        let mut f = FaerCholesky::new();
+        f.analyze(&a).unwrap();
+        assert!(matches!(
+            f.symbolic.as_ref().unwrap().raw(),
+            SymbolicCholeskyRaw::Supernodal(_)
+        ));
+        assert_eq!(f.factor_lower_entries(), Some(n * (n + 1) / 2));
+        assert!(f.factor_nnz().unwrap() > n * (n + 1) / 2);
     }
 
     #[test]

@@ -144,6 +144,11 @@ pub trait SymmetricSolver: Send {
     fn solve_block_in_place(&mut self, rhs: &mut [f64], ncols: usize) -> Result<()>;
     /// Number of nonzeros of the factor `L`, once analysed.
     fn factor_nnz(&self) -> Option<usize>;
+    /// Entries of `L` on and below the diagonal (without a storage's padding above
+    /// it), once analysed; [`Self::factor_nnz`] where the two are the same.
+    fn factor_lower_entries(&self) -> Option<usize> {
+        self.factor_nnz()
+    }
     /// Proposes an elimination order (`order[k]` eliminated `k`-th) for the next
     /// [`SymmetricSolver::analyze`].
     fn set_ordering(&mut self, order: Vec<usize>);

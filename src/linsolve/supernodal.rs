@@ -595,6 +595,15 @@ impl SupernodalSolver {
     pub fn supernodes(&self) -> usize {
         self.nodes.len()
     }
+
+    /// Entries of the factor on and below the diagonal: the stored blocks less the
+    /// unused upper triangles of their diagonal blocks (`n_s (n_s − 1) / 2` each).
+    pub fn lower_entries(&self) -> usize {
+        self.nodes
+            .iter()
+            .map(|sn| sn.ncols * (sn.ncols + 1) / 2 + sn.ncols * sn.npattern)
+            .sum()
+    }
 }
 
 /// How a kernel multiplies and adds: plainly (`a·b + c`, two roundings) or fused

@@ -217,6 +217,12 @@ impl EffectiveSystem {
         self.solver.factor_nnz()
     }
 
+    /// Entries of the factor on and below the diagonal (faer's supernodes also store
+    /// the upper triangles of their diagonal blocks, which [`Self::factor_nnz`] counts).
+    pub fn factor_lower_entries(&self) -> Option<usize> {
+        self.solver.factor_lower_entries()
+    }
+
     /// Numeric factorisations so far.
     pub fn factorizations(&self) -> usize {
         self.factorizations

@@ -60,6 +60,11 @@ impl<'m> BackwardEuler<'m> {
         self.core.sys.factor_nnz()
     }
 
+    /// Entries of the Cholesky factor on and below the diagonal.
+    pub fn factor_lower_entries(&self) -> Option<usize> {
+        self.core.sys.factor_lower_entries()
+    }
+
     /// Numeric factorisations so far.
     pub fn factorizations(&self) -> usize {
         self.core.sys.factorizations()
