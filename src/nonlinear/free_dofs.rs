@@ -86,22 +86,14 @@ pub(crate) fn add_on_free(
         };
         ((f0, c0, u0, du0, base), (f1, c1, u1, du1, base + cut))
     }
-    let leaf = |(f, c, u, du, base): Piece| {
+    let leaf = |(f, c, u, mut du, base): Piece| {
         let mut c2 = 0.0;
-        match du {
-            Some(du) => {
-                for (&d, &x) in f.iter().zip(c) {
-                    u[d - base] += x;
-                    du[d - base] += x;
-                    c2 += x * x;
-                }
+        for (&d, &x) in f.iter().zip(c) {
+            u[d - base] += x;
+            if let Some(du) = du.as_deref_mut() {
+                du[d - base] += x;
             }
-            None => {
-                for (&d, &x) in f.iter().zip(c) {
-                    u[d - base] += x;
-                    c2 += x * x;
-                }
-            }
+            c2 += x * x;
         }
         c2
     };
