@@ -52,6 +52,39 @@ pub struct Report {
     pub available: Option<u64>,
     /// Warnings (huge step counts, huge outputs).
     pub warnings: Vec<String>,
+    /// One entry per material: its lines (model and elastic constants, where an
+    /// identification came from, the parameters).
+    pub materials: Vec<Vec<String>>,
+    /// The nonlocal table, when a material is nonlocal: points, neighbour counts
+    /// (fewest, most, mean) and bytes.
+    pub nonlocal: Option<(usize, usize, usize, f64, u64)>,
+}
+
+/// The lines `check` and `material` print for a material: model, elastic constants,
+/// where identified parameters came from, the parameters.
+pub fn material_lines(m: &crate::material::Material) -> Vec<String> {
+    let kind = m.model_name();
+    let mut lines = vec![format!(
+        "{}: {kind}, E = {} Pa, nu = {}, rho = {}",
+        m.name,
+        crate::material::sig(m.e),
+        m.nu,
+        m.rho
+    )];
+    if let Some(from) = &m.identified_from {
+        lines.push(from.clone());
+    }
+    let params = m.parameters();
+    if !params.is_empty() {
+        lines.push(
+            params
+                .iter()
+                .map(|(k, v)| format!("{k} = {v}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        );
+    }
+    lines
 }
 
 /// Analyses `model` (pattern and symbolic factorisation, no numeric work) and
@@ -129,6 +162,14 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         memory,
         available: memory_limit.or_else(crate::memory::available),
         warnings,
+        materials: model.materials.iter().map(material_lines).collect(),
+        nonlocal: crate::assembly::nonlocal::NonlocalTable::build(mesh, &model.materials).map(
+            |t| {
+                let (lo, hi) = t.neighbour_range();
+                let mean = t.n_entries() as f64 / t.n_points().max(1) as f64;
+                (t.n_points(), lo, hi, mean, t.bytes())
+            },
+        ),
     })
 }
 
@@ -139,6 +180,19 @@ impl fmt::Display for Report {
             writeln!(
                 f,
                 "  {name:<12} {els} elements, thickness {t} m, velocity {v:?} m/s"
+            )?;
+        }
+        writeln!(f, "materials   {}", self.materials.len())?;
+        for lines in &self.materials {
+            for (i, l) in lines.iter().enumerate() {
+                writeln!(f, "  {}{l}", if i == 0 { "" } else { "  " })?;
+            }
+        }
+        if let Some((points, lo, hi, mean, bytes)) = self.nonlocal {
+            writeln!(
+                f,
+                "nonlocal    {points} points, {lo} to {hi} neighbours each (mean {mean:.1}), table {}",
+                human(bytes)
             )?;
         }
         writeln!(f, "nodes       {}", self.nodes)?;

@@ -71,8 +71,12 @@ enum Command {
         #[arg(long, default_value = "examples/benchmarks")]
         benchmarks: PathBuf,
         /// Benchmark 1's mesh sizes (m).
-        #[arg(long, value_delimiter = ',', default_value = "0.2,0.15,0.1,0.05")]
+        #[arg(long, value_delimiter = ',', default_value = "0.2,0.15,0.1,0.05,0.025")]
         meshes: Vec<f64>,
+        /// Benchmark 1's extra mesh sizes of the Mazars models, nonlocal and local (m;
+        /// the flag without a value for none).
+        #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "0.0125")]
+        damage_meshes: Vec<f64>,
         /// Benchmark 1's mesh of the implicit-against-explicit comparison (m).
         #[arg(long, default_value_t = 0.1)]
         compare_mesh: f64,
@@ -308,7 +312,8 @@ fn main() -> ExitCode {
         Command::Run { out, .. } => Some(out.clone()),
         _ => None,
     };
-    let result = std::panic::catch_unwind(|| match cli.command {
+    let result = std::panic::catch_unwind(|| {
+        match cli.command {
         Command::Run {
             scenario,
             out,
@@ -329,12 +334,27 @@ fn main() -> ExitCode {
         Command::Report {
             benchmarks,
             meshes,
+            damage_meshes,
             compare_mesh,
             beam_size,
             sets,
             sweep,
-        } => report_command(benchmarks, meshes, compare_mesh, beam_size, &sets, sweep),
-        Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out)
+        } => report_command(
+            benchmarks,
+            (meshes, damage_meshes),
+            compare_mesh,
+            beam_size,
+            &sets,
+            sweep,
+        ),
+        Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out, |m| {
+            for l in rothe::check::material_lines(m) {
+                eprintln!("{l}");
+            }
+            if m.nonlocal_radius().is_some() {
+                eprintln!("(a single point is a uniform field: its nonlocal average is its own strain)");
+            }
+        })
             .map(|steps| {
                 eprintln!(
                     "{steps} steps; wrote {}",
@@ -354,6 +374,7 @@ fn main() -> ExitCode {
                 Ok(())
             })
         }
+    }
     });
     let result = result.unwrap_or_else(|p| {
         let e = rothe::Error::Internal(format!(
@@ -406,7 +427,7 @@ fn study_command(study: StudyCommand) -> rothe::Result<()> {
 
 fn report_command(
     benchmarks: PathBuf,
-    meshes: Vec<f64>,
+    (meshes, damage_meshes): (Vec<f64>, Vec<f64>),
     compare_mesh: f64,
     beam_size: Option<f64>,
     sets: &[String],
@@ -419,6 +440,7 @@ fn report_command(
     let opts = rothe::study::report::ReportOptions {
         benchmarks,
         meshes,
+        damage_meshes,
         compare_mesh,
         beam_size,
         base,

@@ -19,7 +19,9 @@ use crate::material::store::StateStore;
 use crate::model::{AnalysisKind, Model, TimeScheme};
 use crate::output::checks::Checks;
 use crate::output::recorder::{Recorder, Snapshot};
-use crate::output::summary::{EnergySummary, SolverSummary, Summary, TimingSummary};
+use crate::output::summary::{
+    EnergySummary, MaterialSummary, SolverSummary, Summary, TimingSummary,
+};
 use crate::time::backward_euler::BackwardEuler;
 use crate::time::central_difference::CentralDifference;
 use crate::time::march::{march, Marched, StepControl};
@@ -120,6 +122,11 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         steps: 0,
         t_end: 0.0,
         dt: a.dt,
+        materials: model
+            .materials
+            .iter()
+            .map(|m| (m.name.clone(), MaterialSummary::of(m)))
+            .collect(),
         probes: Default::default(),
         contact: Default::default(),
         energy: EnergySummary::from(&Ledger::default()),

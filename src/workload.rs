@@ -15,6 +15,10 @@ pub const W1_SLS: &str = "model = \"sls\"\nalpha = 0.5\nbeta = 1.0e-4";
 pub const W1_MAZARS: &str =
     "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
 
+/// The W1 Mazars block with nonlocal averaging over `R = 0.03 m` (three cells of
+/// W1 at `ny = 50`).
+pub const W1_MAZARS_NONLOCAL: &str = "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3\nnonlocal = { radius = 0.03 }";
+
 /// The W1 material block with Rankine-Hill plasticity (bilinear C30/37 diagram).
 pub const W1_RANKINE_HILL: &str = "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.5e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.5e9 }";
 
@@ -26,12 +30,13 @@ pub fn w1_variant(ny: usize, name: &str) -> Result<Model> {
         "sls" => (W1_SLS, "newton"),
         "mazars" => (W1_MAZARS, "newton"),
         "mazars-fixed" => (W1_MAZARS, "fixed"),
+        "mazars-nonlocal" => (W1_MAZARS_NONLOCAL, "newton"),
         "rankine-hill" => (W1_RANKINE_HILL, "newton"),
         other => {
             return Err(crate::error::Error::config(
                 "variant",
                 format!(
-                "unknown W1 variant `{other}` (elastic, sls, mazars, mazars-fixed, rankine-hill)"
+                "unknown W1 variant `{other}` (elastic, sls, mazars, mazars-fixed, mazars-nonlocal, rankine-hill)"
             ),
             ))
         }

@@ -3,8 +3,10 @@
 //! ledger closes, the paper's energy checks hold, and the orderings the physics
 //! demands: the elastic model dissipates only the scheme's loss and the contact loss,
 //! every inelastic model dissipates on its own line and more than the elastic one,
-//! plasticity more than damage (the paper's Rankine-Hill over Mazars), and the beam
-//! of benchmark 2 lifts off its unilateral supports after the punch hits it.
+//! plasticity more than damage on a diagram that does not soften (the paper's
+//! Rankine-Hill over its bilinearised Mazars), the concrete's own softening law
+//! failing where the bilinearised one holds, and the beam of benchmark 2 lifting
+//! off its unilateral supports after the punch hits it.
 
 use std::path::{Path, PathBuf};
 
@@ -51,12 +53,18 @@ fn assert_ledger_and_checks(s: &Summary, what: &str) {
 #[test]
 fn benchmark_1_orders_the_models_as_the_physics_demands() {
     let dir = tempfile::tempdir().unwrap();
-    // 0.1 m: on the coarsest mesh (0.2 m) the local Mazars law spreads its damage
-    // over elements so large that it dissipates more than plasticity (the ordering
-    // turns at 0.15 m; the report's table, theory/benchmarks.md).
+    // 0.1 m. Mazars is the concrete identified from its own data (softening in
+    // tension, nonlocal); mazars_plateau holds its tension at f_ct past the peak (the
+    // paper's bilinearised diagram).
     let coarse = Overrides::none().set("meshing.element_size=0.1").unwrap();
     let mut sums = Vec::new();
-    for m in ["elastic", "kelvin_voigt", "mazars", "rankine_hill"] {
+    for m in [
+        "elastic",
+        "kelvin_voigt",
+        "mazars",
+        "rankine_hill",
+        "mazars_plateau",
+    ] {
         let s = run_variant(
             "two_blocks.toml",
             model(m).then(&coarse),
@@ -86,17 +94,31 @@ fn benchmark_1_orders_the_models_as_the_physics_demands() {
     assert!(d(1).viscous > 0.01 * k0 && d(1).damage == 0.0 && d(1).plastic == 0.0);
     assert!(d(2).damage > 0.01 * k0 && d(2).viscous == 0.0 && d(2).plastic == 0.0);
     assert!(d(3).plastic > 0.01 * k0 && d(3).viscous == 0.0 && d(3).damage == 0.0);
+    assert!(d(4).damage > 0.01 * k0 && d(4).viscous == 0.0 && d(4).plastic == 0.0);
     for (i, (m, _)) in sums.iter().enumerate().skip(1) {
         assert!(d(i).total() > e.total(), "{m}");
     }
-    // Plasticity dissipates more than damage (the paper: Rankine-Hill about 53 %
-    // above Mazars).
+    // On diagrams that do not soften, plasticity dissipates more than damage: a
+    // plastic point unloads parallel to its elastic line and keeps the area between,
+    // a damaged one unloads to the origin (the paper's Figure 14: Rankine-Hill about
+    // 53 % above its bilinearised Mazars).
     assert!(
-        d(3).plastic > d(2).damage,
+        d(3).plastic > d(4).damage,
         "{} vs {}",
         d(3).plastic,
-        d(2).damage
+        d(4).damage
     );
+    // The concrete's own law softens to a tail of 0.1 f_ct: the impact's reflected
+    // tension (4-9 f_ct throughout the block in the elastic run) breaks it, and it
+    // takes more of the impact, and deflects more, than the law that holds f_ct.
+    assert!(
+        d(2).damage > d(4).damage,
+        "{} vs {}",
+        d(2).damage,
+        d(4).damage
+    );
+    let peak = |i: usize| -sums[i].1.probes["probe"].min_uy;
+    assert!(peak(2) > peak(4), "{} vs {}", peak(2), peak(4));
 }
 
 #[test]

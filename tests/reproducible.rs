@@ -42,8 +42,14 @@ fn bits(v: &[f64]) -> Vec<u64> {
 #[test]
 fn ledgers_and_fields_repeat_to_the_last_bit_on_any_pool() {
     // ny = 50: 40k dofs, five leaves of the vector passes; the variants cover the
-    // elastic pass, the nodal-field SLS pass and the Gauss-point pass.
-    for (variant, steps) in [("elastic", 20), ("sls", 20), ("rankine-hill", 4)] {
+    // elastic pass, the nodal-field SLS pass, the Gauss-point pass and the nonlocal
+    // averaging (40k points, about 110 neighbours each).
+    for (variant, steps) in [
+        ("elastic", 20),
+        ("sls", 20),
+        ("rankine-hill", 4),
+        ("mazars-nonlocal", 4),
+    ] {
         let two = fingerprint(50, variant, steps, 2);
         for (threads, what) in [(2, "again"), (3, "on 3 threads")] {
             assert!(

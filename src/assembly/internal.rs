@@ -5,6 +5,7 @@
 //! nothing is allocated per pass (element buffers live on the stack, trial states in
 //! the stores).
 
+use super::nonlocal::DRIVERS;
 use super::{Assembler, SharedValues};
 use crate::energy::Dissipation;
 use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind, Plane};
@@ -112,6 +113,9 @@ struct Ctx<'a> {
     at_rest: bool,
     /// The material's elasticity matrix in this plane idealisation.
     c: [[f64; 3]; 3],
+    /// The averaged drivers of the block's points (`nonlocal::DRIVERS` per point)
+    /// when its material is nonlocal.
+    drivers: Option<&'a [f64]>,
 }
 
 impl<'a> Ctx<'a> {
@@ -125,6 +129,7 @@ impl<'a> Ctx<'a> {
         at_rest: bool,
     ) -> Self {
         Ctx {
+            drivers: None,
             mesh,
             mat,
             plane,
@@ -135,6 +140,12 @@ impl<'a> Ctx<'a> {
             at_rest,
             c: mat.c(plane),
         }
+    }
+
+    /// The same context reading the averaged drivers `d` of a nonlocal block.
+    fn with_drivers(mut self, d: Option<&'a [f64]>) -> Self {
+        self.drivers = d;
+        self
     }
 }
 
@@ -161,14 +172,7 @@ fn element_points<F>(
 ) where
     F: FnMut(f64, &PointResponse, Option<&crate::fe::PointKinematics>, &[[f64; 2]], [f64; 3]),
 {
-    let nn = nodes.len();
-    let mut x = [[0.0; 2]; 4];
-    let mut ue = [0.0; 8];
-    for (a, &n) in nodes.iter().enumerate() {
-        x[a] = cx.mesh.coords[n];
-        ue[2 * a] = u[2 * n];
-        ue[2 * a + 1] = u[2 * n + 1];
-    }
+    let (x, ue, nn) = gather(cx.mesh, nodes, u);
     if cx.kind == ElementKind::Bar2 {
         let g = e;
         let eps = element::bar_strain(&x[..2], &ue[..4]);
@@ -225,13 +229,16 @@ fn element_points<F>(
             length,
         };
         let history_n = committed.history(g);
+        let averaged = cx.drivers.map(|d| [d[DRIVERS * g], d[DRIVERS * g + 1]]);
         let mut pred = [0.0; 3];
         let resp = match trial {
             Some(t) => {
                 // SAFETY: point g belongs to element e only; the slots are disjoint
                 // parts of the trial buffer (see `Layout`).
                 let hist = unsafe { t.base.slice(t.layout.history() + g * ns, ns) };
-                let r = cx.mat.update_with(&cx.c, cx.plane, &step, history_n, hist);
+                let r = cx
+                    .mat
+                    .update_driven(&cx.c, cx.plane, &step, averaged, history_n, hist);
                 unsafe {
                     write3(t.base.slice(t.layout.eps() + 3 * g, 3), &eps);
                     write3(t.base.slice(t.layout.sigma() + 3 * g, 3), &r.sigma);
@@ -245,12 +252,30 @@ fn element_points<F>(
                 }
                 r
             }
-            None => cx
-                .mat
-                .update_with(&cx.c, cx.plane, &step, history_n, &mut scratch[..ns]),
+            None => cx.mat.update_driven(
+                &cx.c,
+                cx.plane,
+                &step,
+                averaged,
+                history_n,
+                &mut scratch[..ns],
+            ),
         };
         point(wq * k.det_j * cx.section, &resp, Some(&k), &x[..nn], pred);
     }
+}
+
+/// The coordinates and displacements of an element's nodes, and their number.
+#[inline(always)]
+pub(crate) fn gather(mesh: &Mesh, nodes: &[usize], u: &[f64]) -> ([[f64; 2]; 4], [f64; 8], usize) {
+    let mut x = [[0.0; 2]; 4];
+    let mut ue = [0.0; 8];
+    for (a, &n) in nodes.iter().enumerate() {
+        x[a] = mesh.coords[n];
+        ue[2 * a] = u[2 * n];
+        ue[2 * a + 1] = u[2 * n + 1];
+    }
+    (x, ue, nodes.len())
 }
 
 /// Writes a Voigt triple (element by element: no call to `memcpy` on the hot path).
@@ -339,6 +364,8 @@ impl Assembler {
         mut tangent: Option<&mut [f64]>,
     ) -> PointTotals {
         let u = pass.u;
+        // Nonlocal materials: their drivers averaged at `u` first (one more pass).
+        let nonlocal = self.nonlocal_at(mesh, materials, plane, u, stores);
         f.fill(0.0);
         let kp = tangent.as_mut().map(|k| {
             k.fill(0.0);
@@ -366,7 +393,8 @@ impl Assembler {
                 pass.dt,
                 predict,
                 pass.at_rest,
-            );
+            )
+            .with_drivers(nonlocal.as_ref().and_then(|n| n.block(mesh, bi)));
             let ng = points_per_element(block.elements.kind);
             for colour in &self.colours[bi] {
                 // In halves of a fixed tree (`crate::halves`): the same totals in
@@ -450,6 +478,7 @@ impl Assembler {
         dt: f64,
         stores: &[StateStore],
     ) -> Vec<f64> {
+        let nonlocal = self.nonlocal_at(mesh, materials, plane, u, stores);
         self.assemble(mesh, |bi, e, _x, ke| {
             let block = &mesh.blocks[bi];
             let cx = Ctx::new(
@@ -460,7 +489,8 @@ impl Assembler {
                 dt,
                 false,
                 false,
-            );
+            )
+            .with_drivers(nonlocal.as_ref().and_then(|n| n.block(mesh, bi)));
             let nodes = block.elements.element(e);
             let nd = 2 * nodes.len();
             ke[..nd * nd].fill(0.0);

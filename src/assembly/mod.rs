@@ -6,6 +6,7 @@
 
 pub mod internal;
 pub mod loads;
+pub mod nonlocal;
 pub mod pattern;
 
 use rayon::prelude::*;
@@ -124,12 +125,16 @@ impl Mass {
     }
 }
 
-/// Pattern plus element colours per block: built once per mesh.
+/// Pattern plus element colours per block: built once per mesh. The neighbour table
+/// of nonlocal materials is built at the first Gauss-point pass that needs it and
+/// kept with the buffers of its passes.
 pub struct Assembler {
     /// The shared sparsity pattern.
     pub pattern: Pattern,
     /// Element colours of every block.
     pub colours: Vec<Vec<Vec<usize>>>,
+    /// The nonlocal table and its pass buffers (`None` until needed).
+    nonlocal: std::sync::Mutex<Option<nonlocal::Nonlocal>>,
 }
 
 #[derive(Clone, Copy)]
@@ -150,7 +155,44 @@ impl Assembler {
                 pattern::colour_elements(&b.elements.conn, b.elements.kind.nodes(), mesh.n_nodes())
             })
             .collect();
-        Assembler { pattern, colours }
+        Assembler {
+            pattern,
+            colours,
+            nonlocal: std::sync::Mutex::new(None),
+        }
+    }
+
+    /// The nonlocal table of `materials` on `mesh`, built (or rebuilt, should the
+    /// materials have changed) when missing, with the drivers averaged at `u` from
+    /// the committed states `stores` ([`nonlocal::Nonlocal::evaluate`]); `None`
+    /// inside when no material is nonlocal. The guard holds the buffers for the
+    /// pass that reads them.
+    pub fn nonlocal_at(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        u: &[f64],
+        stores: &[crate::material::store::StateStore],
+    ) -> std::sync::MutexGuard<'_, Option<nonlocal::Nonlocal>> {
+        let mut guard = self
+            .nonlocal
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if !materials.iter().any(|m| m.nonlocal_radius().is_some()) {
+            *guard = None;
+            return guard;
+        }
+        if !guard
+            .as_ref()
+            .is_some_and(|n| n.table.fits(mesh, materials))
+        {
+            *guard = nonlocal::Nonlocal::build(mesh, materials);
+        }
+        if let Some(n) = guard.as_mut() {
+            n.evaluate(mesh, materials, plane, u, stores);
+        }
+        guard
     }
 
     /// Assembles `Σ_e element(block, e, x_e, out)` where `out` is the row-major element

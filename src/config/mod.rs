@@ -311,11 +311,12 @@ pub enum MaterialSpec {
         /// Relaxation time (s).
         beta: f64,
     },
-    /// Mazars damage (eqs. 11-13 of the paper, or the classic 1984 law).
+    /// Mazars damage (eqs. 11-13 of the paper, or the classic 1984 law): raw
+    /// parameters, or `identify` with the concrete's data.
     Mazars {
-        /// Young's modulus (Pa).
-        #[serde(rename = "E")]
-        e: f64,
+        /// Young's modulus (Pa). Optional with `identify.class` (then `E_cm`).
+        #[serde(rename = "E", default)]
+        e: Option<f64>,
         /// Poisson's ratio.
         nu: f64,
         /// Density (kg/m³).
@@ -323,44 +324,62 @@ pub enum MaterialSpec {
         /// `paper` (default) or `classic`.
         #[serde(default)]
         variant: crate::material::MazarsVariant,
+        /// The concrete's data the parameters are identified from (instead of
+        /// `eps_t0`, `eps_c0`, `A_t`, `B_t`, `A_c`, `B_c`).
+        #[serde(default)]
+        identify: Option<IdentifySpec>,
         /// Tensile threshold `ε_t^0` (classic: `κ_0`).
-        eps_t0: f64,
+        #[serde(default)]
+        eps_t0: Option<f64>,
         /// Compressive threshold `ε_c^0` (paper variant; default `eps_t0`).
         #[serde(default)]
         eps_c0: Option<f64>,
         /// `A_t`.
-        #[serde(rename = "A_t")]
-        a_t: f64,
+        #[serde(rename = "A_t", default)]
+        a_t: Option<f64>,
         /// `B_t`.
-        #[serde(rename = "B_t")]
-        b_t: f64,
+        #[serde(rename = "B_t", default)]
+        b_t: Option<f64>,
         /// `A_c`.
-        #[serde(rename = "A_c")]
-        a_c: f64,
+        #[serde(rename = "A_c", default)]
+        a_c: Option<f64>,
         /// `B_c`.
-        #[serde(rename = "B_c")]
-        b_c: f64,
+        #[serde(rename = "B_c", default)]
+        b_c: Option<f64>,
         /// Classic weight exponent `β` (default 1.06, the usual value).
         #[serde(default = "default_mazars_beta")]
         beta: f64,
         /// Damage cap (default 0.99999, as NOTES.md fixes).
         #[serde(default = "default_d_max")]
         d_max: f64,
+        /// Fracture energy `G_f` (N/m): the crack-band variant (the tensile law
+        /// softens to zero, `B_t` per element from `G_f` and the element size).
+        #[serde(default)]
+        fracture_energy: Option<f64>,
+        /// Nonlocal averaging of the equivalent strains (local when absent).
+        #[serde(default)]
+        nonlocal: Option<NonlocalSpec>,
     },
     /// Rankine-Hill plasticity (plane stress): Rankine in tension, von Mises (Hill,
-    /// isotropic) in compression.
+    /// isotropic) in compression. Give `tension` and `compression`, or `identify`.
     RankineHill {
-        /// Young's modulus (Pa).
-        #[serde(rename = "E")]
-        e: f64,
+        /// Young's modulus (Pa). Optional with `identify.class` (then `E_cm`).
+        #[serde(rename = "E", default)]
+        e: Option<f64>,
         /// Poisson's ratio.
         nu: f64,
         /// Density (kg/m³).
         rho: f64,
         /// Tension law.
-        tension: HardeningSpec,
+        #[serde(default)]
+        tension: Option<HardeningSpec>,
         /// Compression law.
-        compression: HardeningSpec,
+        #[serde(default)]
+        compression: Option<HardeningSpec>,
+        /// The concrete's data the laws are identified from: linear tension
+        /// softening by the fracture energy, Eurocode 2 in compression.
+        #[serde(default)]
+        identify: Option<IdentifySpec>,
     },
     /// Kelvin: the SLS without the branch spring, i.e. `σ = C ε + β C ε̇`.
     Kelvin {
@@ -382,6 +401,43 @@ fn default_mazars_beta() -> f64 {
 
 fn default_d_max() -> f64 {
     0.99999
+}
+
+/// `identify = { ... }`: a concrete's data, from which a damage or plasticity
+/// material's parameters are identified (`material::identify`). Give `class`, or
+/// `f_ct`, `f_cm` and `eps_c1`.
+#[derive(Clone, Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct IdentifySpec {
+    /// A Eurocode 2 strength class (`"C30/37"`): `f_cm`, `f_ctm`, `ε_c1`, `ε_cu1`
+    /// and (when `E` is not given) `E_cm` from EN 1992-1-1 Table 3.1.
+    #[serde(default)]
+    pub class: Option<String>,
+    /// Tensile strength (Pa).
+    #[serde(default)]
+    pub f_ct: Option<f64>,
+    /// Mean compressive strength (Pa).
+    #[serde(default)]
+    pub f_cm: Option<f64>,
+    /// Strain at the compressive peak.
+    #[serde(default)]
+    pub eps_c1: Option<f64>,
+    /// Ultimate compressive strain (Rankine-Hill; default EC2's for `f_cm`).
+    #[serde(default)]
+    pub eps_cu1: Option<f64>,
+    /// Fracture energy (N/m; Rankine-Hill; default fib Model Code 2010's
+    /// `73 f_cm^0.18`).
+    #[serde(default)]
+    pub fracture_energy: Option<f64>,
+}
+
+/// `nonlocal = { radius = R }`: nonlocal averaging of a damage model's equivalent
+/// strains over the Gauss points of its body within `R`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NonlocalSpec {
+    /// Interaction radius (m).
+    pub radius: f64,
 }
 
 /// A strength law of one yield surface.

@@ -33,11 +33,16 @@ use std::ptr;
 use suitesparse_sys::{
     cholmod_common, cholmod_dense, cholmod_factor, cholmod_l_analyze, cholmod_l_analyze_p,
     cholmod_l_factorize, cholmod_l_finish, cholmod_l_free_dense, cholmod_l_free_factor,
-    cholmod_l_solve2, cholmod_l_start, cholmod_sparse, CHOLMOD_A, CHOLMOD_AMD, CHOLMOD_DOUBLE,
-    CHOLMOD_GIVEN, CHOLMOD_LONG, CHOLMOD_NOT_POSDEF, CHOLMOD_OK, CHOLMOD_REAL, CHOLMOD_SUPERNODAL,
+    cholmod_l_rcond, cholmod_l_solve2, cholmod_l_start, cholmod_sparse, CHOLMOD_A, CHOLMOD_AMD,
+    CHOLMOD_DOUBLE, CHOLMOD_GIVEN, CHOLMOD_LONG, CHOLMOD_NOT_POSDEF, CHOLMOD_OK, CHOLMOD_REAL,
+    CHOLMOD_SUPERNODAL,
 };
 
 use super::{check_block, not_analysed, LowerCsc, SymmetricSolver};
+
+/// Pivot ratio per unknown below which a factor is taken as singular (`n ε` in all:
+/// the round-off pivots of a singular matrix lie near `ε` of the largest).
+const SINGULAR_RCOND: f64 = f64::EPSILON;
 use crate::error::{Error, Result};
 
 const NAME: &str = "cholmod";
@@ -417,6 +422,23 @@ impl SymmetricSolver for CholmodCholesky {
                 column: col.map(|c| c as usize),
                 message: format!(
                     "numeric factorisation failed {at}: the matrix is not positive definite"
+                ),
+            });
+        }
+        // A singular matrix can factorise with round-off pivots of either sign (which
+        // one depends on the BLAS kernels of the machine): a pivot below `n ε` of
+        // the largest (CHOLMOD's diagonal-ratio estimate of the reciprocal condition
+        // number) is treated as the zero it stands for.
+        // SAFETY: `self.factor` holds the numeric factorisation just computed with
+        // `self.common`.
+        let rcond = unsafe { cholmod_l_rcond(self.factor, &mut *self.common) };
+        if !(rcond > SINGULAR_RCOND * n.max(1) as f64) {
+            return Err(Error::NotPositiveDefinite {
+                backend: NAME,
+                column: None,
+                message: format!(
+                    "numeric factorisation: the matrix is singular to working precision \
+                     (smallest over largest pivot {rcond:.1e})"
                 ),
             });
         }

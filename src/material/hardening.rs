@@ -44,6 +44,38 @@ fn ec2_curve(f_cm: f64, eps_c1: f64, k: f64, eps: f64) -> (f64, f64) {
 }
 
 impl Hardening {
+    /// The law and its parameters in the scenario's words, for `check` and `material`.
+    pub fn describe(&self) -> String {
+        match *self {
+            Hardening::Bilinear {
+                strength,
+                post_yield_modulus,
+            } => format!(
+                "bilinear, strength = {}, post_yield_modulus = {}",
+                super::sig(strength),
+                super::sig(post_yield_modulus)
+            ),
+            Hardening::Ec2 {
+                f_cm,
+                eps_c1,
+                eps_cu1,
+            } => format!(
+                "ec2, f_cm = {}, eps_c1 = {}, eps_cu1 = {}",
+                super::sig(f_cm),
+                super::sig(eps_c1),
+                super::sig(eps_cu1)
+            ),
+            Hardening::LinearSoftening {
+                strength,
+                fracture_energy,
+            } => format!(
+                "linear_softening, strength = {}, fracture_energy = {}",
+                super::sig(strength),
+                super::sig(fracture_energy)
+            ),
+        }
+    }
+
     /// Initial yield stress.
     pub fn initial(&self, e: f64) -> f64 {
         self.strength(0.0, e, 1.0).0

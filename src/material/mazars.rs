@@ -15,6 +15,13 @@
 //! in plane stress, 0 in plane strain. The update returns the secant `(1 − D) C` as
 //! its tangent: the paper's fixed-point linearisation. Damage dissipation is
 //! `ΔW_d = ½(Yⁿ + Yⁿ⁺¹) ΔD`, `Y = ½ ε:C:ε`.
+//!
+//! The equivalent strains that drive the damage ([`drivers`]) are the point's own
+//! (local), or their nonlocal average over the neighbouring Gauss points
+//! ([`Regularisation::Nonlocal`], averaged by `assembly::nonlocal` and handed to
+//! [`update`]); [`Regularisation::CrackBand`] instead scales the tensile softening
+//! with the element size so that a band dissipates the fracture energy
+//! (`theory/damage.md`).
 
 use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 use crate::fe::Plane;
@@ -28,6 +35,40 @@ pub enum MazarsVariant {
     Paper,
     /// Mazars (1984), as other FE codes ship it.
     Classic,
+}
+
+/// How a Mazars law is kept from depending on the mesh past its peak.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum Regularisation {
+    /// None: the law of each point on its own strain (softening localises in one
+    /// element; results past the peak depend on the mesh).
+    #[default]
+    Local,
+    /// Crack band: the tensile law softens exponentially to zero (`A_t = 1`) with
+    /// `B_t` set per element so that a band one element wide dissipates
+    /// `fracture_energy` (N/m) per unit crack area.
+    CrackBand {
+        /// Fracture energy `G_f` (N/m).
+        fracture_energy: f64,
+    },
+    /// Nonlocal integral averaging (Pijaudier-Cabot and Bažant): the equivalent
+    /// strains are averaged over the Gauss points of the same body within `radius`
+    /// with the bell weight `(1 − r²/R²)²`, normalised per point.
+    Nonlocal {
+        /// Interaction radius `R` (m).
+        radius: f64,
+    },
+}
+
+impl Regularisation {
+    /// The name written to `summary.json` and printed by `check`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Regularisation::Local => "local",
+            Regularisation::CrackBand { .. } => "crack_band",
+            Regularisation::Nonlocal { .. } => "nonlocal",
+        }
+    }
 }
 
 /// Mazars parameters.
@@ -51,6 +92,33 @@ pub struct MazarsParams {
     pub beta: f64,
     /// Cap `D_max < 1`.
     pub d_max: f64,
+    /// Local, crack band or nonlocal.
+    pub regularisation: Regularisation,
+}
+
+impl MazarsParams {
+    /// `(A_t, B_t)` of a point in an element of size `h`: the parameters as given,
+    /// or for the crack band `A_t = 1` and the `B_t` of [`crack_band_b`].
+    #[inline]
+    pub fn tension_law(&self, e: f64, h: f64) -> (f64, f64) {
+        match self.regularisation {
+            Regularisation::CrackBand { fracture_energy } => {
+                (1.0, crack_band_b(e, self.eps_t0, fracture_energy, h))
+            }
+            _ => (self.a_t, self.b_t),
+        }
+    }
+}
+
+/// `B_t` of the exponential tension law `σ = E ε e^{−B(ε − ε₀)}` (`A_t = 1`) whose
+/// energy per unit volume to full damage, `E(ε₀²/2 + ε₀/B + 1/B²)`, is `G_f/h`:
+/// `1/B = (−ε₀ + √(4 G_f/(E h) − ε₀²))/2`. Finite while `h < 2 G_f E/f_t²`
+/// (`f_t = E ε₀`), the crack-band limit `validate` checks.
+#[inline]
+pub fn crack_band_b(e: f64, eps0: f64, fracture_energy: f64, h: f64) -> f64 {
+    let g = fracture_energy / (e * h);
+    let x = 0.5 * (-eps0 + (4.0 * g - eps0 * eps0).max(0.0).sqrt());
+    1.0 / x
 }
 
 /// The damage law `1 − (1−A) κ_0/κ − A exp(−B(κ − κ_0))` above the threshold.
@@ -84,26 +152,56 @@ fn principal_stress3(c: &[[f64; 3]; 3], eps: &[f64; 3], nu: f64, plane: Plane) -
     [s1, s2, szz]
 }
 
-/// Damage at strain `eps` given the history `(k1, k2)`: returns `(D_candidate, k1', k2')`.
+/// The equivalent strains that drive the damage at strain `eps`, the quantities a
+/// nonlocal material averages: `[ε_t, ε_c]` of eq. (11) (paper) or `[ε̃, 0]`,
+/// `ε̃ = √Σ⟨ε_i⟩₊²` (classic).
+#[inline]
+pub fn drivers(p: &MazarsParams, nu: f64, plane: Plane, eps: &[f64; 3]) -> [f64; 2] {
+    drivers_of(p, nu, &principal3(eps, nu, plane))
+}
+
+/// [`drivers`] from the three principal strains `e`.
+#[inline]
+fn drivers_of(p: &MazarsParams, nu: f64, e: &[f64; 3]) -> [f64; 2] {
+    match p.variant {
+        MazarsVariant::Paper => {
+            let i1 = e[0] + e[1] + e[2];
+            let j = 0.5 * ((e[0] - e[1]).powi(2) + (e[1] - e[2]).powi(2) + (e[2] - e[0]).powi(2));
+            let sj = j.max(0.0).sqrt();
+            [
+                i1 / (2.0 * (1.0 - 2.0 * nu)) + sj / (2.0 * (1.0 + nu)),
+                i1 / (5.0 * (1.0 - 2.0 * nu)) + 6.0 * sj / (5.0 * (1.0 + nu)),
+            ]
+        }
+        MazarsVariant::Classic => [
+            e.iter().map(|x| x.max(0.0).powi(2)).sum::<f64>().sqrt(),
+            0.0,
+        ],
+    }
+}
+
+/// Damage at strain `eps` (principal strains `e`) driven by the equivalent strains
+/// `drv` (the point's own or their nonlocal average), given the history `(k1, k2)`
+/// and the tension law `(a_t, b_t)`: returns `(D_candidate, k1', k2')`. The mixing
+/// by the triaxiality `r` (paper) and the weights `α_t, α_c` (classic) are the
+/// point's own.
+#[allow(clippy::too_many_arguments)]
 fn damage(
     p: &MazarsParams,
     c: &[[f64; 3]; 3],
     nu: f64,
     plane: Plane,
     eps: &[f64; 3],
+    e: &[f64; 3],
+    drv: [f64; 2],
+    (a_t, b_t): (f64, f64),
     k1: f64,
     k2: f64,
 ) -> (f64, f64, f64) {
-    let e = principal3(eps, nu, plane);
     match p.variant {
         MazarsVariant::Paper => {
-            let i1 = e[0] + e[1] + e[2];
-            let j = 0.5 * ((e[0] - e[1]).powi(2) + (e[1] - e[2]).powi(2) + (e[2] - e[0]).powi(2));
-            let sj = j.max(0.0).sqrt();
-            let et = i1 / (2.0 * (1.0 - 2.0 * nu)) + sj / (2.0 * (1.0 + nu));
-            let ec = i1 / (5.0 * (1.0 - 2.0 * nu)) + 6.0 * sj / (5.0 * (1.0 + nu));
-            let kt = k1.max(et).max(p.eps_t0);
-            let kc = k2.max(ec).max(p.eps_c0);
+            let kt = k1.max(drv[0]).max(p.eps_t0);
+            let kc = k2.max(drv[1]).max(p.eps_c0);
             let s = principal_stress3(c, eps, nu, plane);
             let den: f64 = s.iter().map(|x| x.abs()).sum();
             let r = if den > 0.0 {
@@ -113,14 +211,14 @@ fn damage(
             };
             let es = r * kt + (1.0 - r) * kc;
             let es0 = r * p.eps_t0 + (1.0 - r) * p.eps_c0;
-            let a = r * p.a_t + (1.0 - r) * p.a_c;
-            let b = r * p.b_t + (1.0 - r) * p.b_c;
+            let a = r * a_t + (1.0 - r) * p.a_c;
+            let b = r * b_t + (1.0 - r) * p.b_c;
             (damage_law(es, es0, a, b), kt, kc)
         }
         MazarsVariant::Classic => {
             let et2: f64 = e.iter().map(|x| x.max(0.0).powi(2)).sum();
-            let kappa = k1.max(et2.sqrt()).max(p.eps_t0);
-            let dt = damage_law(kappa, p.eps_t0, p.a_t, p.b_t);
+            let kappa = k1.max(drv[0]).max(p.eps_t0);
+            let dt = damage_law(kappa, p.eps_t0, a_t, b_t);
             let dc = damage_law(kappa, p.eps_t0, p.a_c, p.b_c);
             // Weights from the strains of the positive / negative effective stresses.
             let s = principal_stress3(c, eps, nu, plane);
@@ -146,8 +244,8 @@ fn damage(
     }
 }
 
-/// Young's modulus back from the plane `C` (for the classic split).
-fn e_modulus(c: &[[f64; 3]; 3], nu: f64, plane: Plane) -> f64 {
+/// Young's modulus back from the plane `C` (for the classic split and the crack band).
+pub fn e_modulus(c: &[[f64; 3]; 3], nu: f64, plane: Plane) -> f64 {
     match plane {
         Plane::Stress => c[0][0] * (1.0 - nu * nu),
         Plane::Strain => c[0][0] * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu),
@@ -155,17 +253,24 @@ fn e_modulus(c: &[[f64; 3]; 3], nu: f64, plane: Plane) -> f64 {
 }
 
 /// Mazars update. State: `[k1, k2, D]` (paper: `ε_t*, ε_c*`; classic: `κ, 0`).
+/// `averaged` holds the nonlocal average of the [`drivers`] at this point (`None`:
+/// the point's own).
+#[allow(clippy::too_many_arguments)]
 pub fn update(
     p: &MazarsParams,
     c: &[[f64; 3]; 3],
     nu: f64,
     plane: Plane,
     step: &StrainStep,
+    averaged: Option<[f64; 2]>,
     state_n: &[f64],
     state: &mut [f64],
 ) -> PointResponse {
     let (k1n, k2n, dn) = (state_n[0], state_n[1], state_n[2]);
-    let (dcand, k1, k2) = damage(p, c, nu, plane, &step.eps, k1n, k2n);
+    let e = principal3(&step.eps, nu, plane);
+    let drv = averaged.unwrap_or_else(|| drivers_of(p, nu, &e));
+    let law = p.tension_law(e_modulus(c, nu, plane), step.length);
+    let (dcand, k1, k2) = damage(p, c, nu, plane, &step.eps, &e, drv, law, k1n, k2n);
     let d = dcand.max(dn).clamp(0.0, p.d_max);
     state[0] = k1;
     state[1] = k2;

@@ -10,6 +10,7 @@
 
 pub mod elastic;
 pub mod hardening;
+pub mod identify;
 pub mod linalg;
 pub mod mazars;
 pub mod point_driver;
@@ -19,7 +20,7 @@ pub mod store;
 pub mod viscoelastic;
 
 pub use hardening::Hardening;
-pub use mazars::{MazarsParams, MazarsVariant};
+pub use mazars::{MazarsParams, MazarsVariant, Regularisation};
 pub use rankine_hill::RankineHillParams;
 
 use crate::fe::{elasticity, Plane};
@@ -118,6 +119,9 @@ pub struct Material {
     pub rho: f64,
     /// The constitutive model.
     pub model: Model,
+    /// Where the model's parameters came from when they were identified from the
+    /// concrete's data (`identify` in a scenario), for `check` and `material`.
+    pub identified_from: Option<String>,
 }
 
 impl Material {
@@ -129,6 +133,87 @@ impl Material {
             nu,
             rho,
             model: Model::Elastic,
+            identified_from: None,
+        }
+    }
+
+    /// The model's name as a scenario writes it (`model = "..."`).
+    pub fn model_name(&self) -> &'static str {
+        match &self.model {
+            Model::Elastic => "elastic",
+            Model::KelvinVoigt(_) => "kelvin_voigt",
+            Model::Sls { parallel: true, .. } => "sls",
+            Model::Sls { .. } => "maxwell",
+            Model::Mazars(_) => "mazars",
+            Model::RankineHill(_) => "rankine_hill",
+        }
+    }
+
+    /// The interaction radius of a nonlocal material (`None`: local).
+    pub fn nonlocal_radius(&self) -> Option<f64> {
+        match self.model {
+            Model::Mazars(MazarsParams {
+                regularisation: Regularisation::Nonlocal { radius },
+                ..
+            }) => Some(radius),
+            _ => None,
+        }
+    }
+
+    /// The regularisation of a softening material: `"local"`, `"crack_band"` or
+    /// `"nonlocal"` for Mazars, `"crack_band"` for Rankine-Hill with a softening
+    /// tension law, `None` for the others.
+    pub fn regularisation(&self) -> Option<&'static str> {
+        match self.model {
+            Model::Mazars(p) => Some(p.regularisation.name()),
+            Model::RankineHill(RankineHillParams {
+                tension: Hardening::LinearSoftening { .. },
+                ..
+            }) => Some("crack_band"),
+            _ => None,
+        }
+    }
+
+    /// The model's parameters beyond `E, ν, ρ`, by name, for `check` and `material`.
+    pub fn parameters(&self) -> Vec<(&'static str, String)> {
+        let g = sig;
+        match self.model {
+            Model::Mazars(p) => {
+                let mut v = vec![
+                    ("variant", format!("{:?}", p.variant).to_lowercase()),
+                    ("eps_t0", g(p.eps_t0)),
+                ];
+                if p.variant == MazarsVariant::Paper {
+                    v.push(("eps_c0", g(p.eps_c0)));
+                }
+                match p.regularisation {
+                    Regularisation::CrackBand { fracture_energy } => {
+                        v.push(("A_t", "1 (crack band)".into()));
+                        v.push(("B_t", "per element from G_f (crack band)".into()));
+                        v.push(("fracture_energy", g(fracture_energy)));
+                    }
+                    _ => {
+                        v.push(("A_t", g(p.a_t)));
+                        v.push(("B_t", g(p.b_t)));
+                    }
+                }
+                v.push(("A_c", g(p.a_c)));
+                v.push(("B_c", g(p.b_c)));
+                if p.variant == MazarsVariant::Classic {
+                    v.push(("beta", g(p.beta)));
+                }
+                v.push(("d_max", format!("{}", p.d_max)));
+                v.push(("regularisation", p.regularisation.name().into()));
+                if let Regularisation::Nonlocal { radius } = p.regularisation {
+                    v.push(("radius", g(radius)));
+                }
+                v
+            }
+            Model::RankineHill(p) => vec![
+                ("tension", p.tension.describe()),
+                ("compression", p.compression.describe()),
+            ],
+            _ => Vec::new(),
         }
     }
 
@@ -244,7 +329,16 @@ impl Material {
         dt: f64,
     ) -> [f64; 3] {
         match self.model {
-            Model::Elastic | Model::KelvinVoigt(_) | Model::Mazars(_) | Model::RankineHill(_) => {
+            // The stress at the trial damage: with the strain unchanged neither the
+            // history maxima nor the damage grow (the local law at the committed
+            // strain returns at most the committed `D`; a nonlocal average is not
+            // re-evaluated for a prediction).
+            Model::Mazars(_) => {
+                let w = 1.0 - state[2];
+                let s = mul3(c, eps);
+                [w * s[0], w * s[1], w * s[2]]
+            }
+            Model::Elastic | Model::KelvinVoigt(_) | Model::RankineHill(_) => {
                 let mut st = [0.0; MAX_STATE];
                 self.update_with(
                     c,
@@ -300,6 +394,21 @@ impl Material {
         state_n: &[f64],
         state: &mut [f64],
     ) -> PointResponse {
+        self.update_driven(c, plane, step, None, state_n, state)
+    }
+
+    /// [`Material::update_with`] where the damage of a nonlocal material is driven by
+    /// `averaged`, the nonlocal average of its equivalent strains at this point
+    /// ([`mazars::drivers`]); `None` (and every other model) takes the point's own.
+    pub fn update_driven(
+        &self,
+        c: &[[f64; 3]; 3],
+        plane: Plane,
+        step: &StrainStep,
+        averaged: Option<[f64; 2]>,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse {
         let c = *c;
         match self.model {
             Model::Elastic => elastic::update(&c, step),
@@ -323,11 +432,31 @@ impl Material {
                 state_n,
                 state,
             ),
-            Model::Mazars(p) => mazars::update(&p, &c, self.nu, plane, step, state_n, state),
+            Model::Mazars(p) => {
+                mazars::update(&p, &c, self.nu, plane, step, averaged, state_n, state)
+            }
             Model::RankineHill(p) => {
                 rankine_hill::update(&p, &c, self.e, self.nu, step, state_n, state)
             }
         }
+    }
+}
+
+/// `x` to four significant digits, in plain notation between 10⁻³ and 10⁵.
+pub fn sig(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() {
+        format!("{x}")
+    } else if (1e-3..1e5).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        let t = format!("{x:.decimals$}");
+        if t.contains('.') {
+            t.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            t
+        }
+    } else {
+        format!("{x:.3e}")
     }
 }
 

@@ -338,13 +338,17 @@ where
 
 /// Reads a driver file, runs it and writes `out/material.csv` row by row as the path
 /// is computed (a failure part way keeps the rows written). Returns the steps taken.
-pub fn run_file(file: &Path, out: &Path) -> Result<usize> {
+///
+/// `announce` sees the material before the path runs (the command line prints its
+/// parameters, identified ones included).
+pub fn run_file(file: &Path, out: &Path, announce: impl FnOnce(&Material)) -> Result<usize> {
     let text = std::fs::read_to_string(file).map_err(|e| Error::io(file, e))?;
     let spec: DriverFile = toml::from_str(&text)
         .map_err(|e| Error::config(file.display().to_string(), e.message().to_string()))?;
     let mat = crate::config::material("point", "material", &spec.material)
         .map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
     check(&spec.path).map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
+    announce(&mat);
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let path = out.join("material.csv");
     let mut w =

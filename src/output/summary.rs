@@ -155,6 +155,54 @@ pub struct SolverSummary {
     pub factor_nnz: Option<usize>,
 }
 
+/// What a run used of one material: its model and, for softening models, how it is
+/// regularised (`local`, `crack_band` or `nonlocal`, with the radius or the fracture
+/// energy), and where identified parameters came from.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct MaterialSummary {
+    /// `elastic`, `kelvin_voigt`, `sls`, `maxwell`, `mazars` or `rankine_hill`.
+    pub model: String,
+    /// The regularisation of a softening model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub regularisation: Option<String>,
+    /// The nonlocal interaction radius (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// The crack band's fracture energy (N/m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fracture_energy: Option<f64>,
+    /// The identification the parameters came from.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub identified_from: Option<String>,
+}
+
+impl MaterialSummary {
+    /// The summary of `m`.
+    pub fn of(m: &crate::material::Material) -> Self {
+        use crate::material::{Hardening, Model, Regularisation};
+        let fracture_energy = match &m.model {
+            Model::Mazars(p) => match p.regularisation {
+                Regularisation::CrackBand { fracture_energy } => Some(fracture_energy),
+                _ => None,
+            },
+            Model::RankineHill(p) => match p.tension {
+                Hardening::LinearSoftening {
+                    fracture_energy, ..
+                } => Some(fracture_energy),
+                _ => None,
+            },
+            _ => None,
+        };
+        MaterialSummary {
+            model: m.model_name().into(),
+            regularisation: m.regularisation().map(String::from),
+            radius: m.nonlocal_radius(),
+            fracture_energy,
+            identified_from: m.identified_from.clone(),
+        }
+    }
+}
+
 /// The whole summary.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -173,6 +221,8 @@ pub struct Summary {
     pub t_end: f64,
     /// Step size.
     pub dt: f64,
+    /// The materials by name: model and regularisation.
+    pub materials: BTreeMap<String, MaterialSummary>,
     /// Probe extremes.
     pub probes: BTreeMap<String, ProbeSummary>,
     /// Contact pairs: forces, penetration, active constraints, impulse.

@@ -14,12 +14,24 @@ use crate::config::Overrides;
 use crate::error::{Error, Result};
 use crate::plot::{draw, Figure, Series, Style};
 
-/// The concrete models of benchmark 1 (the variants of `two_blocks.toml`).
-pub const BENCHMARK1_MODELS: [&str; 4] = ["elastic", "kelvin_voigt", "mazars", "rankine_hill"];
-/// The meshes of benchmark 1 (NOTES.md).
-pub const BENCHMARK1_MESHES: [f64; 4] = [0.2, 0.15, 0.1, 0.05];
+/// The concrete models of benchmark 1 (the variants of `two_blocks.toml`): the
+/// paper's four (Mazars nonlocal), the local Mazars law and the bilinearised one.
+pub const BENCHMARK1_MODELS: [&str; 6] = [
+    "elastic",
+    "kelvin_voigt",
+    "mazars",
+    "mazars_local",
+    "mazars_plateau",
+    "rankine_hill",
+];
+/// The meshes of benchmark 1 (NOTES.md's four and 0.025 m).
+pub const BENCHMARK1_MESHES: [f64; 5] = [0.2, 0.15, 0.1, 0.05, 0.025];
+/// The damage models' extra, finer meshes of benchmark 1.
+pub const DAMAGE_MESHES: [f64; 1] = [0.0125];
+/// The damage models run on [`DAMAGE_MESHES`] too.
+pub const DAMAGE_MODELS: [&str; 2] = ["mazars", "mazars_local"];
 /// The concrete models of benchmark 2.
-pub const BENCHMARK2_MODELS: [&str; 3] = ["mazars", "rankine_hill", "kelvin_voigt"];
+pub const BENCHMARK2_MODELS: [&str; 4] = ["mazars", "mazars_local", "rankine_hill", "kelvin_voigt"];
 
 /// What the report runs.
 #[derive(Clone, Debug)]
@@ -28,6 +40,8 @@ pub struct ReportOptions {
     pub benchmarks: PathBuf,
     /// Benchmark 1's meshes.
     pub meshes: Vec<f64>,
+    /// Benchmark 1's extra meshes of the damage models ([`DAMAGE_MODELS`]).
+    pub damage_meshes: Vec<f64>,
     /// Benchmark 1's mesh of the implicit-against-explicit comparison.
     pub compare_mesh: f64,
     /// Benchmark 2's element size (`None`: the scenario's own).
@@ -41,6 +55,7 @@ impl Default for ReportOptions {
         ReportOptions {
             benchmarks: PathBuf::from("examples/benchmarks"),
             meshes: BENCHMARK1_MESHES.to_vec(),
+            damage_meshes: DAMAGE_MESHES.to_vec(),
             compare_mesh: 0.1,
             beam_size: None,
             base: Overrides::none(),
@@ -77,7 +92,12 @@ pub fn plan(o: &ReportOptions) -> Result<Plan> {
     let abs2 = super::plan::absolute(&b2)?;
     let mut runs = Vec::new();
     for m in BENCHMARK1_MODELS {
-        for &s in &o.meshes {
+        let extra: &[f64] = if DAMAGE_MODELS.contains(&m) {
+            &o.damage_meshes
+        } else {
+            &[]
+        };
+        for &s in o.meshes.iter().chain(extra) {
             runs.push(PlannedRun {
                 id: format!("b1_{m}_{s}"),
                 scenario: abs1.clone(),
@@ -219,6 +239,7 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
         }
     }
     md.push_str(&ratio.markdown());
+    md.push_str(&damage_convergence(runs, &meshes));
     // Figures 6-9: probe per mesh, one chart per model.
     md.push('\n');
     for m in BENCHMARK1_MODELS {
@@ -391,6 +412,50 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     md.push_str(&format!("\nSum of the runs' wall times: {total:.1} s.\n"));
     t.write_csv(&dir.join("runs.csv"))?;
     Ok(md)
+}
+
+/// The damage models' material dissipation over the meshes, fine to coarse, with
+/// the successive differences and their ratios (a ratio above 1 is a difference
+/// that shrinks).
+fn damage_convergence(runs: &[RunData], meshes: &[f64]) -> String {
+    let mut t = Table::new(&[
+        "model",
+        "mesh",
+        "material dissipation / E_kin⁰",
+        "difference to the previous mesh",
+        "ratio of successive differences",
+    ]);
+    for m in ["mazars", "mazars_local", "mazars_plateau", "rankine_hill"] {
+        let values: Vec<(f64, f64)> = meshes
+            .iter()
+            .filter_map(|&s| {
+                find(runs, &format!("b1_{m}_{s}"))
+                    .map(|r| (s, r.dissipated_material() / r.kinetic_0()))
+            })
+            .collect();
+        let mut previous: Option<(f64, f64)> = None;
+        let mut last_diff: Option<f64> = None;
+        for &(s, d) in &values {
+            let diff = previous.map(|p| d - p.1);
+            let ratio = match (last_diff, diff) {
+                (Some(a), Some(b)) if b != 0.0 => Some(a.abs() / b.abs()),
+                _ => None,
+            };
+            t.push(vec![
+                m.to_string(),
+                format!("{s} m"),
+                num(Some(d)),
+                num(diff),
+                num(ratio),
+            ]);
+            previous = Some((s, d));
+            last_diff = diff.or(last_diff);
+        }
+    }
+    format!(
+        "\n### Mesh convergence of the material dissipation\n\n{}",
+        t.markdown()
+    )
 }
 
 /// The energies of one run against time: E_kin, E_el, W_ext, each nonzero

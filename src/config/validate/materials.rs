@@ -85,20 +85,28 @@ fn hardening(
 }
 
 /// Linear tension softening needs elements smaller than `2 G_f E / f_t²`, or the
-/// softening branch turns back on itself (snap-back) and the return has no solution.
+/// softening branch turns back on itself (snap-back) and the return has no solution;
+/// the exponential crack band of Mazars needs the same (its `G_f/h` must exceed the
+/// elastic energy `f_t²/(2E)` at the peak).
 pub(super) fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()> {
     use crate::material::{Hardening, Model};
+    use crate::material::{MazarsParams, Regularisation};
     for (bi, b) in mesh.blocks.iter().enumerate() {
         let mat = &materials[b.material];
-        let Model::RankineHill(p) = &mat.model else {
-            continue;
-        };
-        let Hardening::LinearSoftening {
-            strength,
-            fracture_energy,
-        } = p.tension
-        else {
-            continue;
+        let (strength, fracture_energy, key) = match &mat.model {
+            Model::RankineHill(p) => match p.tension {
+                Hardening::LinearSoftening {
+                    strength,
+                    fracture_energy,
+                } => (strength, fracture_energy, "tension.fracture_energy"),
+                _ => continue,
+            },
+            Model::Mazars(MazarsParams {
+                regularisation: Regularisation::CrackBand { fracture_energy },
+                eps_t0,
+                ..
+            }) => (mat.e * eps_t0, *fracture_energy, "fracture_energy"),
+            _ => continue,
         };
         let limit = 2.0 * fracture_energy * mat.e / (strength * strength);
         for e in 0..b.elements.len() {
@@ -118,13 +126,140 @@ pub(super) fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()
             let h = area.abs().sqrt();
             if h >= limit {
                 return Err(Error::config(
-                    format!("materials.{}.tension.fracture_energy", mat.name),
+                    format!("materials.{}.{key}", mat.name),
                     format!("element {e} of block {bi} is {h:.3} m across, beyond the crack-band limit 2 G_f E / f_t² = {limit:.3} m: refine the mesh or raise G_f"),
                 ));
             }
         }
     }
     Ok(())
+}
+
+/// An error naming two keys of one material that must not be given together.
+fn both(field: &str, a: &str, b: &str, why: &str) -> Error {
+    Error::config(
+        format!("{field}.{a}"),
+        format!("`{field}.{a}` and `{field}.{b}` are both given: {why}"),
+    )
+}
+
+/// The concrete's data of an `identify` table and a line saying where they came
+/// from. `E` is the material's own when given, else the class's `E_cm`.
+fn concrete_data(
+    field: &str,
+    id: &crate::config::IdentifySpec,
+    e: Option<f64>,
+    nu: f64,
+) -> Result<(crate::material::identify::ConcreteData, String)> {
+    use crate::material::identify::{ConcreteData, Ec2Class};
+    let f = |k: &str| format!("{field}.identify.{k}");
+    let (d, source) = match &id.class {
+        Some(name) => {
+            for (k, v) in [("f_ct", id.f_ct), ("f_cm", id.f_cm), ("eps_c1", id.eps_c1)] {
+                if v.is_some() {
+                    return Err(Error::config(
+                        f(k),
+                        format!("give `class` or `f_ct`, `f_cm`, `eps_c1`, not both (`{k}` beside class = {name:?})"),
+                    ));
+                }
+            }
+            let c = Ec2Class::named(name).ok_or_else(|| {
+                Error::config(
+                    f("class"),
+                    format!(
+                        "unknown strength class {name:?}; EN 1992-1-1 Table 3.1 has {}",
+                        Ec2Class::names()
+                    ),
+                )
+            })?;
+            let (e, which) = match e {
+                Some(e) => (e, "E as given"),
+                None => (c.e_cm, "E = E_cm"),
+            };
+            (
+                ConcreteData {
+                    e,
+                    nu,
+                    f_ct: c.f_ctm,
+                    f_cm: c.f_cm,
+                    eps_c1: c.eps_c1,
+                },
+                format!(
+                    "{} (EN 1992-1-1 Table 3.1, f_ck = {:.0} MPa, {which})",
+                    c.name,
+                    c.f_ck / 1e6
+                ),
+            )
+        }
+        None => {
+            let req = |k: &str, v: Option<f64>| -> Result<f64> {
+                let v = v.ok_or_else(|| {
+                    Error::config(f(k), "missing (give f_ct, f_cm and eps_c1, or class)")
+                })?;
+                positive(&f(k), v)?;
+                Ok(v)
+            };
+            let e = e.ok_or_else(|| {
+                Error::config(
+                    format!("{field}.E"),
+                    "missing (identify from f_ct, f_cm, eps_c1 needs E; only a class gives E_cm)",
+                )
+            })?;
+            (
+                ConcreteData {
+                    e,
+                    nu,
+                    f_ct: req("f_ct", id.f_ct)?,
+                    f_cm: req("f_cm", id.f_cm)?,
+                    eps_c1: req("eps_c1", id.eps_c1)?,
+                },
+                "the concrete's data".to_string(),
+            )
+        }
+    };
+    check_elastic(field, d.e, d.nu, 1.0)?;
+    let g = crate::material::sig;
+    let line = format!(
+        "identified from {source}: E = {}, nu = {}, f_ct = {}, f_cm = {}, eps_c1 = {}",
+        g(d.e),
+        d.nu,
+        g(d.f_ct),
+        g(d.f_cm),
+        g(d.eps_c1)
+    );
+    Ok((d, line))
+}
+
+/// A strength law written back as its spec (identified laws are validated like
+/// written ones).
+fn hardening_spec(h: &crate::material::Hardening) -> crate::config::HardeningSpec {
+    use crate::config::HardeningSpec as S;
+    use crate::material::Hardening as H;
+    match *h {
+        H::Bilinear {
+            strength,
+            post_yield_modulus,
+        } => S::Bilinear {
+            strength,
+            post_yield_modulus,
+        },
+        H::Ec2 {
+            f_cm,
+            eps_c1,
+            eps_cu1,
+        } => S::Ec2 {
+            f_cm,
+            eps_c1,
+            eps_cu1,
+        },
+        H::LinearSoftening {
+            strength,
+            fracture_energy,
+        } => S::LinearSoftening {
+            strength,
+            fracture_energy,
+        },
+    }
 }
 
 /// Validates one material spec into a [`Material`]; `field` prefixes error paths.
@@ -138,6 +273,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             nu,
             rho,
             model,
+            identified_from: None,
         })
     };
     let viscosity = |key: &str, v: f64| positive(&format!("{field}.{key}"), v);
@@ -206,6 +342,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             nu,
             rho,
             variant,
+            ref identify,
             eps_t0,
             eps_c0,
             a_t,
@@ -214,21 +351,105 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             b_c,
             beta,
             d_max,
+            fracture_energy,
+            nonlocal,
         } => {
-            use crate::material::MazarsParams;
-            positive(&format!("{field}.eps_t0"), eps_t0)?;
-            let eps_c0 = eps_c0.unwrap_or(eps_t0);
-            positive(&format!("{field}.eps_c0"), eps_c0)?;
-            for (k, v) in [("A_t", a_t), ("A_c", a_c)] {
+            use crate::material::{MazarsParams, Regularisation};
+            let regularisation = match (fracture_energy, nonlocal) {
+                (Some(_), Some(_)) => {
+                    return Err(both(field, "fracture_energy", "nonlocal", "one regularisation at a time: the crack band (fracture_energy) or nonlocal averaging"))
+                }
+                (Some(g), None) => {
+                    positive(&format!("{field}.fracture_energy"), g)?;
+                    for (k, v) in [("A_t", a_t), ("B_t", b_t)] {
+                        if v.is_some() {
+                            return Err(both(field, k, "fracture_energy", "the crack band sets the tension law (A_t = 1, B_t from G_f and the element size)"));
+                        }
+                    }
+                    Regularisation::CrackBand { fracture_energy: g }
+                }
+                (None, Some(nl)) => {
+                    positive(&format!("{field}.nonlocal.radius"), nl.radius)?;
+                    Regularisation::Nonlocal { radius: nl.radius }
+                }
+                (None, None) => Regularisation::Local,
+            };
+            let (e, ident, from) = match identify {
+                Some(id) => {
+                    let raw = [
+                        ("eps_t0", eps_t0),
+                        ("eps_c0", eps_c0),
+                        ("A_t", a_t),
+                        ("B_t", b_t),
+                        ("A_c", a_c),
+                        ("B_c", b_c),
+                    ];
+                    if let Some((k, _)) = raw.iter().find(|(_, v)| v.is_some()) {
+                        return Err(both(
+                            field,
+                            k,
+                            "identify",
+                            "give the raw parameters or the concrete's data, not both",
+                        ));
+                    }
+                    if id.eps_cu1.is_some() {
+                        return Err(Error::config(format!("{field}.identify.eps_cu1"), "Mazars does not use eps_cu1 (its compression law peaks at eps_c1 and softens by its own exponential)"));
+                    }
+                    if id.fracture_energy.is_some() {
+                        return Err(Error::config(format!("{field}.identify.fracture_energy"), "put fracture_energy on the material itself: it selects the crack-band variant"));
+                    }
+                    let (d, from) = concrete_data(field, id, e, nu)?;
+                    let m = crate::material::identify::mazars(variant, &d)
+                        .map_err(|m| Error::config(format!("{field}.identify"), m))?;
+                    (d.e, m, Some(from))
+                }
+                None => {
+                    let e = e.ok_or_else(|| {
+                        Error::config(
+                            format!("{field}.E"),
+                            "missing (give E, or identify = { class = ... } for EC2's E_cm)",
+                        )
+                    })?;
+                    let req = |k: &str, v: Option<f64>| {
+                        v.ok_or_else(|| Error::config(format!("{field}.{k}"), "missing (give the raw parameters eps_t0, A_t, B_t, A_c, B_c, or identify = { f_ct, f_cm, eps_c1 } or { class })"))
+                    };
+                    let crack = matches!(regularisation, Regularisation::CrackBand { .. });
+                    let eps_t0 = req("eps_t0", eps_t0)?;
+                    let m = crate::material::identify::MazarsIdentified {
+                        eps_t0,
+                        eps_c0: eps_c0.unwrap_or(eps_t0),
+                        a_t: if crack { 1.0 } else { req("A_t", a_t)? },
+                        b_t: if crack { 0.0 } else { req("B_t", b_t)? },
+                        a_c: req("A_c", a_c)?,
+                        b_c: req("B_c", b_c)?,
+                    };
+                    (e, m, None)
+                }
+            };
+            // Identified values are checked like given ones; their errors name
+            // `identify`.
+            let name = |k: &str| {
+                if from.is_some() {
+                    format!("{field}.identify (identified {k})")
+                } else {
+                    format!("{field}.{k}")
+                }
+            };
+            positive(&name("eps_t0"), ident.eps_t0)?;
+            positive(&name("eps_c0"), ident.eps_c0)?;
+            for (k, v) in [("A_t", ident.a_t), ("A_c", ident.a_c)] {
                 if !(0.0..=2.0).contains(&v) {
                     return Err(Error::config(
-                        format!("{field}.{k}"),
+                        name(k),
                         format!("must lie in [0, 2], got {v:?}"),
                     ));
                 }
             }
-            positive(&format!("{field}.B_t"), b_t)?;
-            positive(&format!("{field}.B_c"), b_c)?;
+            let crack = matches!(regularisation, Regularisation::CrackBand { .. });
+            if !crack {
+                positive(&name("B_t"), ident.b_t)?;
+            }
+            positive(&name("B_c"), ident.b_c)?;
             positive(&format!("{field}.beta"), beta)?;
             if !(d_max > 0.0 && d_max < 1.0) {
                 return Err(Error::config(
@@ -236,22 +457,25 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                     format!("must lie in (0, 1), got {d_max:?}"),
                 ));
             }
-            with(
+            let mut m = with(
                 e,
                 nu,
                 rho,
                 Model::Mazars(MazarsParams {
                     variant,
-                    eps_t0,
-                    eps_c0,
-                    a_t,
-                    b_t,
-                    a_c,
-                    b_c,
+                    eps_t0: ident.eps_t0,
+                    eps_c0: ident.eps_c0,
+                    a_t: if crack { 1.0 } else { ident.a_t },
+                    b_t: if crack { 0.0 } else { ident.b_t },
+                    a_c: ident.a_c,
+                    b_c: ident.b_c,
                     beta,
                     d_max,
+                    regularisation,
                 }),
-            )
+            )?;
+            m.identified_from = from;
+            Ok(m)
         }
         MaterialSpec::RankineHill {
             e,
@@ -259,10 +483,86 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             rho,
             ref tension,
             ref compression,
+            ref identify,
         } => {
-            let tension = hardening(&format!("{field}.tension"), tension, e)?;
-            let compression = hardening(&format!("{field}.compression"), compression, e)?;
-            with(
+            let (e, tension, compression, from) = match identify {
+                Some(id) => {
+                    for (k, v) in [
+                        ("tension", tension.is_some()),
+                        ("compression", compression.is_some()),
+                    ] {
+                        if v {
+                            return Err(both(
+                                field,
+                                k,
+                                "identify",
+                                "give the strength laws or the concrete's data, not both",
+                            ));
+                        }
+                    }
+                    let (d, from) = concrete_data(field, id, e, nu)?;
+                    let eps_cu1 = match (id.eps_cu1, &id.class) {
+                        (Some(x), _) => x,
+                        (None, Some(c)) => crate::material::identify::Ec2Class::named(c)
+                            .map_or(3.5e-3, |c| c.eps_cu1),
+                        (None, None) => crate::material::identify::ec2_eps_cu1(d.f_cm),
+                    };
+                    let gf = id
+                        .fracture_energy
+                        .unwrap_or_else(|| crate::material::identify::fib_fracture_energy(d.f_cm));
+                    positive(&format!("{field}.identify.fracture_energy"), gf)?;
+                    let (t, c) = crate::material::identify::rankine_hill(&d, eps_cu1, gf);
+                    // The laws are validated as if written out.
+                    let t = hardening(
+                        &format!("{field}.identify (tension)"),
+                        &hardening_spec(&t),
+                        d.e,
+                    )?;
+                    let c = hardening(
+                        &format!("{field}.identify (compression)"),
+                        &hardening_spec(&c),
+                        d.e,
+                    )?;
+                    let from = format!(
+                        "{from}; eps_cu1 = {}, G_f = {} N/m{}",
+                        crate::material::sig(eps_cu1),
+                        crate::material::sig(gf),
+                        if id.fracture_energy.is_none() {
+                            " (fib MC2010)"
+                        } else {
+                            ""
+                        }
+                    );
+                    (d.e, t, c, Some(from))
+                }
+                None => {
+                    let e = e.ok_or_else(|| {
+                        Error::config(
+                            format!("{field}.E"),
+                            "missing (give E, or identify = { class = ... } for EC2's E_cm)",
+                        )
+                    })?;
+                    let t = tension.as_ref().ok_or_else(|| {
+                        Error::config(
+                            format!("{field}.tension"),
+                            "missing (give tension and compression laws, or identify)",
+                        )
+                    })?;
+                    let c = compression.as_ref().ok_or_else(|| {
+                        Error::config(
+                            format!("{field}.compression"),
+                            "missing (give tension and compression laws, or identify)",
+                        )
+                    })?;
+                    (
+                        e,
+                        hardening(&format!("{field}.tension"), t, e)?,
+                        hardening(&format!("{field}.compression"), c, e)?,
+                        None,
+                    )
+                }
+            };
+            let mut m = with(
                 e,
                 nu,
                 rho,
@@ -270,7 +570,9 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                     tension,
                     compression,
                 }),
-            )
+            )?;
+            m.identified_from = from;
+            Ok(m)
         }
         MaterialSpec::Kelvin { e, nu, rho, beta } => {
             viscosity("beta", beta)?;

@@ -216,14 +216,18 @@ pub fn estimate(mesh: &Mesh, materials: &[Material], factor_nnz: Option<usize>) 
         .sum();
     let history = materials.iter().map(|m| m.n_state()).max().unwrap_or(0) as u64;
     let tangent = materials.iter().any(|m| !m.has_constant_tangent());
-    Estimate::of(
+    let mut est = Estimate::of(
         mesh.n_nodes() as u64,
         mesh.n_elements() as u64,
         points,
         history,
         factor_nnz.map_or_else(|| factor_nnz_estimate(mesh.n_dofs()), |n| n as u64),
         tangent,
-    )
+    );
+    // The nonlocal table (index and weight per entry) and its per-point buffers.
+    let (nl_points, nl_entries) = crate::assembly::nonlocal::estimated_entries(mesh, materials);
+    est.state += 12 * nl_entries + 64 * nl_points;
+    est
 }
 
 /// A body's part from its mesh spec.

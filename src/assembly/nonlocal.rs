@@ -1,0 +1,460 @@
+//! Nonlocal integral averaging of the damage drivers (Pijaudier-Cabot and Bažant).
+//!
+//! A nonlocal material's equivalent strains ([`crate::material::mazars::drivers`])
+//! are replaced, where they drive the damage, by their average over the Gauss points
+//! of the same body within the interaction radius `R`:
+//!
+//! `ε̄_i = Σ_j α_ij ε_j`,  `α_ij = w(r_ij) V_j / Σ_k w(r_ik) V_k`,  `w(r) = (1 − r²/R²)²`
+//!
+//! (`V_j` the point's integration volume `w_q det J t`). The weights are normalised
+//! per point, so a uniform field averages to itself, at a boundary too. The table of
+//! neighbours and weights depends on the reference geometry only: it is built once
+//! per mesh with an R-tree (`rstar`) and kept ([`NonlocalTable`]); each pass then
+//! evaluates the drivers at every point of a nonlocal block ([`NonlocalTable`]'s
+//! `local` input) and averages them, each point's row summed in one fixed order on
+//! one thread, so the averages repeat to the last bit on any pool. Theory:
+//! `theory/damage.md`, "Nonlocal averaging".
+
+use rayon::prelude::*;
+use rstar::primitives::GeomWithData;
+use rstar::RTree;
+
+use crate::fe::{kinematics, stiffness_rule, strain, ElementKind, Plane};
+use crate::material::store::StateStore;
+use crate::material::{mazars, Material, MazarsVariant, Model};
+use crate::mesh::Mesh;
+
+/// Drivers per point (`[ε_t, ε_c]` or `[ε̃, 0]`).
+pub const DRIVERS: usize = 2;
+
+/// An R-tree of member points (their member numbers as data).
+type PointTree = RTree<GeomWithData<[f64; 2], u32>>;
+
+/// Points per leaf of the parallel passes.
+const POINT_LEAF: usize = 256;
+
+/// The neighbour table of every nonlocal block: for each of their Gauss points (the
+/// "members", numbered block after block), the members of the same body within the
+/// material's radius and their normalised weights, in ascending member order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NonlocalTable {
+    /// Per block: the number of its first member when its material is nonlocal.
+    offsets: Vec<Option<usize>>,
+    /// Per block: the radius the table was built with (to know it still fits).
+    radii: Vec<Option<f64>>,
+    /// Member coordinates.
+    points: Vec<[f64; 2]>,
+    /// Row starts (members + 1).
+    row_ptr: Vec<usize>,
+    /// Neighbour members.
+    cols: Vec<u32>,
+    /// Normalised weights `α_ij`.
+    weights: Vec<f64>,
+    /// The bucket grid that bounds the averages: origin, cell size and cells per row.
+    grid: ([f64; 2], f64, usize, usize),
+    /// Per member: its bucket.
+    bucket: Vec<u32>,
+    /// Per member: how many buckets its radius reaches in each direction.
+    reach: Vec<u8>,
+    /// Per member: its block.
+    block: Vec<u32>,
+}
+
+/// A Gauss point of a continuum element: its position and integration volume.
+fn point_geometry(mesh: &Mesh, bi: usize, e: usize, q: usize) -> ([f64; 2], f64) {
+    let block = &mesh.blocks[bi];
+    let kind = block.elements.kind;
+    let nodes = block.elements.element(e);
+    let mut x = [[0.0; 2]; 4];
+    for (a, &n) in nodes.iter().enumerate() {
+        x[a] = mesh.coords[n];
+    }
+    let (xi, wq) = stiffness_rule(kind)[q];
+    let k = kinematics(kind, &x[..nodes.len()], xi);
+    let mut p = [0.0; 2];
+    for a in 0..nodes.len() {
+        p[0] += k.n[a] * x[a][0];
+        p[1] += k.n[a] * x[a][1];
+    }
+    (p, wq * k.det_j * block.section)
+}
+
+/// The radius of block `bi`'s material when it is nonlocal (continuum blocks only).
+fn block_radius(mesh: &Mesh, materials: &[Material], bi: usize) -> Option<f64> {
+    let b = &mesh.blocks[bi];
+    if b.elements.kind == ElementKind::Bar2 {
+        return None;
+    }
+    materials[b.material].nonlocal_radius()
+}
+
+/// An estimate of the table's entries before it is built (for the memory estimate):
+/// per nonlocal block, its points times those of its body's points a disc of the
+/// radius holds at the block's mean point density.
+pub fn estimated_entries(mesh: &Mesh, materials: &[Material]) -> (u64, u64) {
+    let (mut points, mut entries) = (0u64, 0u64);
+    for (bi, b) in mesh.blocks.iter().enumerate() {
+        let Some(r) = block_radius(mesh, materials, bi) else {
+            continue;
+        };
+        let n = (b.elements.len() * stiffness_rule(b.elements.kind).len()) as u64;
+        let area: f64 = (0..b.elements.len())
+            .map(|e| {
+                let x: Vec<[f64; 2]> = b
+                    .elements
+                    .element(e)
+                    .iter()
+                    .map(|&k| mesh.coords[k])
+                    .collect();
+                0.5 * (0..x.len())
+                    .map(|a| {
+                        let c = (a + 1) % x.len();
+                        x[a][0] * x[c][1] - x[c][0] * x[a][1]
+                    })
+                    .sum::<f64>()
+                    .abs()
+            })
+            .sum();
+        let per_point = (std::f64::consts::PI * r * r * n as f64 / area.max(f64::MIN_POSITIVE))
+            .clamp(1.0, n as f64);
+        points += n;
+        entries += (n as f64 * per_point) as u64;
+    }
+    (points, entries)
+}
+
+impl NonlocalTable {
+    /// The table of `mesh` for `materials`, or `None` when no material is nonlocal.
+    pub fn build(mesh: &Mesh, materials: &[Material]) -> Option<NonlocalTable> {
+        let radii: Vec<Option<f64>> = (0..mesh.blocks.len())
+            .map(|bi| block_radius(mesh, materials, bi))
+            .collect();
+        if radii.iter().all(Option::is_none) {
+            return None;
+        }
+        let mut offsets = vec![None; mesh.blocks.len()];
+        let mut points = Vec::new();
+        let mut volumes = Vec::new();
+        // Member -> (body, radius), and its block.
+        let mut owner = Vec::new();
+        let mut block = Vec::new();
+        for (bi, b) in mesh.blocks.iter().enumerate() {
+            let Some(r) = radii[bi] else { continue };
+            offsets[bi] = Some(points.len());
+            let ng = stiffness_rule(b.elements.kind).len();
+            for e in 0..b.elements.len() {
+                for q in 0..ng {
+                    let (p, v) = point_geometry(mesh, bi, e, q);
+                    points.push(p);
+                    volumes.push(v);
+                    owner.push((b.body, r));
+                    block.push(bi as u32);
+                }
+            }
+        }
+        // One R-tree per body over its members.
+        let mut bodies: Vec<usize> = owner.iter().map(|o| o.0).collect();
+        bodies.sort_unstable();
+        bodies.dedup();
+        let trees: Vec<(usize, PointTree)> = bodies
+            .iter()
+            .map(|&body| {
+                let items = (0..points.len())
+                    .filter(|&m| owner[m].0 == body)
+                    .map(|m| GeomWithData::new(points[m], m as u32))
+                    .collect();
+                (body, RTree::bulk_load(items))
+            })
+            .collect();
+        let rows: Vec<(Vec<u32>, Vec<f64>)> = (0..points.len())
+            .into_par_iter()
+            .map(|i| {
+                let (body, r) = owner[i];
+                let tree = &trees.iter().find(|t| t.0 == body).expect("body tree").1;
+                let r2 = r * r;
+                let mut nb: Vec<(u32, f64)> = tree
+                    .locate_within_distance(points[i], r2)
+                    .filter_map(|g| {
+                        let j = g.data as usize;
+                        let (dx, dy) = (points[j][0] - points[i][0], points[j][1] - points[i][1]);
+                        let s = 1.0 - (dx * dx + dy * dy) / r2;
+                        (s > 0.0).then_some((g.data, s * s * volumes[j]))
+                    })
+                    .collect();
+                nb.sort_unstable_by_key(|p| p.0);
+                let total: f64 = nb.iter().map(|p| p.1).sum();
+                nb.into_iter().map(|(j, w)| (j, w / total)).unzip()
+            })
+            .collect();
+        // Buckets of half the largest radius: a point's neighbours lie in the buckets
+        // within `ceil(R / cell)` of its own.
+        let r_max = owner.iter().map(|o| o.1).fold(0.0, f64::max);
+        let cell = 0.5 * r_max;
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in &points {
+            for d in 0..2 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        let cells = |d: usize| (((hi[d] - lo[d]) / cell).floor() as usize + 1).min(1 << 12);
+        let (nx, ny) = (cells(0), cells(1));
+        let bucket = points
+            .iter()
+            .map(|p| {
+                let ix = (((p[0] - lo[0]) / cell) as usize).min(nx - 1);
+                let iy = (((p[1] - lo[1]) / cell) as usize).min(ny - 1);
+                (iy * nx + ix) as u32
+            })
+            .collect();
+        let reach = owner
+            .iter()
+            .map(|o| (o.1 / cell).ceil().min(255.0) as u8)
+            .collect();
+        let mut row_ptr = Vec::with_capacity(points.len() + 1);
+        row_ptr.push(0);
+        let nnz: usize = rows.iter().map(|r| r.0.len()).sum();
+        let (mut cols, mut weights) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
+        for (c, w) in rows {
+            cols.extend_from_slice(&c);
+            weights.extend_from_slice(&w);
+            row_ptr.push(cols.len());
+        }
+        Some(NonlocalTable {
+            offsets,
+            radii,
+            points,
+            row_ptr,
+            cols,
+            weights,
+            grid: (lo, cell, nx, ny),
+            bucket,
+            reach,
+            block,
+        })
+    }
+
+    /// Whether the table was built for these blocks and radii.
+    pub fn fits(&self, mesh: &Mesh, materials: &[Material]) -> bool {
+        self.radii.len() == mesh.blocks.len()
+            && (0..mesh.blocks.len()).all(|bi| block_radius(mesh, materials, bi) == self.radii[bi])
+    }
+
+    /// Number of members (Gauss points of nonlocal blocks).
+    pub fn n_points(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Number of (point, neighbour) entries.
+    pub fn n_entries(&self) -> usize {
+        self.cols.len()
+    }
+
+    /// Bytes the table holds (indices, weights, rows, coordinates).
+    pub fn bytes(&self) -> u64 {
+        (self.cols.len() * 12 + self.row_ptr.len() * 8 + self.points.len() * 16) as u64
+    }
+
+    /// The smallest and largest neighbour count of a point (itself included).
+    pub fn neighbour_range(&self) -> (usize, usize) {
+        self.row_ptr
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .fold((usize::MAX, 0), |(lo, hi), n| (lo.min(n), hi.max(n)))
+    }
+
+    /// The first member of block `bi`, when its material is nonlocal.
+    pub fn offset(&self, bi: usize) -> Option<usize> {
+        self.offsets.get(bi).copied().flatten()
+    }
+
+    /// Coordinates of member `i`.
+    pub fn point(&self, i: usize) -> [f64; 2] {
+        self.points[i]
+    }
+
+    /// The neighbours of member `i` and their normalised weights.
+    pub fn neighbours(&self, i: usize) -> (&[u32], &[f64]) {
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        (&self.cols[r.clone()], &self.weights[r])
+    }
+
+    /// `out_i = Σ_j α_ij local_j` for each of the [`DRIVERS`] values per member, on
+    /// the thread pool (each row summed in its stored order: the same bits on any
+    /// pool).
+    pub fn average(&self, local: &[f64], out: &mut [f64]) {
+        let mut bounds = vec![[0.0; 2]; self.n_buckets()];
+        self.average_where(local, &mut bounds, |_, _| true, out);
+    }
+
+    /// Number of buckets of the bounding grid.
+    pub fn n_buckets(&self) -> usize {
+        self.grid.2 * self.grid.3
+    }
+
+    /// [`NonlocalTable::average`] for the members where `needed(i, bound)` holds,
+    /// `bound` being an upper bound of their averages (the largest driver in the
+    /// buckets their radius reaches); the others get `-∞`.
+    fn average_where<F>(&self, local: &[f64], bounds: &mut [[f64; 2]], needed: F, out: &mut [f64])
+    where
+        F: Fn(usize, [f64; 2]) -> bool + Sync,
+    {
+        self.bucket_maxima(local, bounds);
+        let bounds = &*bounds;
+        let (_, _, nx, ny) = self.grid;
+        out.par_chunks_mut(DRIVERS * POINT_LEAF)
+            .enumerate()
+            .for_each(|(c, chunk)| {
+                let first = c * POINT_LEAF;
+                for (k, o) in chunk.chunks_exact_mut(DRIVERS).enumerate() {
+                    let i = first + k;
+                    let b = self.bucket[i] as usize;
+                    let (bx, by, r) = (b % nx, b / nx, self.reach[i] as usize);
+                    let mut bound = [f64::NEG_INFINITY; 2];
+                    for y in by.saturating_sub(r)..(by + r + 1).min(ny) {
+                        for x in bx.saturating_sub(r)..(bx + r + 1).min(nx) {
+                            let m = bounds[y * nx + x];
+                            bound = [bound[0].max(m[0]), bound[1].max(m[1])];
+                        }
+                    }
+                    if !needed(i, bound) {
+                        o[0] = f64::NEG_INFINITY;
+                        o[1] = f64::NEG_INFINITY;
+                        continue;
+                    }
+                    let (cols, w) = self.neighbours(i);
+                    let (mut a, mut b) = (0.0, 0.0);
+                    for (&j, &wj) in cols.iter().zip(w) {
+                        let j = j as usize;
+                        a += wj * local[DRIVERS * j];
+                        b += wj * local[DRIVERS * j + 1];
+                    }
+                    o[0] = a;
+                    o[1] = b;
+                }
+            });
+    }
+
+    /// The largest of each driver per bucket, into `m`.
+    fn bucket_maxima(&self, local: &[f64], m: &mut [[f64; 2]]) {
+        m.fill([f64::NEG_INFINITY; 2]);
+        for (i, &b) in self.bucket.iter().enumerate() {
+            let e = &mut m[b as usize];
+            e[0] = e[0].max(local[DRIVERS * i]);
+            e[1] = e[1].max(local[DRIVERS * i + 1]);
+        }
+    }
+
+    /// The drivers of every member at displacements `u` (their own, not averaged),
+    /// on the thread pool.
+    pub fn local_drivers(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        u: &[f64],
+        local: &mut [f64],
+    ) {
+        for (bi, b) in mesh.blocks.iter().enumerate() {
+            let Some(off) = self.offset(bi) else { continue };
+            let mat = &materials[b.material];
+            let Model::Mazars(p) = &mat.model else {
+                continue;
+            };
+            let kind = b.elements.kind;
+            let ng = stiffness_rule(kind).len();
+            let span = &mut local[DRIVERS * off..DRIVERS * (off + ng * b.elements.len())];
+            span.par_chunks_mut(DRIVERS * ng * (POINT_LEAF / ng).max(1))
+                .enumerate()
+                .for_each(|(c, chunk)| {
+                    let per = (POINT_LEAF / ng).max(1);
+                    for (k, el) in chunk.chunks_exact_mut(DRIVERS * ng).enumerate() {
+                        let e = c * per + k;
+                        let (x, ue, nn) = super::internal::gather(mesh, b.elements.element(e), u);
+                        for (q, &(xi, _)) in stiffness_rule(kind).iter().enumerate() {
+                            let kin = kinematics(kind, &x[..nn], xi);
+                            let eps = strain(&kin, nn, &ue);
+                            let d = mazars::drivers(p, mat.nu, plane, &eps);
+                            el[DRIVERS * q] = d[0];
+                            el[DRIVERS * q + 1] = d[1];
+                        }
+                    }
+                });
+        }
+    }
+}
+
+/// The table with the buffers of one pass: the members' own drivers and their
+/// averages. Kept by the [`super::Assembler`] between passes (built at the first
+/// pass that needs it).
+#[derive(Debug)]
+pub struct Nonlocal {
+    /// The neighbour table.
+    pub table: NonlocalTable,
+    /// The members' own drivers of the last pass.
+    pub local: Vec<f64>,
+    /// Their averages (`-∞` where the bound shows that no history maximum can grow).
+    pub averaged: Vec<f64>,
+    /// The largest drivers per bucket of the last pass.
+    bounds: Vec<[f64; 2]>,
+}
+
+impl Nonlocal {
+    /// The table of `mesh` and zeroed buffers, or `None` without nonlocal materials.
+    pub fn build(mesh: &Mesh, materials: &[Material]) -> Option<Nonlocal> {
+        NonlocalTable::build(mesh, materials).map(|table| {
+            let n = DRIVERS * table.n_points();
+            Nonlocal {
+                bounds: vec![[0.0; 2]; table.n_buckets()],
+                table,
+                local: crate::memory::zeroed(n),
+                averaged: crate::memory::zeroed(n),
+            }
+        })
+    }
+
+    /// Evaluates the drivers at `u` and averages them into `averaged` where an
+    /// average can raise a history maximum of the committed states `stores`: a
+    /// point whose bound (the largest driver within its reach) stays at or below its
+    /// history maxima (and thresholds) would take the same damage from any average
+    /// below the bound, so it gets `-∞` instead, which the update reads the same way.
+    pub fn evaluate(
+        &mut self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        u: &[f64],
+        stores: &[StateStore],
+    ) {
+        let t = &self.table;
+        t.local_drivers(mesh, materials, plane, u, &mut self.local);
+        let needed = |i: usize, bound: [f64; 2]| {
+            let bi = t.block[i] as usize;
+            let Model::Mazars(p) = &materials[mesh.blocks[bi].material].model else {
+                return true;
+            };
+            let Some(store) = stores.get(bi) else {
+                return true;
+            };
+            let g = i - t.offsets[bi].unwrap_or(0);
+            let committed = store.committed();
+            let h = committed.history(g);
+            match p.variant {
+                MazarsVariant::Paper => {
+                    bound[0] > h[0].max(p.eps_t0) || bound[1] > h[1].max(p.eps_c0)
+                }
+                MazarsVariant::Classic => bound[0] > h[0].max(p.eps_t0),
+            }
+        };
+        t.average_where(&self.local, &mut self.bounds, needed, &mut self.averaged);
+    }
+
+    /// The averaged drivers of block `bi`'s points (`DRIVERS` per point), when its
+    /// material is nonlocal.
+    pub fn block(&self, mesh: &Mesh, bi: usize) -> Option<&[f64]> {
+        let off = self.table.offset(bi)?;
+        let b = &mesh.blocks[bi];
+        let n = b.elements.len() * stiffness_rule(b.elements.kind).len();
+        Some(&self.averaged[DRIVERS * off..DRIVERS * (off + n)])
+    }
+}
