@@ -81,6 +81,7 @@ fn element_updates(c: &mut Criterion) {
                                 u: &u,
                                 dt: m.analysis.dt,
                                 at_rest: false,
+                                frozen: false,
                             },
                             &mut stores,
                             &mut f,

@@ -76,6 +76,7 @@ fn passes(c: &mut Criterion) {
                             u: &u,
                             dt: 1e-6,
                             at_rest: false,
+                            frozen: false,
                         },
                         &mut points,
                         &mut f,

@@ -80,6 +80,7 @@ fn sls(c: &mut Criterion) {
                         u: &u,
                         dt: 1e-5,
                         at_rest: false,
+                        frozen: false,
                     },
                     &mut points,
                     &mut f,

@@ -38,7 +38,14 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-const VARIANTS: [&str; 5] = ["elastic", "sls", "mazars", "mazars-fixed", "rankine-hill"];
+const VARIANTS: [&str; 6] = [
+    "elastic",
+    "sls",
+    "mazars",
+    "mazars-fixed",
+    "mazars-nonlocal",
+    "rankine-hill",
+];
 
 #[test]
 fn steps_allocate_nothing_the_size_of_the_problem() {

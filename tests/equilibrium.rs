@@ -266,3 +266,75 @@ fn a_failed_return_is_an_outcome_with_its_element() {
         StepOutcome::Accepted(r) => panic!("accepted through an exhausted point: {r:?}"),
     }
 }
+
+#[test]
+fn a_prescribed_jump_does_not_damage_the_first_iterate() {
+    // A Mazars plate pulled at its right edge in load steps (statics, local law,
+    // A_t = 1, B_t = 1e4, ε_t0 = 1e-4). Evaluated at the jump, the first iterate of
+    // a step carries the whole increment in the last column of elements and would
+    // damage them below the threshold; with the first estimate the paper gives,
+    // D(u_{s-1}), the plate stays uniform: no damage while ε < ε_t0, then the same
+    // damage at every point, the uniaxial closed form D = 1 − e^{−B(ε − ε_t0)}.
+    let text = r#"
+[analysis]
+kind = "static"
+t_end = 1.0
+dt = 0.05
+vtk_every = 0
+[materials.concrete]
+model = "mazars"
+E = 30e9
+nu = 0.2
+rho = 2400.0
+eps_t0 = 1.0e-4
+A_t = 1.0
+B_t = 1.0e4
+A_c = 1.2
+B_c = 1.5e3
+[[bodies]]
+name = "plate"
+material = "concrete"
+thickness = 0.1
+mesh = { kind = "rectangle", size = [0.4, 0.2], divisions = [8, 4] }
+[[supports]]
+set = "plate.left"
+fix = ["x"]
+[[supports]]
+set = "plate.bottom_left"
+fix = ["y"]
+[[prescribed]]
+set = "plate.right"
+component = "x"
+value = 6.0e-5
+function = { kind = "ramp", t0 = 0.0, t1 = 1.0 }
+"#;
+    let m = model(text);
+    let mut st = Statics::new(&m, Backend::Faer).unwrap();
+    let mut s = st.initial_state();
+    march(
+        &mut st,
+        &mut s,
+        StepControl::of(&m),
+        |_, s: &rothe::time::State, _| {
+            let eps = s.t * 6.0e-5 / 0.4;
+            let c = s.points[0].committed();
+            let d: Vec<f64> = (0..c.n_points()).map(|g| c.history(g)[2]).collect();
+            let expected = if eps > 1e-4 {
+                1.0 - (-1e4 * (eps - 1e-4)).exp()
+            } else {
+                0.0
+            };
+            for &x in &d {
+                assert!(
+                    (x - expected).abs() <= 1e-9,
+                    "t = {}: D = {x}, expected {expected}",
+                    s.t
+                );
+            }
+            Ok(())
+        },
+    )
+    .unwrap();
+    let c = s.points[0].committed();
+    assert!((c.history(0)[2] - (1.0 - (-0.5f64).exp())).abs() < 1e-9);
+}

@@ -377,6 +377,7 @@ fn under_a_uniform_strain_nonlocal_is_local() {
                         u: &u,
                         dt: 1e-5,
                         at_rest: false,
+                        frozen: false,
                     },
                     &mut stores,
                     &mut f,

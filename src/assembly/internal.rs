@@ -111,6 +111,8 @@ struct Ctx<'a> {
     /// Evaluate the state at rest at `u` (the initial state): `ε_n = ε`, no
     /// history evolution, no dissipation.
     at_rest: bool,
+    /// Keep every history at its committed value (`Material::update_frozen`).
+    frozen: bool,
     /// The material's elasticity matrix in this plane idealisation.
     c: [[f64; 3]; 3],
     /// The averaged drivers of the block's points (`nonlocal::DRIVERS` per point)
@@ -130,6 +132,7 @@ impl<'a> Ctx<'a> {
     ) -> Self {
         Ctx {
             drivers: None,
+            frozen: false,
             mesh,
             mat,
             plane,
@@ -140,6 +143,12 @@ impl<'a> Ctx<'a> {
             at_rest,
             c: mat.c(plane),
         }
+    }
+
+    /// The same context with histories frozen (`frozen`).
+    fn frozen(mut self, frozen: bool) -> Self {
+        self.frozen = frozen;
+        self
     }
 
     /// The same context reading the averaged drivers `d` of a nonlocal block.
@@ -236,9 +245,13 @@ fn element_points<F>(
                 // SAFETY: point g belongs to element e only; the slots are disjoint
                 // parts of the trial buffer (see `Layout`).
                 let hist = unsafe { t.base.slice(t.layout.history() + g * ns, ns) };
-                let r = cx
-                    .mat
-                    .update_driven(&cx.c, cx.plane, &step, averaged, history_n, hist);
+                let r = if cx.frozen {
+                    cx.mat
+                        .update_frozen(&cx.c, cx.plane, &step, history_n, hist)
+                } else {
+                    cx.mat
+                        .update_driven(&cx.c, cx.plane, &step, averaged, history_n, hist)
+                };
                 unsafe {
                     write3(t.base.slice(t.layout.eps() + 3 * g, 3), &eps);
                     write3(t.base.slice(t.layout.sigma() + 3 * g, 3), &r.sigma);
@@ -341,6 +354,11 @@ pub struct PointPass<'a> {
     pub dt: f64,
     /// Evaluate the state at rest at `u` (the initial state: history not evolved).
     pub at_rest: bool,
+    /// Keep every history at its committed value where the material has such a
+    /// form (`Material::update_frozen`): the first iterate of an implicit step whose
+    /// prescribed displacements jump, evaluated with the last step's damage (the
+    /// paper's first estimate `D(u_{s−1})`).
+    pub frozen: bool,
 }
 
 impl Assembler {
@@ -394,6 +412,7 @@ impl Assembler {
                 predict,
                 pass.at_rest,
             )
+            .frozen(pass.frozen)
             .with_drivers(nonlocal.as_ref().and_then(|n| n.block(mesh, bi)));
             let ng = points_per_element(block.elements.kind);
             for colour in &self.colours[bi] {

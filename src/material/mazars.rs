@@ -275,6 +275,24 @@ pub fn update(
     state[0] = k1;
     state[1] = k2;
     state[2] = d;
+    secant_response(c, step, dn, d)
+}
+
+/// The Mazars point with its history frozen at the committed state: `D = D⁰`,
+/// `σ = (1 − D⁰)Cε` (the paper's first estimate of a step, `D(u_{s−1})`).
+pub fn frozen(
+    c: &[[f64; 3]; 3],
+    step: &StrainStep,
+    state_n: &[f64],
+    state: &mut [f64],
+) -> PointResponse {
+    state.copy_from_slice(&state_n[..state.len()]);
+    secant_response(c, step, state_n[2], state_n[2])
+}
+
+/// Stress, secant, stored energy and the step's dissipation of a point whose damage
+/// goes from `dn` to `d` (theory/damage.md, (M4)–(M6)).
+fn secant_response(c: &[[f64; 3]; 3], step: &StrainStep, dn: f64, d: f64) -> PointResponse {
     let ce = mul3(c, &step.eps);
     let y1 = 0.5 * dot3(&step.eps, &ce);
     let y0 = 0.5 * dot3(&step.eps_n, &mul3(c, &step.eps_n));

@@ -397,6 +397,29 @@ impl Material {
         self.update_driven(c, plane, step, None, state_n, state)
     }
 
+    /// [`Material::update_with`] with every history frozen at its committed value
+    /// where the model has such a form (Mazars: `D = D⁰`, the secant of the last
+    /// step, the paper's first estimate); the ordinary update for the others.
+    pub fn update_frozen(
+        &self,
+        c: &[[f64; 3]; 3],
+        plane: Plane,
+        step: &StrainStep,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse {
+        match self.model {
+            Model::Mazars(_) => mazars::frozen(c, step, state_n, state),
+            _ => self.update_with(c, plane, step, state_n, state),
+        }
+    }
+
+    /// Whether [`Material::update_frozen`] differs from the update (a state the
+    /// first iterate of a step with prescribed increments must not evolve).
+    pub fn has_frozen_form(&self) -> bool {
+        matches!(self.model, Model::Mazars(_))
+    }
+
     /// [`Material::update_with`] where the damage of a nonlocal material is driven by
     /// `averaged`, the nonlocal average of its equivalent strains at this point
     /// ([`mazars::drivers`]); `None` (and every other model) takes the point's own.

@@ -51,6 +51,9 @@ pub struct Evaluation {
     pub tangent: bool,
     /// A material point whose update failed.
     pub failure: Option<PointFailure>,
+    /// The evaluation kept the histories committed (a step's first estimate): it may
+    /// start the iteration but never ends it.
+    pub provisional: bool,
 }
 
 /// Relative round-off of a residual: an iterate whose residual is below `ROUNDOFF`
@@ -249,6 +252,7 @@ where
             }
             let at_roundoff = r2 <= ROUNDOFF * ROUNDOFF * ev.magnitude2;
             if finite
+                && !ev.provisional
                 && ((nl <= test.tolerance && small_correction) || at_roundoff)
                 && test.constraints_hold(&constraints)
             {

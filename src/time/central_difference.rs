@@ -166,6 +166,7 @@ impl<'m> CentralDifference<'m> {
                     u,
                     dt: self.h,
                     at_rest,
+                    frozen: false,
                 },
                 points,
                 f,

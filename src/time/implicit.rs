@@ -317,6 +317,7 @@ impl Operators {
                 u: &u,
                 dt: self.h(),
                 at_rest: true,
+                frozen: false,
             };
             let totals = self.internal(model, pass, &mut points, &mut f_int, pred, None);
             points.iter_mut().for_each(|p| p.commit());
@@ -436,6 +437,9 @@ struct ImplicitStep<'a> {
     w: &'a mut Scratch,
     /// Prescribed displacements move in this step (`Δu_c ≠ 0`).
     moving: bool,
+    /// The next evaluation keeps the histories committed (the first of a step with
+    /// moving prescribed displacements and a material with a frozen form).
+    frozen_first: bool,
 }
 
 impl StepProblem for ImplicitStep<'_> {
@@ -503,6 +507,7 @@ impl StepProblem for ImplicitStep<'_> {
         // `kdu` holds K Δu (the elastic force increment, and h K v for damping).
         let p = &ops.asm.pattern;
         let mut failure = None;
+        let mut provisional = false;
         let elastic = ops.response == Response::Elastic;
         if elastic {
             // K Δu (and M Δu with a consistent mass) in one pass over the pattern.
@@ -539,10 +544,17 @@ impl StepProblem for ImplicitStep<'_> {
         } else {
             let pred = (!w.f_pred_np1.is_empty()).then_some(&mut w.f_pred_np1[..]);
             let kt = tangent.then_some(&mut w.kt[..]);
+            // The first evaluation of a step whose prescribed displacements jump keeps
+            // the damage of the last step (the paper's first estimate): evaluated at
+            // the jump, the whole increment sits in the elements next to the moved
+            // dofs and could damage them in an iterate the solution never visits.
+            let frozen = std::mem::take(&mut self.frozen_first);
+            provisional = frozen;
             let pass = PointPass {
                 u,
                 dt: h,
                 at_rest: false,
+                frozen,
             };
             w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int_np1, pred, kt);
             failure = w.totals.failure;
@@ -609,6 +621,7 @@ impl StepProblem for ImplicitStep<'_> {
             increment2: sums[1],
             tangent,
             failure,
+            provisional,
         }
     }
 
@@ -808,12 +821,16 @@ pub(crate) fn step(
     let mut u = std::mem::take(&mut w.u_np1);
     let mut nl = std::mem::take(&mut w.nl);
     let outcome = {
+        let frozen_first = moving
+            && matches!(ops.response, Response::StateDependent(_))
+            && model.materials.iter().any(|m| m.has_frozen_form());
         let mut problem = ImplicitStep {
             model,
             ops,
             s,
             w,
             moving,
+            frozen_first,
         };
         nonlinear::solve(&mut problem, correction, sys, &ops.test, &mut u, &mut nl)
     };
