@@ -72,7 +72,7 @@ pub fn material_lines(m: &crate::material::Material) -> Vec<String> {
         m.rho
     )];
     if let Some(from) = &m.identified_from {
-        lines.push(from.clone());
+        lines.push(format!("identified from {from}"));
     }
     let params = m.parameters();
     if !params.is_empty() {

@@ -274,3 +274,52 @@ fn material_driver_writes_curves_and_rejects_bad_parameters() {
         }
     }
 }
+
+#[test]
+fn check_and_material_print_the_identified_concrete() {
+    // `rothe check` on the cracking cantilever (identified, nonlocal) and `rothe
+    // material` on a class: both print the data the parameters came from and the
+    // parameters; `summary.json` says which regularisation ran.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sc = root.join("examples/scenarios/cracking_cantilever.toml");
+    let (ok, out, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    for s in [
+        "identified from the concrete's data",
+        "f_cm = 3.800e7",
+        "eps_c0 = 3.107e-4",
+        "A_c = 1.353",
+        "regularisation = nonlocal",
+        "nonlocal    ",
+    ] {
+        assert!(out.contains(s), "{s} missing:\n{out}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let m = root.join("examples/materials/mazars_compression.toml");
+    let (ok, _, err) = rothe(&[
+        "material",
+        m.to_str().unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("C30/37 (EN 1992-1-1 Table 3.1") && err.contains("E = E_cm"),
+        "{err}"
+    );
+    let out = dir.path().join("run");
+    let (ok, _, err) = rothe(&[
+        "run",
+        sc.to_str().unwrap(),
+        "--set",
+        "analysis.t_end=5e-5",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(v["materials"]["concrete"]["regularisation"], "nonlocal");
+    assert_eq!(v["materials"]["concrete"]["radius"], 0.1);
+}

@@ -120,7 +120,8 @@ pub struct Material {
     /// The constitutive model.
     pub model: Model,
     /// Where the model's parameters came from when they were identified from the
-    /// concrete's data (`identify` in a scenario), for `check` and `material`.
+    /// concrete's data (`identify` in a scenario): the source and the data, e.g.
+    /// `C30/37 (EN 1992-1-1 Table 3.1, ...): E = ..., f_ct = ...`.
     pub identified_from: Option<String>,
 }
 

@@ -220,7 +220,7 @@ fn concrete_data(
     check_elastic(field, d.e, d.nu, 1.0)?;
     let g = crate::material::sig;
     let line = format!(
-        "identified from {source}: E = {}, nu = {}, f_ct = {}, f_cm = {}, eps_c1 = {}",
+        "{source}: E = {}, nu = {}, f_ct = {}, f_cm = {}, eps_c1 = {}",
         g(d.e),
         d.nu,
         g(d.f_ct),
