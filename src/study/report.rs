@@ -26,9 +26,7 @@ pub const BENCHMARK1_MODELS: [&str; 6] = [
 ];
 /// The meshes of benchmark 1 (NOTES.md's four and 0.025 m).
 pub const BENCHMARK1_MESHES: [f64; 5] = [0.2, 0.15, 0.1, 0.05, 0.025];
-/// The damage models' extra, finer meshes of benchmark 1.
-pub const DAMAGE_MESHES: [f64; 1] = [0.0125];
-/// The damage models run on [`DAMAGE_MESHES`] too.
+/// The damage models run on `ReportOptions::damage_meshes` too.
 pub const DAMAGE_MODELS: [&str; 2] = ["mazars", "mazars_local"];
 /// The concrete models of benchmark 2.
 pub const BENCHMARK2_MODELS: [&str; 4] = ["mazars", "mazars_local", "rankine_hill", "kelvin_voigt"];
@@ -55,7 +53,7 @@ impl Default for ReportOptions {
         ReportOptions {
             benchmarks: PathBuf::from("examples/benchmarks"),
             meshes: BENCHMARK1_MESHES.to_vec(),
-            damage_meshes: DAMAGE_MESHES.to_vec(),
+            damage_meshes: Vec::new(),
             compare_mesh: 0.1,
             beam_size: None,
             base: Overrides::none(),
