@@ -201,6 +201,9 @@ fn benchmark_1_dissipation_over_the_meshes() {
     assert!(diffs[1].abs() < diffs[0].abs(), "bilinearised: {diffs:?}");
     for (a, b) in nonlocal.iter().zip(&local) {
         assert!(*a > 0.5 && *b > 0.5, "the block breaks: {a}, {b}");
-        assert!((a - b).abs() < 0.1 * a, "diffuse damage: nonlocal {a}, local {b}");
+        assert!(
+            (a - b).abs() < 0.1 * a,
+            "diffuse damage: nonlocal {a}, local {b}"
+        );
     }
 }

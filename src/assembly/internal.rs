@@ -211,14 +211,7 @@ fn element_points<F>(
     }
     let rule = stiffness_rule(cx.kind);
     // Element size for crack-band regularisation: the square root of its area.
-    let area = 0.5
-        * (0..nn)
-            .map(|a| {
-                let b = (a + 1) % nn;
-                x[a][0] * x[b][1] - x[b][0] * x[a][1]
-            })
-            .sum::<f64>();
-    let length = area.abs().sqrt();
+    let length = crate::mesh::polygon_area(&x[..nn]).abs().sqrt();
     let ns = cx.mat.n_state();
     let mut scratch = [0.0; MAX_STATE];
     for (q, &(xi, wq)) in rule.iter().enumerate() {

@@ -99,21 +99,7 @@ pub fn estimated_entries(mesh: &Mesh, materials: &[Material]) -> (u64, u64) {
         };
         let n = (b.elements.len() * stiffness_rule(b.elements.kind).len()) as u64;
         let area: f64 = (0..b.elements.len())
-            .map(|e| {
-                let x: Vec<[f64; 2]> = b
-                    .elements
-                    .element(e)
-                    .iter()
-                    .map(|&k| mesh.coords[k])
-                    .collect();
-                0.5 * (0..x.len())
-                    .map(|a| {
-                        let c = (a + 1) % x.len();
-                        x[a][0] * x[c][1] - x[c][0] * x[a][1]
-                    })
-                    .sum::<f64>()
-                    .abs()
-            })
+            .map(|e| mesh.element_area(bi, e))
             .sum();
         let per_point = (std::f64::consts::PI * r * r * n as f64 / area.max(f64::MIN_POSITIVE))
             .clamp(1.0, n as f64);

@@ -60,6 +60,18 @@ impl Elements {
     }
 }
 
+/// The signed area of the polygon `x` (positive when its vertices run
+/// counter-clockwise).
+#[inline]
+pub fn polygon_area(x: &[[f64; 2]]) -> f64 {
+    0.5 * (0..x.len())
+        .map(|a| {
+            let b = (a + 1) % x.len();
+            x[a][0] * x[b][1] - x[b][0] * x[a][1]
+        })
+        .sum::<f64>()
+}
+
 /// The shape of a continuum element, from the Jacobian of its reference map at its
 /// corners and Gauss points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,13 +101,7 @@ impl Shape {
                 Shape::Degenerate
             };
         }
-        let area = 0.5
-            * (0..x.len())
-                .map(|a| {
-                    let b = (a + 1) % x.len();
-                    x[a][0] * x[b][1] - x[b][0] * x[a][1]
-                })
-                .sum::<f64>();
+        let area = polygon_area(x);
         if area.is_nan() || area.abs() <= 1e-12 * size * size {
             return Shape::Degenerate;
         }
@@ -342,6 +348,16 @@ impl Mesh {
             }
         }
         size
+    }
+
+    /// The area of continuum element `e` of `block`.
+    pub fn element_area(&self, block: usize, e: usize) -> f64 {
+        let nodes = self.blocks[block].elements.element(e);
+        let mut x = [[0.0; 2]; 4];
+        for (a, &n) in nodes.iter().enumerate() {
+            x[a] = self.coords[n];
+        }
+        polygon_area(&x[..nodes.len()]).abs()
     }
 
     /// Characteristic length of element `e` of `block` (the CFL estimate takes the minimum):

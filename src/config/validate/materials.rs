@@ -110,20 +110,7 @@ pub(super) fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()
         };
         let limit = 2.0 * fracture_energy * mat.e / (strength * strength);
         for e in 0..b.elements.len() {
-            let x: Vec<[f64; 2]> = b
-                .elements
-                .element(e)
-                .iter()
-                .map(|&n| mesh.coords[n])
-                .collect();
-            let area = 0.5
-                * (0..x.len())
-                    .map(|a| {
-                        let c = (a + 1) % x.len();
-                        x[a][0] * x[c][1] - x[c][0] * x[a][1]
-                    })
-                    .sum::<f64>();
-            let h = area.abs().sqrt();
+            let h = mesh.element_area(bi, e).sqrt();
             if h >= limit {
                 return Err(Error::config(
                     format!("materials.{}.{key}", mat.name),
