@@ -375,8 +375,9 @@ impl Assembler {
         mut tangent: Option<&mut [f64]>,
     ) -> PointTotals {
         let u = pass.u;
-        // Nonlocal materials: their drivers averaged at `u` first (one more pass).
-        let nonlocal = self.nonlocal_at(mesh, materials, plane, u, stores);
+        // Nonlocal materials: their drivers averaged at `u` first (one more pass; a
+        // frozen pass reads none).
+        let nonlocal = (!pass.frozen).then(|| self.nonlocal_at(mesh, materials, plane, u, stores));
         f.fill(0.0);
         let kp = tangent.as_mut().map(|k| {
             k.fill(0.0);
@@ -406,7 +407,12 @@ impl Assembler {
                 pass.at_rest,
             )
             .frozen(pass.frozen)
-            .with_drivers(nonlocal.as_ref().and_then(|n| n.block(mesh, bi)));
+            .with_drivers(
+                nonlocal
+                    .as_ref()
+                    .and_then(|g| g.as_ref())
+                    .and_then(|n| n.block(mesh, bi)),
+            );
             let ng = points_per_element(block.elements.kind);
             for colour in &self.colours[bi] {
                 // In halves of a fixed tree (`crate::halves`): the same totals in
