@@ -178,7 +178,7 @@ fn b1_dissipation(m: &str, sizes: &[f64], dir: &Path) -> Vec<f64> {
 }
 
 #[test]
-#[ignore = "long: benchmark 1 with three Mazars models on 0.1, 0.05 and 0.025 m (about 10 minutes on two cores)"]
+#[ignore = "long: benchmark 1 with three Mazars models on 0.1, 0.05 and 0.025 m (about 11 minutes on two cores)"]
 fn benchmark_1_dissipation_over_the_meshes() {
     // theory/benchmarks.md, "Mesh convergence". The bilinearised Mazars law (tension
     // held at f_ct, nonlocal) does not soften: its dissipation converges, the
