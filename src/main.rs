@@ -124,6 +124,11 @@ enum StudyCommand {
         /// Or: the scenario's step and N halvings of it.
         #[arg(long)]
         halvings: Option<usize>,
+        /// The errors are measured against a reference run 2^K times finer than the
+        /// finest step (0: against the finest run itself, whose last orders then lean
+        /// high).
+        #[arg(long, default_value_t = rothe::study::time_study::DEFAULT_REFERENCE_HALVINGS)]
+        reference_halvings: usize,
         #[command(flatten)]
         sweep: SweepArgs,
     },
@@ -403,6 +408,7 @@ fn study_command(study: StudyCommand) -> rothe::Result<()> {
             scenario,
             h,
             halvings,
+            reference_halvings,
             sweep,
         } => {
             let base = scenario.overrides()?;
@@ -410,7 +416,8 @@ fn study_command(study: StudyCommand) -> rothe::Result<()> {
                 Some(n) => rothe::study::time_study::halvings(&scenario.scenario, &base, n)?,
                 None => h,
             };
-            let plan = rothe::study::time_study::plan(&scenario.scenario, &base, &hs)?;
+            let plan =
+                rothe::study::time_study::plan(&scenario.scenario, &base, &hs, reference_halvings)?;
             sweep.execute(&plan)
         }
         StudyCommand::Mesh {

@@ -49,6 +49,11 @@ fn cell(row: &std::collections::BTreeMap<String, String>, col: &str) -> f64 {
 
 #[test]
 fn time_study_of_the_wave_in_a_bar_converges_at_first_order() {
+    // The wave bar as a 1D strip (50 x 1 Q4): its highest mode has ω h = 0.2-3 over
+    // the steps studied, so the observed order climbs to 1 from below. The errors
+    // are measured against a reference four times finer than the finest step (the
+    // default): against the finest run itself the last order would read 1.40
+    // (theory/studies.md), and a half-order scheme would read 0.5-0.6.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("study");
     let (ok, md, err) = rothe(&[
@@ -59,30 +64,34 @@ fn time_study_of_the_wave_in_a_bar_converges_at_first_order() {
         "analysis.t_end=3e-4",
         "--set",
         "analysis.vtk_every=0",
+        "--set",
+        "bodies.bar.mesh.divisions=[50, 1]",
         "--h",
-        "4e-7,2e-7,1e-7,5e-8,2.5e-8",
+        "8e-7,4e-7,2e-7,1e-7,5e-8",
         "--out",
         out.to_str().unwrap(),
         "--quiet",
     ]);
     assert!(ok, "{err}");
-    assert!(md.contains("Time study"), "{md}");
+    assert!(
+        md.contains("Time study") && md.contains("a run of its own"),
+        "{md}"
+    );
     let rows = study_rows(&out);
-    assert_eq!(rows.len(), 5);
-    // Observed orders of the L∞(0,T; L2) errors of both interpolants between the
-    // three coarsest runs (the finest pair measures against a reference only twice
-    // as fine, which inflates its order: Richardson's column corrects for it).
+    assert_eq!(
+        rows.len(),
+        5,
+        "the studied runs; the reference is not a row"
+    );
+    // Observed orders of the L∞(0,T; L2) errors of both interpolants: each within
+    // [0.75, 1.15], and the finest pair's at least 0.9.
     for col in ["order_constant_Linf_L2", "order_linear_Linf_L2"] {
-        for row in &rows[1..3] {
-            let p = cell(row, col);
-            assert!((0.75..1.35).contains(&p), "{col} = {p}");
-        }
+        let p: Vec<f64> = rows[1..].iter().map(|r| cell(r, col)).collect();
+        assert!(p.iter().all(|x| (0.75..1.15).contains(x)), "{col}: {p:?}");
+        assert!(p[p.len() - 1] >= 0.9, "{col}: {p:?}");
     }
     // Errors fall monotonically and the energy bound max_s E_s is finite.
-    let e: Vec<f64> = rows[..4]
-        .iter()
-        .map(|r| cell(r, "err_linear_L2_H1"))
-        .collect();
+    let e: Vec<f64> = rows.iter().map(|r| cell(r, "err_linear_L2_H1")).collect();
     assert!(e.windows(2).all(|w| w[1] < w[0]), "{e:?}");
     assert!(rows.iter().all(|r| cell(r, "max_energy").is_finite()));
     for f in ["study.md", "plots/convergence.png", "plots/convergence.svg"] {
@@ -111,11 +120,20 @@ fn time_study_of_benchmark_1_converges_at_first_order() {
         "--quiet",
     ]);
     assert!(ok, "{err}");
+    // Against the default reference (four times finer than 5e-7) the orders climb to
+    // 1 through the impact's pre-asymptotic range (0.68, 0.78, 0.90, 1.08 when this
+    // was written): the two finest pairs within [0.85, 1.15], none below 0.6. Against
+    // the finest run the last would read 1.40; a half-order scheme, about 0.5-0.6.
     let rows = study_rows(&out);
-    for row in &rows[1..3] {
-        let p = cell(row, "order_linear_Linf_L2");
-        assert!((0.7..1.5).contains(&p), "order {p}");
-    }
+    let p: Vec<f64> = rows[1..]
+        .iter()
+        .map(|r| cell(r, "order_linear_Linf_L2"))
+        .collect();
+    assert!(p.iter().all(|x| (0.6..1.15).contains(x)), "orders {p:?}");
+    assert!(
+        p[p.len() - 2..].iter().all(|x| (0.85..1.15).contains(x)),
+        "orders {p:?}"
+    );
 }
 
 #[test]

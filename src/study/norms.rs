@@ -1,10 +1,14 @@
 //! Inner products of displacement fields on a mesh: `L2(Ω)` and `H1(Ω)`
-//! (`(x, y)_H1 = ∫ x·y + ∇x:∇y dΩ`), by the stiffness quadrature of every continuum
-//! element (exact for bilinear fields on parallelograms). Bars are lines of the
-//! continuum's nodes and add nothing. The domain is the plane section (no thickness
-//! weight): the norms of the Rothe theory on `Ω ⊂ R²`.
+//! (`(x, y)_H1 = ∫ x·y + ∇x:∇y dΩ`), by the mass quadrature of every continuum
+//! element, which is exact for the products of its shape functions: 2×2 Gauss on a
+//! parallelogram Q4 (bilinear times bilinear), the three-point rule on a T3 (linear
+//! times linear, quadratic). The one-point stiffness rule of a T3 would see only the
+//! centroid, where a linear field with nodal values `(1, −1, 0)` vanishes although
+//! its `∫ u² = A/6`: a seminorm. Bars are lines of the continuum's nodes and add
+//! nothing. The domain is the plane section (no thickness weight): the norms of the
+//! Rothe theory on `Ω ⊂ R²`.
 
-use crate::fe::{kinematics, stiffness_rule, ElementKind};
+use crate::fe::{kinematics, mass_rule, ElementKind};
 use crate::mesh::Mesh;
 
 /// One Gauss point: weight × det J, shape values and gradients, element nodes.
@@ -45,7 +49,7 @@ impl Norms {
                 let x: Vec<[f64; 2]> = conn.iter().map(|&n| mesh.coords[n]).collect();
                 let mut nodes = [0; 4];
                 nodes[..nn].copy_from_slice(conn);
-                for &(xi, w) in stiffness_rule(kind) {
+                for &(xi, w) in mass_rule(kind) {
                     let k = kinematics(kind, &x, xi);
                     points.push(Point {
                         w: w * k.det_j,
@@ -92,7 +96,7 @@ impl Norms {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::structured;
+    use crate::mesh::{structured, Part};
 
     #[test]
     fn norms_of_linear_fields_are_exact() {
@@ -109,5 +113,32 @@ mod tests {
         let v: Vec<f64> = mesh.coords.iter().flat_map(|c| [0.0, c[1]]).collect();
         let q = Norms::new(&mesh).products(&u, &v);
         assert!(q.l2.abs() < 1e-14 && q.h1.abs() < 1e-14);
+    }
+
+    #[test]
+    fn norms_of_linear_fields_on_triangles_are_exact() {
+        // One T3 of area A = 1/2 with the nodal values (1, −1, 0) in x: the field
+        // u = 1 − 2x − y vanishes at the centroid, yet ∫u² = A/6 (the mass matrix
+        // A/12 (1 + δ_ab) applied to (1, −1, 0)) and ∫|∇u|² = A |(−2, −1)|² = 5A.
+        let part = Part {
+            coords: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            blocks: vec![crate::mesh::Elements::new(ElementKind::Tri3, vec![0, 1, 2])],
+            ..Default::default()
+        };
+        let mut mesh = Mesh::default();
+        mesh.add_part(&part, 0, "b", 0, 1.0);
+        let u = [1.0, 0.0, -1.0, 0.0, 0.0, 0.0];
+        let p = Norms::new(&mesh).products(&u, &u);
+        let a = 0.5;
+        assert!((p.l2 - a / 6.0).abs() < 1e-15, "{}", p.l2);
+        assert!((p.h1 - p.l2 - a * 5.0).abs() < 1e-14, "{}", p.h1);
+        // The linear fields of the Q4 test on triangles: ∫x² = 8/3 on [0,2]x[0,1].
+        let mut mesh = Mesh::default();
+        let part = structured::rectangle([0.0, 0.0], [2.0, 1.0], 4, 3, ElementKind::Tri3);
+        mesh.add_part(&part, 0, "b", 0, 1.0);
+        let u: Vec<f64> = mesh.coords.iter().flat_map(|c| [c[0], 0.0]).collect();
+        let p = Norms::new(&mesh).products(&u, &u);
+        assert!((p.l2 - 8.0 / 3.0).abs() < 1e-12, "{}", p.l2);
+        assert!((p.h1 - p.l2 - 2.0).abs() < 1e-12, "{}", p.h1);
     }
 }

@@ -1,10 +1,12 @@
 //! `rothe study time`: one scenario for a sequence of steps `h`, the Rothe
-//! interpolants of each run against the finest.
+//! interpolants of each run against a reference run `2^K` times finer than the
+//! finest studied step (`--reference-halvings K`, default 2; `K = 0` takes the finest
+//! studied run itself).
 //!
 //! For a run with states `u_k` at `t_k`, the piecewise-constant interpolant is
 //! `ū(t) = u_k` on `(t_{k−1}, t_k]` and the piecewise-linear one `û` joins the
-//! states. Both are compared with the finest run's piecewise-linear interpolant, on
-//! the finest run's intervals: there the difference is linear in `t` (the coarse
+//! states. Both are compared with the reference run's piecewise-linear interpolant,
+//! on the reference's intervals: there the difference is linear in `t` (the coarse
 //! steps are multiples of the finest), so `sup_t ‖e‖` is attained at an interval's
 //! end and `∫ ‖e‖² dt = τ/3 (‖e_a‖² + (e_a, e_b) + ‖e_b‖²)` exactly. The norms are
 //! `L∞(0,T; L2(Ω))` and `L2(0,T; H1(Ω))` ([`super::norms`]). Fields stream from each
@@ -22,8 +24,21 @@ use crate::error::{Error, Result};
 use crate::output::fields::FieldReader;
 use crate::plot::{draw, reference_slope, Figure, Series, Style};
 
-/// The plan of a time study: `hs` (any order; sorted coarse to fine).
-pub fn plan(scenario: &Path, base: &Overrides, hs: &[f64]) -> Result<Plan> {
+/// The id of the reference run of a time study.
+pub const REFERENCE_ID: &str = "reference";
+
+/// Reference halvings beyond the finest studied step, by default: the errors of the
+/// finest studied run against a reference four times finer.
+pub const DEFAULT_REFERENCE_HALVINGS: usize = 2;
+
+/// The plan of a time study: `hs` (any order; sorted coarse to fine) and, for
+/// `reference_halvings > 0`, the reference run at `min(hs) / 2^reference_halvings`.
+pub fn plan(
+    scenario: &Path,
+    base: &Overrides,
+    hs: &[f64],
+    reference_halvings: usize,
+) -> Result<Plan> {
     let scenario = super::plan::absolute(scenario)?;
     let mut hs: Vec<f64> = hs.to_vec();
     if hs.len() < 2 || hs.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
@@ -34,22 +49,37 @@ pub fn plan(scenario: &Path, base: &Overrides, hs: &[f64]) -> Result<Plan> {
     }
     hs.sort_by(|a, b| b.total_cmp(a));
     hs.dedup();
-    let runs = hs
+    if reference_halvings > 20 {
+        return Err(Error::config(
+            "--reference-halvings",
+            format!("at most 20 (a reference 2^20 times finer), got {reference_halvings}"),
+        ));
+    }
+    let run = |id: String, h: f64, label: String| PlannedRun {
+        id,
+        scenario: scenario.clone(),
+        overrides: base.then(
+            &Overrides::none()
+                .set(&format!("analysis.dt={h:e}"))
+                .expect("k=v"),
+        ),
+        param: h,
+        label,
+        record_fields: true,
+    };
+    let mut runs: Vec<PlannedRun> = hs
         .iter()
         .enumerate()
-        .map(|(i, h)| PlannedRun {
-            id: format!("h{i}"),
-            scenario: scenario.clone(),
-            overrides: base.then(
-                &Overrides::none()
-                    .set(&format!("analysis.dt={h:e}"))
-                    .expect("k=v"),
-            ),
-            param: *h,
-            label: format!("h = {h:.3e} s"),
-            record_fields: true,
-        })
+        .map(|(i, &h)| run(format!("h{i}"), h, format!("h = {h:.3e} s")))
         .collect();
+    if reference_halvings > 0 {
+        let h = hs[hs.len() - 1] / f64::powi(2.0, reference_halvings as i32);
+        runs.push(run(
+            REFERENCE_ID.into(),
+            h,
+            format!("reference, h = {h:.3e} s"),
+        ));
+    }
     Ok(Plan {
         kind: StudyKind::Time,
         runs,
@@ -150,8 +180,7 @@ fn accumulate(norms: &Norms, ea: &[f64], eb: &[f64], tau: f64, sup: &mut f64, in
     *int += tau / 3.0 * (aa.h1 + ab.h1 + bb.h1);
 }
 
-/// The errors of every run but the last against the last (the finest), streaming
-/// the fields.
+/// The errors of every run of `runs` against `reference`, streaming the fields.
 pub fn errors(norms: &Norms, runs: &[&Path], reference: &Path) -> Result<Vec<Errors>> {
     let mut fine = FieldReader::open(reference)?;
     let n = fine.dofs();
@@ -227,8 +256,27 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
             runs.len()
         )));
     }
-    let reference = done[done.len() - 1];
-    let coarse = &done[..done.len() - 1];
+    // The reference run when the plan has one (and it completed), else the finest.
+    let (reference, coarse): (&RunData, Vec<&RunData>) =
+        match done.iter().position(|r| r.run.id == REFERENCE_ID) {
+            Some(i) => (
+                done[i],
+                done.iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != i)
+                    .map(|(_, r)| *r)
+                    .collect(),
+            ),
+            None => (done[done.len() - 1], done[..done.len() - 1].to_vec()),
+        };
+    let separate = reference.run.id == REFERENCE_ID;
+    if coarse.len() < 2 && separate || coarse.is_empty() {
+        return Err(Error::Stepping(format!(
+            "a time study needs two completed runs besides its reference, {} of {} completed",
+            coarse.len(),
+            runs.len()
+        )));
+    }
     let model = load_with_overrides(
         &reference.run.scenario,
         &LoadOptions::unlimited(),
@@ -273,7 +321,12 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
         header.push(format!("richardson_{n}"));
     }
     let mut table = Table::new(&header);
-    for (i, r) in done.iter().enumerate() {
+    let rows: Vec<&RunData> = if separate {
+        coarse.clone()
+    } else {
+        done.clone()
+    };
+    for (i, r) in rows.iter().enumerate() {
         let mut row = vec![
             format!("{:e}", r.run.param),
             num(r.number("/steps")),
@@ -299,7 +352,11 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     table.write_csv(&dir.join("study.csv"))?;
     // Convergence plot with reference slopes of order 1 and 1/2.
     let mut fig = Figure::new(
-        "Rothe interpolants against the finest run",
+        if separate {
+            "Rothe interpolants against the reference run"
+        } else {
+            "Rothe interpolants against the finest run"
+        },
         "h [s]",
         "error norm (SI units)",
     )
@@ -320,12 +377,20 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     }
     draw(&fig, &dir.join("plots").join("convergence"))?;
     super::mesh_study::probe_overlay(dir, &done, "time")?;
+    let which = if separate {
+        format!("a run of its own, h = {h_ref:e} s, finer than every studied step")
+    } else {
+        format!(
+            "the finest run, h = {h_ref:e} s (no separate reference: the last observed \
+             orders lean high, theory/studies.md)"
+        )
+    };
     let mut md = format!(
-        "# Time study: {}\n\nReference: the finest run, h = {h_ref:e} s. Errors of the \
-         Rothe interpolants against its piecewise-linear interpolant; observed order \
-         between consecutive runs; Richardson's estimate of the true error (order of \
-         the two finest runs). `max_energy` is the discrete energy bound max_s (E_kin + \
-         E_el). Table: `study.csv`; plots: `plots/convergence.png`, `plots/probe_*`.\n\n",
+        "# Time study: {}\n\nReference: {which}. Errors of the Rothe interpolants \
+         against its piecewise-linear interpolant; observed order between consecutive \
+         runs; Richardson's estimate of the true error (order of the two finest runs). \
+         `max_energy` is the discrete energy bound max_s (E_kin + E_el). Table: \
+         `study.csv`; plots: `plots/convergence.png`, `plots/probe_*`.\n\n",
         reference.run.scenario.display()
     );
     let mut short = Table::new(&[
