@@ -1,6 +1,7 @@
 //! Implicit contact: a block resting on a block, two bars colliding head on against
 //! 1D wave theory, momentum in a free collision, condensed against full QP with the
-//! KKT conditions, a beam dropped on unilateral supports, ledgers with every material
+//! KKT conditions, a beam dropped on unilateral supports, the energy split of an impact
+//! against its closed form, ledgers with every material
 //! model, and the validation of contact pairs.
 
 use std::path::Path;
@@ -571,5 +572,151 @@ fn check_writes_the_matrices_and_the_gap_rows_in_matrix_market() {
         }
         assert!(sx.abs() < 1e-15 && sy.abs() < 1e-15, "{row:?}");
         assert_eq!(m.mesh.node_body[slave.expect("a slave entry +1 in y")], 1);
+    }
+}
+
+/// A very stiff block 0.1 x 0.1 m (thickness 0.1 m, density 1000, mass 1 kg) falling
+/// at `v0` onto a rigid line, its bottom `θ h v0` above it: the gap closes at the
+/// fraction `θ` of the first step. `E` is high enough that the block moves as a rigid
+/// mass over a step: its elastic energy under the impact force is `λ²/K`, a fraction
+/// `1/(ωh)² ≈ 1e-6` of `m v0²`. The run is the contact step and the step after (a
+/// body at rest with such a stiffness has no force to measure its residual against).
+fn rigid_drop(theta: f64, h: f64, v0: f64) -> String {
+    let gap = theta * h * v0;
+    format!(
+        r#"
+[analysis]
+t_end = {t_end:e}
+dt = {h:e}
+vtk_every = 0
+
+[materials.rigid]
+model = "elastic"
+E = 1.0e13
+nu = 0.0
+rho = 1000.0
+
+[[bodies]]
+name = "block"
+material = "rigid"
+thickness = 0.1
+velocity = [0.0, {vy:e}]
+mesh = {{ kind = "rectangle", origin = [-0.05, {gap:e}], size = [0.1, 0.1], divisions = [1, 1] }}
+
+[[contact]]
+name = "wall"
+slave = "block.bottom"
+rigid_line = [[-1.0, 0.0], [1.0, 0.0]]
+"#,
+        t_end = 2.0 * h,
+        vy = -v0,
+    )
+}
+
+#[test]
+fn a_rigid_mass_hitting_a_wall_splits_its_energy_as_the_closed_form_says() {
+    // theory/contact.md, "The energy of an implicit impact": a rigid mass m at v0
+    // whose gap closes at the fraction θ of the contact step. Contact step: v¹ = θ v0,
+    // ΔD_contact = λ g⁰ = m v0² θ(1 − θ), ΔD_num = ½ m v0² (1 − θ)². The step after:
+    // the mass still moves towards the wall at v¹ with g⁰ = 0, so v² = 0, ΔD_contact = 0,
+    // ΔD_num = ½ m v0² θ². Over the impact D_contact = m v0² θ(1 − θ) and
+    // D_num = ½ m v0² (θ² + (1 − θ)²).
+    let (h, v0, m) = (1e-3, 1.0, 1.0);
+    let e0 = 0.5 * m * v0 * v0;
+    for theta in [0.1, 0.25, 0.5, 0.75, 0.9] {
+        let model = model(&rigid_drop(theta, h, v0));
+        assert_eq!(model.analysis.n_steps(), 2);
+        let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let mut steps = Vec::new();
+        for _ in 0..2 {
+            be.step_accepted(&mut s).unwrap();
+            let d = s.ledger.dissipated();
+            steps.push((d.contact, d.numerical, s.ledger.kinetic()));
+            assert!(s.ledger.relative_residual() < 1e-9);
+            assert!(s.contact.pairs[0].penetration <= model.analysis.contact_tolerance);
+        }
+        eprintln!("θ = {theta}: (D_contact, D_num, E_kin) after each step {steps:?}");
+        let close = |got: f64, want: f64, what: &str| {
+            assert!(
+                (got - want).abs() < 1e-5 * e0,
+                "θ = {theta}: {what} {got:.12e}, closed form {want:.12e}"
+            );
+        };
+        let contact = m * v0 * v0 * theta * (1.0 - theta);
+        let (c1, num1, kin1) = steps[0];
+        close(c1, contact, "D_contact after the contact step");
+        close(
+            num1,
+            e0 * (1.0 - theta).powi(2),
+            "D_num after the contact step",
+        );
+        close(kin1, e0 * theta * theta, "E_kin after the contact step");
+        let (c2, num2, kin2) = steps[1];
+        close(c2, contact, "D_contact after the step after");
+        close(
+            num2,
+            e0 * (theta * theta + (1.0 - theta).powi(2)),
+            "D_num after the step after",
+        );
+        close(kin2, 0.0, "E_kin after the step after");
+    }
+}
+
+#[test]
+fn two_bars_meeting_within_a_step_split_the_impact_as_the_note_derives() {
+    // theory/contact.md: two free bars, undeformed and approaching at v, whose gap
+    // g⁰ = θ h v closes within a step. The step's free motion is h v⁰ (K v⁰ = 0), so
+    // the active rows give λ = W⁻¹1 h v (1 − θ) (W = G S⁻¹ Gᵀ the condensed
+    // compliance), the step's contact force F₁ = 1ᵀλ ∝ (1 − θ), and
+    // ΔD_contact = λ·g⁰ = F₁ θ h v ∝ θ(1 − θ). Later steps keep the bars in contact
+    // (g⁰ = 0) with aligned normals, so D_contact stays. Checked for several θ: the
+    // booked D_contact equals F₁ θ h v, F₁/(1 − θ) and D_contact/(θ(1 − θ)) are the
+    // same for every θ, and the ledger closes.
+    let (h, v, n) = (2e-6, 1.0, 2);
+    let mut per_theta = Vec::new();
+    for theta in [0.2, 0.5, 0.8] {
+        let gap = (n as f64 + theta) * h * v;
+        let text = bars(h, "condensed").replace(
+            "origin = [-1.0, 0.0]",
+            &format!("origin = [{:.17e}, 0.0]", -1.0 - gap),
+        );
+        assert!(text.contains(&format!("{:.17e}", -1.0 - gap)));
+        let m = model(&text);
+        let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let (mut f1, mut booked, mut first) = (None, 0.0, None);
+        for step in 0..200 {
+            be.step_accepted(&mut s).unwrap();
+            assert!(s.ledger.relative_residual() < 1e-8);
+            let c = s.ledger.dissipated().contact;
+            let f = s.contact.pairs[0].force;
+            if f > 0.0 && f1.is_none() {
+                f1 = Some(f);
+                booked = c;
+                first = Some(step);
+            } else if f1.is_some() {
+                assert!(
+                    (c - booked).abs() < 1e-9 * booked,
+                    "θ = {theta}, step {step}: D_contact {c} moved from {booked} in persistent contact"
+                );
+            }
+        }
+        let f1 = f1.expect("the bars meet");
+        assert_eq!(first, Some(n), "θ = {theta}: the gap closes in step {n}");
+        let want = f1 * theta * h * v;
+        eprintln!(
+            "θ = {theta}: F₁ = {f1:.9e} N, D_contact = {booked:.9e} J (F₁ θ h v = {want:.9e})"
+        );
+        assert!(
+            (booked - want).abs() < 1e-6 * want,
+            "θ = {theta}: D_contact {booked} against F₁ θ h v = {want}"
+        );
+        per_theta.push((f1 / (1.0 - theta), booked / (theta * (1.0 - theta))));
+    }
+    let (f_ref, d_ref) = per_theta[0];
+    for (f, d) in &per_theta {
+        assert!((f - f_ref).abs() < 1e-6 * f_ref, "{per_theta:?}");
+        assert!((d - d_ref).abs() < 1e-6 * d_ref, "{per_theta:?}");
     }
 }
