@@ -1,8 +1,8 @@
 //! Implicit contact: a block resting on a block, two bars colliding head on against
 //! 1D wave theory, momentum in a free collision, condensed against full QP with the
 //! KKT conditions, a beam dropped on unilateral supports, the energy split of an impact
-//! against its closed form, ledgers with every material
-//! model, and the validation of contact pairs.
+//! against its closed form, ledgers with every material model, and the validation of
+//! contact pairs.
 
 use std::path::Path;
 
