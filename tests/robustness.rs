@@ -392,3 +392,227 @@ fn a_material_path_with_bad_numbers_is_refused_and_a_good_one_streams() {
         }
     }
 }
+
+/// A real Gmsh 4.1 mesh of `tests/data` (a 2 x 1 plate with a hole of radius 0.2 at
+/// (1, 0.5); physical curves `left`, `right`, `hole`, surface `plate`).
+fn plate(name: &str) -> Vec<u8> {
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// The coordinates of every node of `part` by its Gmsh tag.
+fn by_tag(part: &rothe::mesh::Part) -> std::collections::BTreeMap<u64, [f64; 2]> {
+    let tags = part.node_tags.as_ref().unwrap();
+    tags.iter()
+        .copied()
+        .zip(part.coords.iter().copied())
+        .collect()
+}
+
+/// The ASCII plate with its `$Nodes` section rewritten by `edit`, which gets each
+/// block's tags and coordinate lines and returns them as the block should list them.
+fn with_node_blocks(edit: impl Fn(&mut Vec<String>, &mut Vec<String>)) -> String {
+    let text = String::from_utf8(plate("plate_tri.msh")).unwrap();
+    let (head, rest) = text.split_once("$Nodes\n").unwrap();
+    let (nodes, tail) = rest.split_once("$EndNodes\n").unwrap();
+    let mut lines = nodes.lines();
+    let mut out = format!("{head}$Nodes\n{}\n", lines.next().unwrap());
+    while let Some(header) = lines.next() {
+        let n: usize = header.split_whitespace().nth(3).unwrap().parse().unwrap();
+        let mut tags: Vec<String> = (0..n).map(|_| lines.next().unwrap().into()).collect();
+        let mut xyz: Vec<String> = (0..n).map(|_| lines.next().unwrap().into()).collect();
+        edit(&mut tags, &mut xyz);
+        out.push_str(header);
+        out.push('\n');
+        for l in tags.iter().chain(&xyz) {
+            out.push_str(l);
+            out.push('\n');
+        }
+    }
+    out + "$EndNodes\n" + tail
+}
+
+#[test]
+fn gmsh_nodes_get_their_own_coordinates_whatever_the_order_of_their_tags() {
+    let ascii = rothe::mesh::gmsh::parse(&plate("plate_tri.msh")).unwrap();
+    ascii.check().unwrap();
+    // The geometry is where the file says it is: every node of `hole` on the circle,
+    // of `left` at x = 0, of `right` at x = 2.
+    for &n in &ascii.node_sets["hole"] {
+        let [x, y] = ascii.coords[n];
+        assert!(((x - 1.0).hypot(y - 0.5) - 0.2).abs() < 1e-9, "{x}, {y}");
+    }
+    assert!(ascii.node_sets["left"]
+        .iter()
+        .all(|&n| ascii.coords[n][0] == 0.0));
+    assert!(ascii.node_sets["right"]
+        .iter()
+        .all(|&n| ascii.coords[n][0] == 2.0));
+    let reference = by_tag(&ascii);
+    // Gmsh's binary file of the same mesh.
+    let binary = rothe::mesh::gmsh::parse(&plate("plate_tri_binary.msh")).unwrap();
+    // (The ASCII file has 16 significant digits, the binary all 17.)
+    let b = by_tag(&binary);
+    assert!(b.keys().eq(reference.keys()));
+    for (t, x) in &b {
+        let y = reference[t];
+        assert!(
+            (x[0] - y[0]).abs() < 1e-14 && (x[1] - y[1]).abs() < 1e-14,
+            "tag {t}"
+        );
+    }
+    assert_eq!(binary.node_sets, ascii.node_sets);
+    assert_eq!(binary.blocks[0].conn.len(), ascii.blocks[0].conn.len());
+    // Every block listed in descending order of its tags: the same node, the same
+    // place (the defect this guards against rotated the mesh).
+    let descending = with_node_blocks(|tags, xyz| {
+        tags.reverse();
+        xyz.reverse();
+    });
+    let part = rothe::mesh::gmsh::parse(descending.as_bytes()).unwrap();
+    assert_eq!(by_tag(&part), reference);
+    let area = |p: &rothe::mesh::Part| -> f64 {
+        (0..p.blocks[0].len())
+            .map(|e| {
+                let c = |k: usize| p.coords[p.blocks[0].element(e)[k]];
+                let (a, b, d) = (c(0), c(1), c(2));
+                0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (d[0] - a[0]) * (b[1] - a[1]))
+            })
+            .sum()
+    };
+    let plate_area = 2.0 - std::f64::consts::PI * 0.04;
+    assert!((area(&part) - area(&ascii)).abs() < 1e-12);
+    assert!((area(&ascii) - plate_area).abs() < 0.01, "{}", area(&ascii));
+    // Sparse tags (every tag times 10, the elements' references too).
+    let text = String::from_utf8(plate("plate_tri.msh")).unwrap();
+    let times_ten = |line: &str| -> String {
+        line.split_whitespace()
+            .map(|w| format!("{}0", w))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let sparse = with_node_blocks(|tags, _| {
+        for t in tags.iter_mut() {
+            *t = times_ten(t);
+        }
+    });
+    let (head, elements) = sparse.split_once("$Elements\n").unwrap();
+    let mut lines = elements.lines();
+    let mut rebuilt = format!("{head}$Elements\n{}\n", lines.next().unwrap());
+    while let Some(header) = lines.next() {
+        if header == "$EndElements" {
+            rebuilt += "$EndElements\n";
+            break;
+        }
+        let n: usize = header.split_whitespace().nth(3).unwrap().parse().unwrap();
+        rebuilt += &format!("{header}\n");
+        for _ in 0..n {
+            let l = lines.next().unwrap();
+            let (tag, nodes) = l.trim().split_once(' ').unwrap();
+            rebuilt += &format!("{tag} {}\n", times_ten(nodes));
+        }
+    }
+    rebuilt += &text[text.find("$EndElements\n").unwrap() + "$EndElements\n".len()..];
+    let part = rothe::mesh::gmsh::parse(rebuilt.as_bytes()).unwrap();
+    let tens: std::collections::BTreeMap<u64, [f64; 2]> =
+        reference.iter().map(|(t, x)| (10 * t, *x)).collect();
+    assert_eq!(by_tag(&part), tens);
+    assert_eq!(part.node_sets, ascii.node_sets);
+    // Quadrilaterals read as well (Gmsh's recombined mesh).
+    let quads = rothe::mesh::gmsh::parse(&plate("plate_quad.msh")).unwrap();
+    quads.check().unwrap();
+    assert_eq!(quads.blocks[0].kind, rothe::mesh::ElementKind::Quad4);
+}
+
+#[test]
+fn gmsh_files_that_define_a_tag_twice_or_never_are_refused_naming_it() {
+    let text = String::from_utf8(plate("plate_tri.msh")).unwrap();
+    let parse = |t: &str| {
+        rothe::mesh::gmsh::parse(t.as_bytes())
+            .err()
+            .unwrap_or_default()
+    };
+    // A node tag repeated: the second block's tag becomes the first block's.
+    let repeated = with_node_blocks(|tags, _| {
+        if tags.len() > 1 {
+            tags[1] = tags[0].clone();
+        }
+    });
+    let e = parse(&repeated);
+    assert!(e.contains("is defined twice"), "{e}");
+    // The triangles: the lines after the surface block's header `2 <entity> 2 <n>`.
+    let (head, els) = text.split_once("$Elements\n").unwrap();
+    let lines: Vec<String> = els.lines().map(String::from).collect();
+    let header = 1 + lines[1..]
+        .iter()
+        .position(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            w.len() == 4 && w[0] == "2" && w[2] == "2"
+        })
+        .unwrap();
+    let (first_tri, last) = (header + 1, lines.len() - 2);
+    assert_eq!(lines[last + 1], "$EndElements");
+    let file = |lines: &[String]| format!("{head}$Elements\n{}\n", lines.join("\n"));
+    let fields = |l: &str| -> Vec<String> { l.split_whitespace().map(String::from).collect() };
+    // An element using a tag no block defines.
+    let mut undefined = lines.clone();
+    let mut w = fields(&lines[last]);
+    w[1] = "99999".into();
+    undefined[last] = w.join(" ");
+    let e = parse(&file(&undefined));
+    assert!(
+        e.contains(&format!(
+            "element with Gmsh tag {} refers to node tag 99999",
+            w[0]
+        )) && e.contains("no node block defines"),
+        "{e}"
+    );
+    // An element tag used twice.
+    let mut dup = lines.clone();
+    let mut w = fields(&lines[last]);
+    let tag0 = fields(&lines[first_tri])[0].clone();
+    w[0] = tag0.clone();
+    dup[last] = w.join(" ");
+    let e = parse(&file(&dup));
+    assert!(
+        e.contains(&format!("element tag {tag0} is used by two elements")),
+        "{e}"
+    );
+    // The same triangle twice under two tags.
+    let mut twice = lines.clone();
+    let mut w = fields(&lines[first_tri]);
+    w[0] = fields(&lines[last])[0].clone();
+    twice[last] = w.join(" ");
+    let e = parse(&file(&twice));
+    assert!(e.contains("have the same nodes"), "{e}");
+    // Two physical groups of one name.
+    let e = parse(&text.replace("1 3 \"right\"", "1 3 \"left\""));
+    assert!(e.contains("two physical groups are named `left`"), "{e}");
+    // A node off the plane z = 0.
+    let lifted = with_node_blocks(|_, xyz| {
+        if xyz.len() > 2 {
+            let w: Vec<&str> = xyz[1].split_whitespace().collect();
+            xyz[1] = format!("{} {} 0.01", w[0], w[1]);
+        }
+    });
+    let e = parse(&lifted);
+    assert!(e.contains("lies off the plane z = 0"), "{e}");
+    // Through `check`: the file and the tag named.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("p.msh"), &repeated).unwrap();
+    let sc = good().replace(
+        "mesh = { kind = \"rectangle\", size = [2.0, 0.5], divisions = [8, 2] }",
+        "mesh = { kind = \"gmsh\", file = \"p.msh\" }",
+    );
+    let sc = scenario(dir.path(), "p.toml", &sc);
+    let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        err.contains("p.msh") && err.contains("is defined twice"),
+        "{err}"
+    );
+}

@@ -1,18 +1,22 @@
-//! Gmsh `.msh` v4.1 reader (ASCII or binary) through the `mshio` crate.
+//! Gmsh `.msh` v4.1 meshes (ASCII or binary, read by [`super::msh41`]).
 //!
 //! 2D elements (3-node triangles, 4-node quadrilaterals) become the part's elements;
 //! physical groups become sets: a physical surface gives a node set, a physical curve
 //! gives a node set and an edge set (its 2-node line elements), a physical point gives
 //! a node set. Sets are named by their `$PhysicalNames` entry, or `physical_<dim>_<tag>`
 //! when the file names none; a named group without elements is an empty set.
-//! Elements given clockwise are turned counter-clockwise. The file's node and element
-//! tags are kept for messages, and the part is checked (finite coordinates, every
-//! node in an element, no degenerate or distorted element) before it is used.
-//! `mshio` does not read `$PhysicalNames`, so that small text section is read here.
+//! Elements given clockwise are turned counter-clockwise. Every node gets the
+//! coordinates its own block lists beside its tag, whatever the order of the tags.
+//! The file's node and element tags are kept for messages. Refused, naming the tag: a
+//! node tag defined twice, an element using a tag never defined, an element tag used
+//! twice, a surface element listed twice (the same nodes), two physical groups of one
+//! name, a node off the plane `z = 0`. The part is then checked (finite coordinates,
+//! every node in an element, no degenerate or distorted element) before it is used.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
+use super::msh41::{self, MshFile};
 use super::{ElementKind, Elements, Part};
 use crate::error::{Error, Result};
 
@@ -27,72 +31,22 @@ pub fn read(path: &Path) -> Result<Part> {
 
 /// Parses the bytes of a Gmsh v4.1 file into a [`Part`].
 pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
-    let msh =
-        mshio::parse_msh_bytes(bytes).map_err(|e| format!("not a valid MSH 4.1 file: {e}"))?;
-    let names = physical_names(bytes);
-    let nodes = msh
-        .data
-        .nodes
-        .as_ref()
-        .ok_or("the file has no $Nodes section")?;
-    let elements = msh
-        .data
-        .elements
-        .as_ref()
-        .ok_or("the file has no $Elements section")?;
-
-    // Node tags to dense indices.
-    let mut tag_to_index: HashMap<u64, usize> = HashMap::new();
-    let mut coords = Vec::new();
-    let mut node_tags = Vec::new();
-    let mut running_tag = nodes.min_node_tag;
-    for block in &nodes.node_blocks {
-        match &block.node_tags {
-            Some(tags) => {
-                let mut pairs: Vec<(u64, usize)> = tags.iter().map(|(&t, &i)| (t, i)).collect();
-                pairs.sort_by_key(|p| p.1);
-                for (tag, i) in pairs {
-                    let n = block
-                        .nodes
-                        .get(i)
-                        .ok_or_else(|| format!("node tag {tag} points past its node block"))?;
-                    tag_to_index.insert(tag, coords.len());
-                    coords.push([n.x, n.y]);
-                    node_tags.push(tag);
-                }
-            }
-            None => {
-                for n in &block.nodes {
-                    tag_to_index.insert(running_tag, coords.len());
-                    coords.push([n.x, n.y]);
-                    node_tags.push(running_tag);
-                    running_tag += 1;
-                }
-            }
-        }
+    let msh = msh41::parse(bytes).map_err(|e| format!("not a valid MSH 4.1 file: {e}"))?;
+    if !msh.has_nodes {
+        return Err("the file has no $Nodes section".into());
     }
-    let index = |tag: u64| -> std::result::Result<usize, String> {
-        tag_to_index
-            .get(&tag)
-            .copied()
-            .ok_or_else(|| format!("an element refers to node tag {tag}, which is not defined"))
+    if !msh.has_elements {
+        return Err("the file has no $Elements section".into());
+    }
+    let (coords, node_tags, tag_to_index) = nodes(&msh)?;
+    let index = |tag: u64, element: u64| -> std::result::Result<usize, String> {
+        tag_to_index.get(&tag).copied().ok_or_else(|| {
+            format!("element with Gmsh tag {element} refers to node tag {tag}, which no node block defines")
+        })
     };
-
-    // Physical tags of each entity.
-    let mut phys: HashMap<(i32, i32), Vec<i32>> = HashMap::new();
-    if let Some(ent) = &msh.data.entities {
-        for p in &ent.points {
-            phys.insert((0, p.tag), p.physical_tags.clone());
-        }
-        for c in &ent.curves {
-            phys.insert((1, c.tag), c.physical_tags.clone());
-        }
-        for s in &ent.surfaces {
-            phys.insert((2, s.tag), s.physical_tags.clone());
-        }
-    }
+    let set_names = group_names(&msh)?;
     let set_name = |dim: i32, tag: i32| -> String {
-        names
+        set_names
             .get(&(dim, tag))
             .cloned()
             .unwrap_or_else(|| format!("physical_{dim}_{tag}"))
@@ -102,49 +56,47 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     let (mut tris, mut tri_tags) = (Vec::new(), Vec::new());
     let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut edge_sets: BTreeMap<String, Vec<[usize; 2]>> = BTreeMap::new();
-    for block in &elements.element_blocks {
+    let mut element_tags: HashMap<u64, ()> = HashMap::new();
+    let mut surface_elements: HashMap<Vec<usize>, u64> = HashMap::new();
+    let mut ns = Vec::new();
+    for block in &msh.element_blocks {
         let dim = block.entity_dim;
-        let groups = phys
+        let groups = msh
+            .entity_groups
             .get(&(dim, block.entity_tag))
             .cloned()
             .unwrap_or_default();
-        for el in &block.elements {
-            let ns: Vec<usize> = el
-                .nodes
-                .iter()
-                .map(|&t| index(t))
-                .collect::<std::result::Result<_, _>>()?;
-            let wanted = match block.element_type {
-                mshio::ElementType::Qua4 => 4,
-                mshio::ElementType::Tri3 => 3,
-                mshio::ElementType::Lin2 => 2,
-                _ => 0,
-            };
-            if ns.len() < wanted {
-                return Err(format!(
-                    "element with Gmsh tag {} has {} nodes, its type needs {wanted}",
-                    el.element_tag,
-                    ns.len()
-                ));
+        let per = block.nodes_per_element;
+        for (e, &tag) in block.tags.iter().enumerate() {
+            if element_tags.insert(tag, ()).is_some() {
+                return Err(format!("element tag {tag} is used by two elements"));
+            }
+            ns.clear();
+            for &t in &block.nodes[e * per..(e + 1) * per] {
+                ns.push(index(t, tag)?);
             }
             match block.element_type {
-                mshio::ElementType::Qua4 => {
-                    let mut q = [ns[0], ns[1], ns[2], ns[3]];
-                    if signed_area(&coords, &q) < 0.0 {
-                        q.swap(1, 3);
+                3 | 2 => {
+                    let mut key = ns.clone();
+                    key.sort_unstable();
+                    if let Some(first) = surface_elements.insert(key, tag) {
+                        return Err(format!(
+                            "elements with Gmsh tags {first} and {tag} have the same nodes \
+                             (an element listed twice)"
+                        ));
                     }
-                    quads.extend_from_slice(&q);
-                    quad_tags.push(el.element_tag);
-                }
-                mshio::ElementType::Tri3 => {
-                    let mut t = [ns[0], ns[1], ns[2]];
-                    if signed_area(&coords, &t) < 0.0 {
-                        t.swap(1, 2);
+                    let (list, tags) = if per == 4 {
+                        (&mut quads, &mut quad_tags)
+                    } else {
+                        (&mut tris, &mut tri_tags)
+                    };
+                    if signed_area(&coords, &ns) < 0.0 {
+                        ns[1..].reverse();
                     }
-                    tris.extend_from_slice(&t);
-                    tri_tags.push(el.element_tag);
+                    list.extend_from_slice(&ns);
+                    tags.push(tag);
                 }
-                mshio::ElementType::Lin2 => {
+                1 => {
                     for &g in &groups {
                         edge_sets
                             .entry(set_name(1, g))
@@ -152,11 +104,13 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
                             .push([ns[0], ns[1]]);
                     }
                 }
-                mshio::ElementType::Pnt => {}
+                15 => {}
                 other => {
                     return Err(format!(
-                        "element type {other:?} is not supported (use 3-node triangles, \
-                         4-node quadrilaterals and 2-node lines)"
+                        "element with Gmsh tag {tag} has type {other} ({}), which a 2D \
+                         model does not take (use 3-node triangles, 4-node quadrilaterals \
+                         and 2-node lines)",
+                        type_name(other)
                     ))
                 }
             }
@@ -173,9 +127,9 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
         nodes.dedup();
     }
     // A named group without elements is an empty set, not an unknown one.
-    for (&(dim, _), name) in &names {
+    for (dim, _, name) in &msh.physical_names {
         node_sets.entry(name.clone()).or_default();
-        if dim == 1 {
+        if *dim == 1 {
             edge_sets.entry(name.clone()).or_default();
         }
     }
@@ -208,6 +162,77 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     })
 }
 
+/// The nodes in the order the file lists them: coordinates, tags and the map from a
+/// tag to its index. A tag defined twice and a node off the plane are errors.
+#[allow(clippy::type_complexity)]
+fn nodes(
+    msh: &MshFile,
+) -> std::result::Result<(Vec<[f64; 2]>, Vec<u64>, HashMap<u64, usize>), String> {
+    let n: usize = msh.node_blocks.iter().map(|b| b.tags.len()).sum();
+    let mut coords = Vec::with_capacity(n);
+    let mut tags = Vec::with_capacity(n);
+    let mut index = HashMap::with_capacity(n);
+    let extent = msh
+        .node_blocks
+        .iter()
+        .flat_map(|b| &b.xyz)
+        .flat_map(|p| [p[0].abs(), p[1].abs()])
+        .filter(|x| x.is_finite())
+        .fold(0.0f64, f64::max);
+    let z_tolerance = 1e-9 * extent.max(f64::MIN_POSITIVE);
+    for block in &msh.node_blocks {
+        for (&tag, p) in block.tags.iter().zip(&block.xyz) {
+            if index.insert(tag, coords.len()).is_some() {
+                return Err(format!("node tag {tag} is defined twice"));
+            }
+            if p[2].abs() > z_tolerance {
+                return Err(format!(
+                    "node with Gmsh tag {tag} at {p:?} lies off the plane z = 0 \
+                     (a 2D model takes x and y only)"
+                ));
+            }
+            coords.push([p[0], p[1]]);
+            tags.push(tag);
+        }
+    }
+    Ok((coords, tags, index))
+}
+
+/// The set names of the physical groups; two groups of one name are an error.
+fn group_names(msh: &MshFile) -> std::result::Result<HashMap<(i32, i32), String>, String> {
+    let mut by_name: HashMap<&str, (i32, i32)> = HashMap::new();
+    let mut out = HashMap::new();
+    for (dim, tag, name) in &msh.physical_names {
+        if let Some((d0, t0)) = by_name.insert(name, (*dim, *tag)) {
+            return Err(format!(
+                "two physical groups are named `{name}` (dimension {d0} tag {t0} and \
+                 dimension {dim} tag {tag}): set names must be unique"
+            ));
+        }
+        if out.insert((*dim, *tag), name.clone()).is_some() {
+            return Err(format!(
+                "physical group of dimension {dim} and tag {tag} is named twice"
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// A short name of a Gmsh element type, for messages.
+fn type_name(t: i32) -> &'static str {
+    match t {
+        4 => "4-node tetrahedron",
+        5 => "8-node hexahedron",
+        6 => "6-node prism",
+        7 => "5-node pyramid",
+        8 => "3-node line",
+        9 => "6-node triangle",
+        10 => "9-node quadrilateral",
+        16 => "8-node quadrilateral",
+        _ => "a higher-order or 3D element",
+    }
+}
+
 fn signed_area(coords: &[[f64; 2]], poly: &[usize]) -> f64 {
     let n = poly.len();
     (0..n)
@@ -217,26 +242,4 @@ fn signed_area(coords: &[[f64; 2]], poly: &[usize]) -> f64 {
         })
         .sum::<f64>()
         * 0.5
-}
-
-/// Reads the `$PhysicalNames` section (always ASCII, even in binary files).
-fn physical_names(bytes: &[u8]) -> HashMap<(i32, i32), String> {
-    let mut out = HashMap::new();
-    let text = String::from_utf8_lossy(bytes);
-    let Some(start) = text.find("$PhysicalNames") else {
-        return out;
-    };
-    let Some(end) = text[start..].find("$EndPhysicalNames") else {
-        return out;
-    };
-    for line in text[start..start + end].lines().skip(2) {
-        let mut parts = line.splitn(3, char::is_whitespace);
-        let (Some(dim), Some(tag), Some(name)) = (parts.next(), parts.next(), parts.next()) else {
-            continue;
-        };
-        if let (Ok(dim), Ok(tag)) = (dim.parse(), tag.parse()) {
-            out.insert((dim, tag), name.trim().trim_matches('"').to_string());
-        }
-    }
-    out
 }

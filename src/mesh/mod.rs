@@ -6,6 +6,7 @@
 //! continuum's nodes. Start with [`structured::rectangle`] and [`Mesh::add_part`].
 
 pub mod gmsh;
+pub mod msh41;
 pub mod structured;
 
 use std::collections::BTreeMap;

@@ -131,7 +131,7 @@ impl VtkSeries {
         let name = format!("step_{step:07}.vtu");
         let path = self.dir.join("vtk").join(&name);
         let vtk = Vtk {
-            version: Version::new((1, 0)),
+            version: Version::new_xml(1, 0),
             title: format!("rothe t = {t:e}"),
             byte_order: ByteOrder::LittleEndian,
             data: DataSet::inline(piece),
