@@ -87,22 +87,20 @@ pub fn material_lines(m: &crate::material::Material) -> Vec<String> {
     lines
 }
 
-/// Analyses `model` (pattern and symbolic factorisation, no numeric work) and
-/// reports; refuses a model whose memory estimate exceeds `memory_limit`.
-pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
+/// The output a run of `model` writes and the warnings of a runaway run.
+pub struct Volume {
+    /// `(rows, bytes)` of `history.csv`.
+    pub history: (usize, u64),
+    /// `(files, bytes)` of the VTK series.
+    pub vtk: (usize, u64),
+    /// A step count or an output size far past what is meant, one sentence each.
+    pub warnings: Vec<String>,
+}
+
+/// Estimates the output of a run of `model`: `check` prints it and `run` warns with
+/// the same sentences before it starts.
+pub fn volume(model: &Model) -> Volume {
     let mesh = &model.mesh;
-    let pattern = Pattern::new(mesh);
-    let dofs = DofMap::new(mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let system = EffectiveSystem::new(
-        &pattern,
-        dofs,
-        Backend::Faer,
-        model.analysis.ordering,
-        &mesh.coords,
-    )?;
-    let nnz_l = system.factor_nnz().unwrap_or(0);
-    let memory = crate::config::memory_estimate(model, Some(nnz_l));
-    memory.check(memory_limit, "the run")?;
     let a = &model.analysis;
     let steps = a.n_steps();
     let probes = model.probes.len();
@@ -131,6 +129,37 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
             human(vtk.1)
         ));
     }
+    Volume {
+        history,
+        vtk,
+        warnings,
+    }
+}
+
+/// Analyses `model` (pattern and symbolic factorisation, no numeric work) and
+/// reports; refuses a model whose memory estimate exceeds `memory_limit`.
+pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
+    let mesh = &model.mesh;
+    let pattern = Pattern::new(mesh);
+    let dofs = DofMap::new(mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+    let system = EffectiveSystem::new(
+        &pattern,
+        dofs,
+        Backend::Faer,
+        model.analysis.ordering,
+        &mesh.coords,
+    )?;
+    let nnz_l = system.factor_nnz().unwrap_or(0);
+    let memory = crate::config::memory_estimate(model, Some(nnz_l));
+    memory.check(memory_limit, "the run")?;
+    let a = &model.analysis;
+    let steps = a.n_steps();
+    let Volume {
+        history,
+        vtk,
+        mut warnings,
+    } = volume(model);
+    warnings.extend(model.warnings.iter().cloned());
     let cfl =
         crate::time::cfl::critical_step(model).map(|c| (c.dt, c.block, c.element, a.dt / c.dt));
     Ok(Report {

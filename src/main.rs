@@ -43,6 +43,11 @@ enum Command {
         /// error norms read it).
         #[arg(long)]
         record_fields: bool,
+        /// Replace an earlier run in the output directory (its summary, history, VTK
+        /// files, fields and plots are removed first); without it such a directory is
+        /// refused.
+        #[arg(long)]
+        overwrite: bool,
     },
     /// Convergence studies: `time` (a sequence of steps), `mesh` (a sequence of mesh
     /// sizes), `collect` (tables and plots of an emitted sweep run elsewhere).
@@ -271,6 +276,7 @@ fn run_command(
     backend: Backend,
     quiet: bool,
     record_fields: bool,
+    overwrite: bool,
 ) -> rothe::Result<()> {
     let model = scenario.load()?;
     let summary = run(
@@ -281,6 +287,7 @@ fn run_command(
             progress: !quiet,
             memory_limit: scenario.options().memory_limit,
             record_fields,
+            overwrite,
         },
     )?;
     eprintln!(
@@ -326,7 +333,8 @@ fn main() -> ExitCode {
             backend,
             quiet,
             record_fields,
-        } => run_command(&scenario, &out, backend, quiet, record_fields),
+            overwrite,
+        } => run_command(&scenario, &out, backend, quiet, record_fields, overwrite),
         Command::Study { study } => study_command(study),
         Command::Compare { scenario, sweep } => scenario
             .overrides()

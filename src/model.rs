@@ -277,6 +277,9 @@ pub struct Model {
     pub contacts: Vec<ContactPair>,
     /// Analysis settings.
     pub analysis: Analysis,
+    /// What the scenario gives that this analysis will not read, one sentence each
+    /// naming the key (`check` and `run` print them; `summary.json` keeps them).
+    pub warnings: Vec<String>,
 }
 
 /// The master side of one direction of a contact pair.

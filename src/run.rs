@@ -43,10 +43,14 @@ pub struct RunOptions {
     /// Also write every step's displacement to `fields.bin`
     /// ([`crate::output::fields`]), for the time study's error norms.
     pub record_fields: bool,
+    /// Remove an earlier run's files from `out` (otherwise they are refused:
+    /// [`crate::output::prepare`]).
+    pub overwrite: bool,
 }
 
 impl RunOptions {
-    /// Options for a run into `out` on `backend`, quiet, without a memory limit.
+    /// Options for a run into `out` on `backend`, quiet, without a memory limit,
+    /// replacing an earlier run there (studies own their run directories).
     pub fn new(out: impl Into<PathBuf>, backend: Backend) -> Self {
         RunOptions {
             out: out.into(),
@@ -54,6 +58,7 @@ impl RunOptions {
             progress: false,
             memory_limit: None,
             record_fields: false,
+            overwrite: true,
         }
     }
 }
@@ -109,14 +114,25 @@ pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 /// Runs `model` and writes `history.csv`, `summary.json` and VTK files to `opts.out`.
 pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
     let start = Instant::now();
+    crate::output::prepare(&opts.out, opts.overwrite)?;
     let mut rec = Recorder::new(model, &opts.out)?;
     if opts.record_fields {
         rec.record_fields(model, &opts.out)?;
     }
     let a = &model.analysis;
+    let volume = crate::check::volume(model);
+    for w in model.warnings.iter().chain(&volume.warnings) {
+        eprintln!("warning: {w}");
+    }
     let mut summary = Summary {
         status: "running".into(),
         error: None,
+        warnings: model
+            .warnings
+            .iter()
+            .chain(&volume.warnings)
+            .cloned()
+            .collect(),
         dofs: model.mesh.n_dofs(),
         elements: model.mesh.n_elements(),
         steps: 0,

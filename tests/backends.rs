@@ -515,6 +515,7 @@ fn full_run_histories_agree() {
             progress: false,
             memory_limit: None,
             record_fields: false,
+            overwrite: true,
         };
         let summary = rothe::run::run(&model, &opts).unwrap();
         assert_eq!(summary.status, "completed");

@@ -31,6 +31,7 @@ fn run_text(text: &str, dir: &std::path::Path) -> rothe::Result<rothe::output::s
             progress: false,
             memory_limit: None,
             record_fields: false,
+            overwrite: true,
         },
     )
 }

@@ -105,6 +105,7 @@ fn histories_match_their_references() {
                 progress: false,
                 memory_limit: None,
                 record_fields: false,
+                overwrite: true,
             },
         )
         .unwrap();

@@ -4,6 +4,7 @@
 //!
 //! Start with [`load`]; the format is documented in the README and `examples/`.
 
+mod exact;
 pub mod overrides;
 mod validate;
 
@@ -125,7 +126,7 @@ pub struct ContactSpec {
     pub master: Option<String>,
     /// A rigid line `[[x0, y0], [x1, y1]]` the slave nodes may not cross (a unilateral
     /// support). Its side is the one the slave body lies on.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option_segment")]
     pub rigid_line: Option<[[f64; 2]; 2]>,
     /// Also check the master's nodes against the slave's edges (the slave must be an
     /// edge set). Default false: slave nodes against master segments only.
@@ -180,9 +181,10 @@ pub struct AnalysisSpec {
     pub zeta: f64,
     /// Rayleigh coefficients `[a_m, a_k]`: `C += a_m M + a_k K`. Default none.
     #[serde(default)]
+    #[serde(deserialize_with = "exact::array")]
     pub rayleigh: [f64; 2],
     /// Gravity acceleration vector (m/s²), applied from `t = 0`. Default none.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option_array")]
     pub gravity: Option<[f64; 2]>,
     /// Write a VTK file every this many steps; 0 for none.
     #[serde(default = "default_vtk_every")]
@@ -201,7 +203,7 @@ pub struct AnalysisSpec {
     /// `newton` (default: refactorise every iteration) or `fixed` (factorise once
     /// per step).
     #[serde(default)]
-    pub iteration: crate::model::IterationMethod,
+    pub iteration: Option<crate::model::IterationMethod>,
     /// Step cuts (each halving `h`) allowed before the run stops. Default 8.
     #[serde(default = "default_max_cuts")]
     pub max_cuts: usize,
@@ -217,13 +219,13 @@ pub struct AnalysisSpec {
     /// forces, `W = G K_eff⁻¹ Gᵀ` from the factor) or `full` (the primal QP over all
     /// free dofs, the reference).
     #[serde(default)]
-    pub contact_qp: crate::model::ContactQp,
+    pub contact_qp: Option<crate::model::ContactQp>,
     /// Where the implicit schemes keep the state of linear viscoelastic materials:
     /// `nodal` (default: nodal fields, a step of matrix-vector products) or `points`
     /// (the Gauss points, with each point's cumulative dissipation density in the
     /// VTK output).
     #[serde(default)]
-    pub viscoelastic_state: crate::model::ViscoelasticState,
+    pub viscoelastic_state: Option<crate::model::ViscoelasticState>,
 }
 
 fn default_displacement_tolerance() -> f64 {
@@ -482,6 +484,7 @@ pub struct BodySpec {
     pub thickness: f64,
     /// Initial velocity (m/s). Default at rest.
     #[serde(default)]
+    #[serde(deserialize_with = "exact::array")]
     pub velocity: [f64; 2],
     /// Its mesh.
     pub mesh: MeshSpec,
@@ -495,12 +498,14 @@ pub enum MeshSpec {
     Rectangle {
         /// Lower left corner. Default the origin.
         #[serde(default)]
+        #[serde(deserialize_with = "exact::array")]
         origin: [f64; 2],
         /// Width and height.
+        #[serde(deserialize_with = "exact::array")]
         size: [f64; 2],
         /// Cells along x and y (equal cells). Give this, or `element_size` (here or in
         /// `[meshing]`).
-        #[serde(default)]
+        #[serde(default, deserialize_with = "exact::option_array")]
         divisions: Option<[usize; 2]>,
         /// Largest cell size (m): each side (each band between `x_lines` /
         /// `y_lines`) is cut into the fewest equal cells no larger than it. Overrides
@@ -543,8 +548,10 @@ pub struct BarSpec {
     /// Cross-section area (m²).
     pub area: f64,
     /// Start point of the line.
+    #[serde(deserialize_with = "exact::array")]
     pub from: [f64; 2],
     /// End point of the line.
+    #[serde(deserialize_with = "exact::array")]
     pub to: [f64; 2],
 }
 
@@ -596,6 +603,7 @@ pub enum LoadSpec {
         /// Edge set.
         set: String,
         /// Traction vector.
+        #[serde(deserialize_with = "exact::array")]
         value: [f64; 2],
         /// Time function (default constant).
         #[serde(default = "constant")]
@@ -606,6 +614,7 @@ pub enum LoadSpec {
         /// Node set.
         set: String,
         /// Force vector per node.
+        #[serde(deserialize_with = "exact::array")]
         value: [f64; 2],
         /// Time function (default constant).
         #[serde(default = "constant")]
@@ -620,7 +629,7 @@ pub struct ProbeSpec {
     /// Column prefix.
     pub name: String,
     /// The node nearest this point.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option_array")]
     pub at: Option<[f64; 2]>,
     /// Or the single node of this set.
     #[serde(default)]
@@ -653,6 +662,20 @@ pub fn load_with_overrides(path: &Path, opts: &LoadOptions, ov: &Overrides) -> R
     validate::build(&scenario, dir, opts).map_err(in_file)
 }
 
+/// The scenario file at `path` as a TOML table after its variants and `ov` are
+/// applied (no validation): what a plan asks of a scenario before it runs it.
+pub fn merged_table(path: &Path, ov: &Overrides) -> Result<toml::Table> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let table: toml::Table = toml::from_str(&text).map_err(|e| match toml_error(&text, e) {
+        Error::Config { field, message } => Error::Config {
+            field: format!("{}: {field}", path.display()),
+            message,
+        },
+        other => other,
+    })?;
+    overrides::apply(table, ov)
+}
+
 /// Parses scenario text after applying `ov` (no validation). Without variants and
 /// overrides this is [`parse`], whose messages give line numbers.
 pub fn parse_with(text: &str, ov: &Overrides) -> Result<Scenario> {
@@ -661,35 +684,71 @@ pub fn parse_with(text: &str, ov: &Overrides) -> Result<Scenario> {
         return parse(text);
     }
     let merged = overrides::apply(table, ov)?;
-    toml::Value::Table(merged)
-        .try_into()
-        .map_err(|e: toml::de::Error| {
+    serde_path_to_error::deserialize(toml::Value::Table(merged)).map_err(
+        |e: serde_path_to_error::Error<toml::de::Error>| {
             Error::config(
-                "scenario (after variants and --set)",
-                e.message().to_string(),
+                format!("{} (after variants and --set)", field_path(e.path())),
+                e.inner().message().to_string(),
             )
-        })
+        },
+    )
+}
+
+/// The dotted path of a field as serde saw it (`bodies[0].thickness`), or
+/// `scenario` at the top.
+fn field_path(p: &serde_path_to_error::Path) -> String {
+    let s = p.to_string();
+    if s.is_empty() || s == "." {
+        "scenario".into()
+    } else {
+        s
+    }
+}
+
+/// Line and column (from 1) of a byte offset of `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text.as_bytes()[..offset.min(text.len())];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    let column = String::from_utf8_lossy(&before[line_start..])
+        .chars()
+        .count()
+        + 1;
+    (line, column)
 }
 
 fn toml_error(text: &str, e: toml::de::Error) -> Error {
-    let span = e.span().map(|s| {
-        let end = s.start.min(text.len());
-        let line = text.as_bytes()[..end]
-            .iter()
-            .filter(|&&b| b == b'\n')
-            .count()
-            + 1;
-        format!("line {line}")
+    let at = e.span().map(|s| {
+        let (line, column) = line_column(text, s.start);
+        format!("line {line}, column {column}")
     });
     Error::config(
-        span.unwrap_or_else(|| "scenario".into()),
+        at.unwrap_or_else(|| "scenario".into()),
         e.message().to_string(),
     )
 }
 
-/// Parses scenario text (no validation).
+/// Parses scenario text (no validation). A value of the wrong type or length is
+/// named by its field path and its line and column.
 pub fn parse(text: &str) -> Result<Scenario> {
-    toml::from_str(text).map_err(|e| toml_error(text, e))
+    let de = toml::Deserializer::new(text);
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = field_path(e.path());
+        let inner = e.into_inner();
+        match inner.span() {
+            Some(s) if path != "scenario" => {
+                let (line, column) = line_column(text, s.start);
+                Error::config(
+                    format!("{path} (line {line}, column {column})"),
+                    inner.message().to_string(),
+                )
+            }
+            _ => toml_error(text, inner),
+        }
+    })
 }
 
 /// Parses and validates scenario text; relative mesh paths resolve against `dir`.

@@ -120,7 +120,16 @@ pub fn apply(mut table: Table, ov: &Overrides) -> Result<Table> {
             ))
         }
     };
-    for (group, option) in &ov.variants {
+    for (i, (group, option)) in ov.variants.iter().enumerate() {
+        if let Some((_, first)) = ov.variants[..i].iter().find(|(g, _)| g == group) {
+            return Err(Error::config(
+                "--variant",
+                format!(
+                    "variant group `{group}` is selected twice (`{first}` and `{option}`): \
+                     a group takes one option"
+                ),
+            ));
+        }
         let options = match variants.get(group) {
             Some(Value::Table(t)) => t,
             Some(_) => {
@@ -267,16 +276,71 @@ fn set_path(table: &mut Table, path: &str, value: Value) -> Result<()> {
     Ok(())
 }
 
-/// Removes the key at a dotted path of tables (a missing key is not an error: the
-/// default is what is asked for).
+/// Removes the key at a dotted path of tables (or of named or numbered elements of
+/// arrays of tables, as `--set` reaches them). A path the scenario does not have is
+/// an error naming it and what the table holds: a misspelt `--unset` must not pass
+/// as a no-op.
 fn unset_path(table: &mut Table, path: &str) -> Result<()> {
     let keys: Vec<&str> = path.split('.').collect();
+    if keys.iter().any(|k| k.is_empty()) {
+        return Err(Error::config(
+            "--unset",
+            format!("`{path}` is not a dotted path"),
+        ));
+    }
+    let missing = |here: &str, key: &str, t: &Table| {
+        let known: Vec<&str> = t.keys().map(String::as_str).collect();
+        Error::config(
+            "--unset",
+            format!(
+                "`{path}`: {} has no key `{key}` (it has: {})",
+                if here.is_empty() {
+                    "the scenario".to_string()
+                } else {
+                    format!("`{here}`")
+                },
+                list(&known)
+            ),
+        )
+    };
     let mut cur = table;
-    for key in &keys[..keys.len() - 1] {
-        cur = match cur.get_mut(*key) {
-            Some(Value::Table(t)) => t,
-            None => return Ok(()),
-            Some(_) => {
+    let mut depth = 0;
+    while depth + 1 < keys.len() {
+        let here = keys[..depth].join(".");
+        let key = keys[depth];
+        if !cur.contains_key(key) {
+            return Err(missing(&here, key, cur));
+        }
+        cur = match cur.get_mut(key) {
+            Some(Value::Table(t)) => {
+                depth += 1;
+                t
+            }
+            Some(Value::Array(items)) => {
+                let seg = keys[depth + 1];
+                let n = items.len();
+                let idx = array_index(items, seg).ok_or_else(|| {
+                    Error::config(
+                        "--unset",
+                        format!("`{path}`: `{key}` has {n} elements and none is `{seg}`"),
+                    )
+                })?;
+                if depth + 2 == keys.len() {
+                    items.remove(idx);
+                    return Ok(());
+                }
+                depth += 2;
+                match &mut items[idx] {
+                    Value::Table(t) => t,
+                    _ => {
+                        return Err(Error::config(
+                            "--unset",
+                            format!("`{path}`: `{key}.{seg}` is not a table"),
+                        ))
+                    }
+                }
+            }
+            _ => {
                 return Err(Error::config(
                     "--unset",
                     format!("`{path}`: `{key}` is not a table"),
@@ -284,8 +348,24 @@ fn unset_path(table: &mut Table, path: &str) -> Result<()> {
             }
         };
     }
-    cur.remove(keys[keys.len() - 1]);
+    let key = keys[keys.len() - 1];
+    if cur.remove(key).is_none() {
+        return Err(missing(&keys[..keys.len() - 1].join("."), key, cur));
+    }
     Ok(())
+}
+
+/// Whether the merged scenario `table` has a value at the dotted path of tables.
+pub fn has_path(table: &Table, path: &str) -> bool {
+    let mut cur = table;
+    let keys: Vec<&str> = path.split('.').collect();
+    for key in &keys[..keys.len() - 1] {
+        match cur.get(*key) {
+            Some(Value::Table(t)) => cur = t,
+            _ => return false,
+        }
+    }
+    cur.contains_key(keys[keys.len() - 1])
 }
 
 /// The element of an array of tables named by position or by its `name` key.
@@ -375,12 +455,21 @@ velocity = [0.0, -6.0]
         assert_eq!(t["bodies"][0]["name"].as_str(), Some("base"));
         assert_eq!(t["meshing"]["element_size"].as_float(), Some(0.1));
         assert_eq!(t["materials"]["concrete"]["model"].as_str(), Some("mazars"));
-        let u = apply(
-            table(),
-            &Overrides::none().unset("analysis.dt").unset("x.y"),
-        )
-        .unwrap();
+        let u = apply(table(), &Overrides::none().unset("analysis.dt")).unwrap();
         assert!(u["analysis"].get("dt").is_none());
+        // A path the scenario does not have is named, with what the table holds.
+        for (path, words) in [
+            ("x.y", "the scenario has no key `x`"),
+            ("analysis.dtt", "`analysis` has no key `dtt`"),
+            ("bodies.nobody.velocity", "none is `nobody`"),
+        ] {
+            let e = apply(table(), &Overrides::none().unset(path))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("--unset") && e.contains(words), "{e}");
+        }
+        let v = apply(table(), &Overrides::none().unset("bodies.steel.velocity")).unwrap();
+        assert!(v["bodies"][1].get("velocity").is_none());
         assert_eq!(
             ov.to_args(),
             [
@@ -417,5 +506,15 @@ velocity = [0.0, -6.0]
         assert!(e.contains("`analysis.dt` is a value"), "{e}");
         assert!(Overrides::none().set("dt").is_err());
         assert!(Overrides::none().variant("=x").is_err());
+        // One group selected twice.
+        let e = err(Overrides::none()
+            .variant("concrete=elastic")
+            .unwrap()
+            .variant("concrete=kv")
+            .unwrap());
+        assert!(
+            e.contains("`concrete` is selected twice (`elastic` and `kv`)"),
+            "{e}"
+        );
     }
 }

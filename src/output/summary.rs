@@ -211,6 +211,9 @@ pub struct Summary {
     /// The error, when failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// What the scenario gives that the analysis did not read ([`crate::model::Model::warnings`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Number of dofs.
     pub dofs: usize,
     /// Number of elements.

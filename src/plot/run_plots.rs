@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::chart_names;
 use super::draw::draw;
 use super::figure::{Figure, Series, Style};
 use super::history::History;
@@ -59,7 +60,8 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>> {
         Ok(())
     };
 
-    for p in h.probes() {
+    let probe_files = chart_names("probe", &h.probes());
+    for (p, file) in h.probes().iter().zip(&probe_files) {
         let uy = scaled(&h, &format!("{p}_uy"), 1e3).unwrap_or_default();
         let fig = Figure::new(format!("Probe {p}"), "t [ms]", "u_y [mm]").with(Series::from_xy(
             format!("{p}: u_y"),
@@ -67,7 +69,7 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>> {
             &uy,
             Style::Line,
         ));
-        emit(fig, &format!("probe_{}", file_safe(&p)))?;
+        emit(fig, file)?;
     }
 
     // Dissipation lines that are present and not identically zero, and the total.
@@ -118,28 +120,15 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>> {
         emit(fig, "dissipation")?;
     }
 
-    for p in h.pairs() {
+    let pair_files = chart_names("contact", &h.pairs());
+    for (p, file) in h.pairs().iter().zip(&pair_files) {
         let f = scaled(&h, &format!("{p}_force"), 1e-3).unwrap_or_default();
         let fig = Figure::new(format!("Contact {p}"), "t [ms]", "normal force [kN]").with(
             Series::from_xy(format!("{p}: total normal force"), &t, &f, Style::Line),
         );
-        emit(fig, &format!("contact_{}", file_safe(&p)))?;
+        emit(fig, file)?;
     }
     Ok(written)
-}
-
-/// `name` with every character but ASCII letters, digits, `-`, `_` and `.` replaced
-/// by `_`, for a file name.
-fn file_safe(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || "-_.".contains(c) {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }
 
 /// `energy.kinetic_0` of `dir/summary.json` when the file has it, else `E_kin` of

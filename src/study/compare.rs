@@ -31,13 +31,16 @@ pub fn pair(
 ) -> Result<Vec<PlannedRun>> {
     let scenario = super::plan::absolute(scenario)?;
     let implicit = base.then(&Overrides::none().set("analysis.scheme=\"backward_euler\"")?);
-    // The explicit run takes its own stable step and lumped mass.
-    let explicit = base.then(
-        &Overrides::none()
-            .unset("analysis.dt")
-            .unset("analysis.mass")
-            .set("analysis.scheme=\"central_difference\"")?,
-    );
+    // The explicit run takes its own stable step and lumped mass: the scenario's
+    // `dt` and `mass` are removed where it has them.
+    let table = crate::config::merged_table(&scenario, base)?;
+    let mut own = Overrides::none();
+    for key in ["analysis.dt", "analysis.mass"] {
+        if crate::config::overrides::has_path(&table, key) {
+            own = own.unset(key);
+        }
+    }
+    let explicit = base.then(&own.set("analysis.scheme=\"central_difference\"")?);
     Ok(vec![
         PlannedRun {
             id: format!("{prefix}implicit"),

@@ -77,7 +77,9 @@ pub fn probe_overlay(dir: &Path, runs: &[&RunData], what: &str) -> Result<()> {
         return Ok(());
     };
     let plots = dir.join("plots");
-    for p in first.probes() {
+    let probes = first.probes();
+    let files = crate::plot::chart_names("probe", &probes);
+    for (p, file) in probes.iter().zip(&files) {
         let mut fig = Figure::new(format!("Probe {p}, {what} study"), "t [ms]", "u_y [mm]");
         for r in runs {
             fig = fig.with(Series::new(
@@ -86,7 +88,7 @@ pub fn probe_overlay(dir: &Path, runs: &[&RunData], what: &str) -> Result<()> {
                 Style::Line,
             ));
         }
-        draw(&fig, &plots.join(format!("probe_{p}")))?;
+        draw(&fig, &plots.join(file))?;
     }
     let mut fig = Figure::new(
         format!("Total dissipation, {what} study"),

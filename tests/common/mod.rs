@@ -24,6 +24,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
         gravity: None,
         probes: Vec::new(),
         contacts: Vec::new(),
+        warnings: Vec::new(),
         analysis: Analysis {
             kind: AnalysisKind::Static,
             scheme: rothe::model::TimeScheme::BackwardEuler,

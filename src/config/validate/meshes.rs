@@ -24,6 +24,51 @@ fn rectangle_size(nx: u64, ny: u64, element: ElementKind) -> Option<(u64, u64)> 
     Some((nodes, elements))
 }
 
+/// `[meshing] element_size` must reach a body: on a scenario whose bodies all give
+/// `divisions`, their own `element_size` or a file, setting it (by `--set` or a mesh
+/// study's `--sizes`) would change nothing, and a study over it would report the
+/// convergence of one mesh.
+pub fn meshing_size_is_taken(s: &Scenario) -> Result<()> {
+    if s.meshing.element_size.is_none() {
+        return Ok(());
+    }
+    let taken = s.bodies.iter().any(|b| {
+        matches!(
+            b.mesh,
+            MeshSpec::Rectangle {
+                divisions: None,
+                element_size: None,
+                ..
+            }
+        )
+    });
+    if taken {
+        return Ok(());
+    }
+    let how: Vec<String> = s
+        .bodies
+        .iter()
+        .map(|b| {
+            let given = match &b.mesh {
+                MeshSpec::Rectangle {
+                    divisions: Some(_), ..
+                } => "divisions",
+                MeshSpec::Rectangle { .. } => "its own element_size",
+                MeshSpec::Gmsh { .. } => "a Gmsh file",
+            };
+            format!("`{}` gives {given}", b.name)
+        })
+        .collect();
+    Err(Error::config(
+        "meshing.element_size",
+        format!(
+            "no body takes it ({}): it would change no mesh; remove `divisions` from the \
+             bodies it should size",
+            how.join(", ")
+        ),
+    ))
+}
+
 /// How one rectangle is cut, resolved from its spec and `[meshing]`.
 enum Cuts<'a> {
     /// `divisions`: equal cells.

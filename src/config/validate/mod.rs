@@ -64,6 +64,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         return Err(Error::config("bodies", "at least one body is needed"));
     }
     meshes::check_generated_size(s, &materials, &mat_index, opts)?;
+    meshes::meshing_size_is_taken(s)?;
     let mut mesh = Mesh::default();
     let mut bodies = Vec::new();
     for (bi, b) in s.bodies.iter().enumerate() {
@@ -93,6 +94,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                     e => e,
                 }
             })?;
+        products_are_finite(&field, b, &materials[mat], a.plane, &part)?;
         mesh.add_part(&part, bi, &b.name, mat, b.thickness);
         bodies.push(Body {
             name: b.name.clone(),
@@ -143,18 +145,97 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             tolerance: a.tolerance,
             max_iterations: a.max_iterations,
             displacement_tolerance: a.displacement_tolerance,
-            iteration: a.iteration,
+            iteration: a.iteration.unwrap_or_default(),
             max_cuts: a.max_cuts,
             ordering: a.ordering,
             contact_tolerance,
-            contact_qp: a.contact_qp,
-            viscoelastic_state: a.viscoelastic_state,
+            contact_qp: a.contact_qp.unwrap_or_default(),
+            viscoelastic_state: a.viscoelastic_state.unwrap_or_default(),
         },
+        warnings: unread_keys(a),
     };
     if explicit {
         explicit_step(&mut model, a.dt, opts)?;
     }
     Ok(model)
+}
+
+/// A body's thickness times its material's stiffness and density (and times its
+/// area) must stay finite: a thickness of 1e300 overflows the element matrices,
+/// which would otherwise surface as a singular stiffness far from its cause.
+fn products_are_finite(
+    field: &str,
+    b: &super::BodySpec,
+    m: &crate::material::Material,
+    plane: crate::fe::Plane,
+    part: &crate::mesh::Part,
+) -> Result<()> {
+    let stiffness = m
+        .c(plane)
+        .iter()
+        .flatten()
+        .fold(0.0f64, |a, c| a.max(c.abs()));
+    let area: f64 = part
+        .blocks
+        .iter()
+        .flat_map(|bl| (0..bl.len()).map(move |e| (bl, e)))
+        .map(|(bl, e)| {
+            let x: Vec<[f64; 2]> = bl.element(e).iter().map(|&n| part.coords[n]).collect();
+            crate::mesh::polygon_area(&x).abs()
+        })
+        .sum();
+    for (what, product) in [
+        ("its material's stiffness", b.thickness * stiffness),
+        (
+            "its density and area (the mass)",
+            b.thickness * m.rho * area,
+        ),
+    ] {
+        if !product.is_finite() {
+            return Err(Error::config(
+                format!("{field}.thickness"),
+                format!(
+                    "{:e} m times {what} overflows ({product}): the element matrices would \
+                     not be finite",
+                    b.thickness
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Keys the analysis will not read, each as a warning naming it: those only the
+/// other time scheme reads (kept, so that `compare` can run one file both ways), and
+/// `omega` beside a given explicit step.
+fn unread_keys(a: &super::AnalysisSpec) -> Vec<String> {
+    let mut w = Vec::new();
+    let explicit = a.scheme == TimeScheme::CentralDifference;
+    if explicit {
+        let implicit_only = [
+            ("analysis.contact_qp", a.contact_qp.is_some()),
+            ("analysis.iteration", a.iteration.is_some()),
+            (
+                "analysis.viscoelastic_state",
+                a.viscoelastic_state.is_some(),
+            ),
+        ];
+        for (key, given) in implicit_only {
+            if given {
+                w.push(format!(
+                    "{key} is read by the implicit schemes only; central differences ignore it"
+                ));
+            }
+        }
+        if a.omega.is_some() && a.dt.is_some() {
+            w.push(
+                "analysis.omega sets the default explicit step only; the given analysis.dt \
+                 replaces it, so omega is ignored"
+                    .into(),
+            );
+        }
+    }
+    w
 }
 
 /// The paper's default fraction of the critical step.

@@ -1,0 +1,48 @@
+//! Fixed-size arrays read exactly: a scenario array with more or fewer entries than
+//! the quantity has (a velocity of three numbers, a rigid line of three points) is an
+//! error naming its length, never truncated (serde's own arrays stop reading after
+//! the length they want and drop the rest).
+
+use serde::de::{Deserialize, Deserializer, Error};
+
+/// Reads `[T; N]` from an array of exactly `N` entries.
+pub fn array<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let v = Vec::<T>::deserialize(d)?;
+    exactly(v)
+}
+
+/// Reads an optional `[T; N]` (with `#[serde(default)]`).
+pub fn option_array<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    Vec::<T>::deserialize(d).and_then(exactly).map(Some)
+}
+
+/// Reads an optional segment `[[x, y], [x, y]]`: two points of two coordinates.
+pub fn option_segment<'de, D>(d: D) -> Result<Option<[[f64; 2]; 2]>, D::Error>
+where
+    D: Deserializer<'de>,
+{
+    let points = Vec::<Vec<f64>>::deserialize(d)?;
+    let points: Vec<[f64; 2]> = points
+        .into_iter()
+        .map(exactly)
+        .collect::<Result<_, D::Error>>()?;
+    exactly(points).map(Some)
+}
+
+fn exactly<E: Error, T, const N: usize>(v: Vec<T>) -> Result<[T; N], E> {
+    let n = v.len();
+    v.try_into().map_err(|_| {
+        E::custom(format!(
+            "has {n} entries, expected {N}{}",
+            if N == 2 { " (x, y)" } else { "" }
+        ))
+    })
+}
