@@ -16,7 +16,7 @@ use crate::model::Model;
 use crate::system::{DofMap, EffectiveSystem};
 
 /// Output volumes from which `check` warns.
-const HUGE_OUTPUT: u64 = 20_000_000_000;
+pub const HUGE_OUTPUT: u64 = 20_000_000_000;
 
 /// What `rothe check` reports.
 #[derive(Clone, Debug)]

@@ -68,6 +68,10 @@ pub enum Error {
         /// Time of the step.
         t: f64,
     },
+    /// Runs of a study or sweep did not complete (each listed with its own error);
+    /// what the others gave was collected.
+    #[error("{0}")]
+    RunsFailed(String),
     /// A bug: something that must not happen did (a panic caught at the top).
     #[error("internal error (please report it with the input file): {0}")]
     Internal(String),

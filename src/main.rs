@@ -174,8 +174,23 @@ struct SweepArgs {
 }
 
 impl SweepArgs {
-    /// Emits the plan, or sweeps and collects it.
+    /// Checks the plan, then emits it, or sweeps and collects it. Fails (non-zero
+    /// exit) when a run failed, after collecting the others.
     fn execute(&self, plan: &rothe::study::Plan) -> rothe::Result<()> {
+        if let Some(j) = self.jobs {
+            if !(1..=MAX_JOBS).contains(&j) {
+                return Err(rothe::Error::config(
+                    "--jobs",
+                    format!("{j}: give 1 to {MAX_JOBS} runs at once"),
+                ));
+            }
+        }
+        let (steps, bytes) = plan.preflight()?;
+        eprintln!(
+            "{} runs, {steps} steps in all, about {:.1} MB of output",
+            plan.runs.len(),
+            bytes as f64 / 1e6
+        );
         if let Some(dir) = &self.emit {
             for f in plan.emit(dir)? {
                 println!("wrote {}", f.display());
@@ -197,11 +212,11 @@ impl SweepArgs {
         }
         let outcomes = rothe::study::sweep(plan, &self.out, &opts)?;
         let failed = outcomes.iter().filter(|o| o.error.is_some()).count();
-        let md = rothe::study::collect(&self.out)?;
+        let collected = rothe::study::collect(&self.out)?;
         if plan.kind == rothe::study::StudyKind::Report {
             println!("wrote {}", self.out.join("report.md").display());
         } else {
-            println!("{md}");
+            println!("{}", collected.markdown);
         }
         eprintln!(
             "{} runs ({failed} failed) in {:.1} s of run time; output in {}",
@@ -209,9 +224,12 @@ impl SweepArgs {
             outcomes.iter().map(|o| o.seconds).sum::<f64>(),
             self.out.display()
         );
-        Ok(())
+        collected.all_completed()
     }
 }
+
+/// Most runs a sweep starts at once.
+const MAX_JOBS: usize = 1024;
 
 /// A scenario and how to read it: the file, its variants and overrides, and the
 /// checks a user may lift.
@@ -437,7 +455,10 @@ fn study_command(study: StudyCommand) -> rothe::Result<()> {
             let plan = rothe::study::mesh_study::plan(&scenario.scenario, &base, &sizes)?;
             sweep.execute(&plan)
         }
-        StudyCommand::Collect { dir } => rothe::study::collect(&dir).map(|md| println!("{md}")),
+        StudyCommand::Collect { dir } => rothe::study::collect(&dir).and_then(|c| {
+            println!("{}", c.markdown);
+            c.all_completed()
+        }),
     }
 }
 

@@ -60,12 +60,14 @@ pub struct FieldReader {
     input: BufReader<File>,
     n: usize,
     buf: Vec<u8>,
+    len: u64,
 }
 
 impl FieldReader {
     /// Opens the file and reads its header.
     pub fn open(path: &Path) -> Result<Self> {
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
+        let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
         let mut input = BufReader::new(file);
         let mut head = [0u8; 16];
         input
@@ -83,7 +85,38 @@ impl FieldReader {
             input,
             n,
             buf: vec![0u8; 8 * (n + 1)],
+            len,
         })
+    }
+
+    /// The number of whole records, and whether the file ends exactly after the
+    /// last of them (false: a record was cut, as when a run is killed mid-write).
+    pub fn records(&self) -> (u64, bool) {
+        let record = 8 * (self.n as u64 + 1);
+        let body = self.len.saturating_sub(16);
+        (body / record, body % record == 0)
+    }
+
+    /// For the file of a run that completed: whole records only, as many as `states`,
+    /// `n_dofs` unknowns each; otherwise an error naming what does not match
+    /// (a truncated or foreign file must not pass for a shorter run).
+    pub fn expect(&self, states: u64, n_dofs: usize) -> Result<()> {
+        let (records, whole) = self.records();
+        let problem = if self.n != n_dofs {
+            Some(format!("{} dofs per state, the model has {n_dofs}", self.n))
+        } else if !whole {
+            Some("its last record is cut short (truncated)".to_string())
+        } else if records != states {
+            Some(format!(
+                "{records} states, the completed run recorded {states} (truncated or from another run)"
+            ))
+        } else {
+            None
+        };
+        match problem {
+            Some(p) => Err(Error::io(&self.path, std::io::Error::other(p))),
+            None => Ok(()),
+        }
     }
 
     /// Dofs per state.

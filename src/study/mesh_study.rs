@@ -16,13 +16,8 @@ use crate::plot::{draw, Figure, Series, Style};
 /// The plan of a mesh study over `sizes` (sorted coarse to fine).
 pub fn plan(scenario: &Path, base: &Overrides, sizes: &[f64]) -> Result<Plan> {
     let scenario = super::plan::absolute(scenario)?;
+    super::plan::check_sizes("--sizes", sizes, true)?;
     let mut sizes = sizes.to_vec();
-    if sizes.is_empty() || sizes.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
-        return Err(Error::config(
-            "--sizes",
-            format!("a mesh study needs positive sizes, got {sizes:?}"),
-        ));
-    }
     sizes.sort_by(|a, b| b.total_cmp(a));
     sizes.dedup();
     let runs = sizes

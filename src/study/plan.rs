@@ -43,6 +43,33 @@ pub struct PlannedRun {
     pub record_fields: bool,
 }
 
+/// Checks a list of mesh sizes given for `flag`: finite and positive, at most
+/// [`MAX_SIZES`] of them, and not empty when `needed`.
+pub fn check_sizes(flag: &str, sizes: &[f64], needed: bool) -> Result<()> {
+    if needed && sizes.is_empty() {
+        return Err(Error::config(flag, "give at least one size (m)"));
+    }
+    if sizes.len() > MAX_SIZES {
+        return Err(Error::config(
+            flag,
+            format!("{} sizes: at most {MAX_SIZES}", sizes.len()),
+        ));
+    }
+    if let Some(s) = sizes.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
+        return Err(Error::config(
+            flag,
+            format!("sizes must be positive lengths (m), got {s} in {sizes:?}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Most sizes a mesh list of a study may hold.
+pub const MAX_SIZES: usize = 32;
+
+/// Most runs a plan may hold.
+pub const MAX_RUNS: usize = 1000;
+
 /// A sweep.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
@@ -74,6 +101,67 @@ impl Plan {
         Ok(path)
     }
 
+    /// Checks the plan before anything runs: it has runs, at most [`MAX_RUNS`]; every
+    /// run's scenario loads with its overrides (an error names the run); and the
+    /// plan's total steps and output stay within the limits `check` warns at
+    /// ([`crate::config::HUGE_STEPS`], [`crate::check::HUGE_OUTPUT`]), so a study
+    /// with a mistyped size or halving count is refused instead of started.
+    /// Returns the total `(steps, output bytes)`.
+    pub fn preflight(&self) -> Result<(usize, u64)> {
+        if self.runs.is_empty() {
+            return Err(Error::config("plan", "has no runs"));
+        }
+        if self.runs.len() > MAX_RUNS {
+            return Err(Error::config(
+                "plan",
+                format!(
+                    "{} runs: more than {MAX_RUNS}; is a count or a list of sizes mistyped?",
+                    self.runs.len()
+                ),
+            ));
+        }
+        let (mut steps, mut bytes) = (0usize, 0u64);
+        for r in &self.runs {
+            let model = crate::config::load_with_overrides(
+                &r.scenario,
+                &crate::config::LoadOptions::default(),
+                &r.overrides,
+            )
+            .map_err(|e| Error::config(format!("run {} ({})", r.id, r.label), e.to_string()))?;
+            let v = crate::check::volume(&model);
+            let fields = if r.record_fields {
+                (model.analysis.n_steps() as u64 + 1) * (model.mesh.n_dofs() as u64 + 1) * 8
+            } else {
+                0
+            };
+            steps = steps.saturating_add(model.analysis.n_steps());
+            bytes = bytes.saturating_add(v.history.1 + v.vtk.1 + fields);
+        }
+        if steps >= crate::config::HUGE_STEPS {
+            return Err(Error::config(
+                "plan",
+                format!(
+                    "{} runs take {steps} steps in all, past the {} a check calls runaway; \
+                     fewer halvings or coarser steps?",
+                    self.runs.len(),
+                    crate::config::HUGE_STEPS
+                ),
+            ));
+        }
+        if bytes >= crate::check::HUGE_OUTPUT {
+            return Err(Error::config(
+                "plan",
+                format!(
+                    "{} runs would write about {:.1} GB in all (history, VTK, fields): raise \
+                     vtk_every or plan fewer runs",
+                    self.runs.len(),
+                    bytes as f64 / 1e9
+                ),
+            ));
+        }
+        Ok((steps, bytes))
+    }
+
     /// The output directory of a run.
     pub fn run_dir(dir: &Path, run: &PlannedRun) -> PathBuf {
         dir.join("runs").join(&run.id)
@@ -94,6 +182,7 @@ impl Plan {
                 args.push("--out".into());
                 args.push(Self::run_dir(dir, r).display().to_string());
                 args.push("--quiet".into());
+                args.push("--overwrite".into());
                 if r.record_fields {
                     args.push("--record-fields".into());
                 }
@@ -178,7 +267,7 @@ mod tests {
         let c = &plan.commands(Path::new("/d"))[0];
         assert_eq!(
             c,
-            "rothe run '/s/a b.toml' --set 'bodies.steel.velocity=[0.0, -1.0]' --out /d/runs/h0 --quiet --record-fields"
+            "rothe run '/s/a b.toml' --set 'bodies.steel.velocity=[0.0, -1.0]' --out /d/runs/h0 --quiet --overwrite --record-fields"
         );
         let dir = tempfile::tempdir().unwrap();
         plan.emit(dir.path()).unwrap();

@@ -86,6 +86,16 @@ pub fn plan(o: &ReportOptions) -> Result<Plan> {
             ));
         }
     }
+    for (flag, sizes) in [
+        ("--meshes", &o.meshes),
+        ("--damage-meshes", &o.damage_meshes),
+    ] {
+        super::plan::check_sizes(flag, sizes, flag == "--meshes")?;
+    }
+    super::plan::check_sizes("--compare-mesh", &[o.compare_mesh], true)?;
+    if let Some(s) = o.beam_size {
+        super::plan::check_sizes("--beam-size", &[s], true)?;
+    }
     let abs1 = super::plan::absolute(&b1)?;
     let abs2 = super::plan::absolute(&b2)?;
     let mut runs = Vec::new();

@@ -98,7 +98,8 @@ pub fn sweep(plan: &Plan, dir: &Path, opts: &SweepOptions) -> Result<Vec<RunOutc
             running.fetch_sub(1, Ordering::Relaxed);
             let error = result.err().map(|e| e.to_string());
             if let Some(e) = &error {
-                pb.println(format!("run {} ({}) failed: {e}", r.id, r.label));
+                // A failure is printed whether or not the progress display shows.
+                pb.suspend(|| eprintln!("run {} ({}) failed: {e}", r.id, r.label));
             } else {
                 pb.println(format!("run {} ({}) done in {seconds:.1} s", r.id, r.label));
             }

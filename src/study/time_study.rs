@@ -47,6 +47,12 @@ pub fn plan(
             format!("a time study needs at least two positive steps, got {hs:?}"),
         ));
     }
+    if hs.len() > super::plan::MAX_SIZES {
+        return Err(Error::config(
+            "--h",
+            format!("{} steps: at most {}", hs.len(), super::plan::MAX_SIZES),
+        ));
+    }
     hs.sort_by(|a, b| b.total_cmp(a));
     hs.dedup();
     if reference_halvings > 20 {
@@ -86,8 +92,17 @@ pub fn plan(
     })
 }
 
-/// The steps `h, h/2, ..., h/2^n` from the scenario's own `h`.
+/// Most halvings a time study takes (`h / 2^20`: a million times the steps).
+pub const MAX_HALVINGS: usize = 20;
+
+/// The steps `h, h/2, ..., h/2^n` from the scenario's own `h` (`1 ≤ n ≤ 20`).
 pub fn halvings(scenario: &Path, base: &Overrides, n: usize) -> Result<Vec<f64>> {
+    if !(1..=MAX_HALVINGS).contains(&n) {
+        return Err(Error::config(
+            "--halvings",
+            format!("{n}: give 1 to {MAX_HALVINGS} (a study needs two steps)"),
+        ));
+    }
     let model = load_with_overrides(scenario, &LoadOptions::default(), base)?;
     let h = model.analysis.dt;
     Ok((0..=n).map(|k| h / f64::powi(2.0, k as i32)).collect())
@@ -283,6 +298,12 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
         &reference.run.overrides,
     )?;
     let norms = Norms::new(&model.mesh);
+    // Each completed run's fields: one whole state per row of its history, on the
+    // reference's mesh.
+    for r in coarse.iter().chain(std::iter::once(&reference)) {
+        let states = r.column("t").len() as u64;
+        FieldReader::open(&r.dir.join("fields.bin"))?.expect(states, model.mesh.n_dofs())?;
+    }
     let paths: Vec<std::path::PathBuf> = coarse.iter().map(|r| r.dir.join("fields.bin")).collect();
     let refs: Vec<&Path> = paths.iter().map(|p| p.as_path()).collect();
     let errs = errors(&norms, &refs, &reference.dir.join("fields.bin"))?;
