@@ -426,9 +426,9 @@ fn contact_pairs_are_validated() {
 
 #[test]
 fn an_infeasible_contact_qp_cuts_the_step_then_stops_naming_the_pair_and_status() {
-    // A block whose bottom nodes may not move vertically sits a millimetre below the
-    // apex of a V of two rigid lines: its middle bottom node penetrates both, and
-    // moving sideways cannot free it from both (the QP is infeasible). Every step
+    // A block whose bottom nodes are driven down (prescribed y) into a V of two rigid
+    // lines: once the bottom passes below the apex (step 7, t = 6e-5 s), no sideways
+    // motion keeps a bottom node above both lines (the QP is infeasible). Every step
     // cut fails the same way; the run stops naming the step, the pair, Clarabel's
     // status and the worst gap, and keeps what it wrote.
     let text = r#"
@@ -446,10 +446,12 @@ rho = 7850.0
 name = "block"
 material = "steel"
 thickness = 0.1
-mesh = { kind = "rectangle", origin = [-0.05, -0.001], size = [0.1, 0.1], divisions = [2, 2] }
-[[supports]]
+mesh = { kind = "rectangle", origin = [-0.05, 0.06], size = [0.1, 0.1], divisions = [2, 2] }
+[[prescribed]]
 set = "block.bottom"
-fix = ["y"]
+component = "y"
+value = -0.1
+function = { kind = "ramp", t0 = 0.0, t1 = 1.0e-4 }
 [[contact]]
 name = "vee_left"
 slave = "block.bottom"
@@ -471,7 +473,7 @@ rigid_line = [[0.0, 0.0], [1.0, 1.0]]
     assert!(!run.status.success(), "the run went through: {err}");
     assert!(!err.contains("panicked"), "{err}");
     for word in [
-        "step 1",
+        "step 7",
         "3 step cuts",
         "vee_left",
         "vee_right",

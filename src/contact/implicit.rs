@@ -122,6 +122,8 @@ pub struct ContactCorrection<'m> {
     added: bool,
     // Workspace.
     x: Vec<f64>,
+    /// Node positions at the start of the step (`x` above is the current one).
+    x0: Vec<f64>,
     delta0: Vec<f64>,
     rows: Vec<usize>,
     y: Vec<f64>,
@@ -168,6 +170,7 @@ impl<'m> ContactCorrection<'m> {
             f_c: vec![0.0; n],
             added: false,
             x: vec![0.0; n],
+            x0: Vec::new(),
             delta0: Vec::new(),
             rows: Vec::new(),
             y: Vec::new(),
@@ -198,6 +201,15 @@ impl<'m> ContactCorrection<'m> {
         // Slaves that came around the end of a rigid line are not its candidates;
         // those it holds stay on it a little beyond its ends.
         let coords = &self.model.mesh.coords;
+        // The geometry at the start of the step: a slave's motion from it is swept
+        // for crossings ([`super::detect::crossed`]).
+        self.x0.clear();
+        self.x0.extend(
+            coords
+                .iter()
+                .enumerate()
+                .flat_map(|(n, c)| [c[0] + u[2 * n], c[1] + u[2 * n + 1]]),
+        );
         self.rigid.beneath = super::detect::beneath_rigid(
             self.pairs,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
@@ -290,6 +302,16 @@ impl<'m> ContactCorrection<'m> {
             &self.rigid,
             &mut self.cands,
         );
+        if !self.x0.is_empty() {
+            let x0 = &self.x0;
+            super::detect::crossed(
+                self.pairs,
+                |n| [x0[2 * n], x0[2 * n + 1]],
+                |n| [x[2 * n], x[2 * n + 1]],
+                &self.rigid,
+                &mut self.cands,
+            );
+        }
         self.stats.detect_s += t.elapsed().as_secs_f64();
     }
 

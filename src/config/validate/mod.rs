@@ -157,7 +157,46 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     if explicit {
         explicit_step(&mut model, a.dt, opts)?;
     }
+    initial_overlap(&model)?;
     Ok(model)
+}
+
+/// Bodies (or a body and a rigid line) must not overlap at the start: a slave node
+/// deeper than the contact tolerance behind its master is refused with the pair, the
+/// node and the depth. (The QP would otherwise fling it out in the first step, or
+/// report an infeasible step far from the cause.)
+fn initial_overlap(model: &Model) -> Result<()> {
+    let mut cands = Vec::new();
+    let coords = &model.mesh.coords;
+    crate::contact::detect::detect(&model.contacts, |n| coords[n], &mut cands);
+    let tol = model.analysis.contact_tolerance;
+    let deepest = cands
+        .iter()
+        .filter(|c| c.gap < -tol)
+        .min_by(|a, b| a.gap.total_cmp(&b.gap));
+    let Some(c) = deepest else {
+        return Ok(());
+    };
+    let count = cands.iter().filter(|c| c.gap < -tol).count();
+    let pair = &model.contacts[c.pair];
+    let master = match c.master {
+        crate::contact::detect::Contactee::Rigid => "its rigid line".to_string(),
+        crate::contact::detect::Contactee::Segment { nodes, .. } => {
+            format!("the master segment of nodes {} and {}", nodes[0], nodes[1])
+        }
+    };
+    Err(Error::config(
+        format!("contact[{}]", c.pair),
+        format!(
+            "pair `{}`: the bodies overlap at the start: {} lies {:.3e} m behind {master} \
+             ({count} slave node{} deeper than the contact tolerance {tol:.1e} m); move \
+             the bodies apart (touching is fine)",
+            pair.name,
+            model.describe_node(c.slave),
+            -c.gap,
+            if count == 1 { "" } else { "s" },
+        ),
+    ))
 }
 
 /// A body's thickness times its material's stiffness and density (and times its
