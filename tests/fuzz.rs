@@ -5,6 +5,13 @@
 //! message: never a panic, never a non-finite number reported as a success, never an
 //! allocation beyond the memory limit (2 GB here, so a huge mesh is refused).
 //!
+//! Gmsh files are fuzzed too (the node and element blocks of a real Gmsh mesh
+//! with tags permuted, repeated, dropped or made sparse, coordinates and counts
+//! corrupted, bytes cut off or flipped): read, a mesh must come out with every node
+//! where its block put it, or an error. Command-line overrides (`--set`, `--unset`,
+//! `--variant` with good and bad paths and values) are applied to the examples: a
+//! model or an error, never a panic.
+//!
 //! `FUZZ_SHOW=1` prints every refusal. A few hundred seeded cases run by default;
 //! `cargo test --release --test fuzz -- --ignored` runs a long campaign (20,000
 //! cases, about 15 s).
@@ -344,4 +351,369 @@ fn mutated_examples_never_panic_or_pass_non_finite_results() {
 fn mutated_examples_long_campaign() {
     std::panic::set_hook(Box::new(|_| {}));
     campaign(20_000);
+}
+
+/// A change to a Gmsh file.
+#[derive(Clone, Debug)]
+enum GmshMutation {
+    /// Reverse the tags (and coordinates) of the `k`-th node block.
+    Reverse(usize),
+    /// Rotate the tag list of the `k`-th node block (coordinates stay: tags move).
+    RotateTags(usize),
+    /// Multiply every node tag (and every reference to it) by `f`.
+    Sparse(u64),
+    /// Give the `k`-th node line of a block the tag of the first.
+    Repeat(usize),
+    /// Replace the `k`-th number of the file by `v`.
+    Number(usize, String),
+    /// Cut the file after `k` bytes (modulo its length).
+    Cut(usize),
+    /// Flip byte `k` (modulo the length) to `b`.
+    Flip(usize, u8),
+}
+
+fn gmsh_mutation() -> impl Strategy<Value = GmshMutation> {
+    prop_oneof![
+        (0..20usize).prop_map(GmshMutation::Reverse),
+        (0..20usize).prop_map(GmshMutation::RotateTags),
+        (2..50u64).prop_map(GmshMutation::Sparse),
+        (0..200usize).prop_map(GmshMutation::Repeat),
+        (
+            0..3000usize,
+            prop_oneof![
+                Just("0".to_string()),
+                Just("-1".to_string()),
+                Just("99999999999999999999".to_string()),
+                Just("nan".to_string()),
+                Just("1e308".to_string()),
+                Just("x".to_string()),
+                Just("4".to_string()),
+            ]
+        )
+            .prop_map(|(k, v)| GmshMutation::Number(k, v)),
+        (0..20000usize).prop_map(GmshMutation::Cut),
+        (0..20000usize, any::<u8>()).prop_map(|(k, b)| GmshMutation::Flip(k, b)),
+    ]
+}
+
+/// The node blocks of an ASCII MSH 4.1 text: `(header line, tag lines, coordinate
+/// lines)` each, with the text before and after `$Nodes`'s body.
+fn node_blocks(text: &str) -> Option<(String, Vec<(String, Vec<String>, Vec<String>)>, String)> {
+    let (head, rest) = text.split_once("$Nodes\n")?;
+    let (body, tail) = rest.split_once("$EndNodes\n")?;
+    let mut lines = body.lines();
+    let first = lines.next()?.to_string();
+    let mut blocks = Vec::new();
+    while let Some(h) = lines.next() {
+        let n: usize = h.split_whitespace().nth(3)?.parse().ok()?;
+        let tags: Vec<String> = (0..n)
+            .map(|_| lines.next().map(String::from))
+            .collect::<Option<_>>()?;
+        let xyz: Vec<String> = (0..n)
+            .map(|_| lines.next().map(String::from))
+            .collect::<Option<_>>()?;
+        blocks.push((h.to_string(), tags, xyz));
+    }
+    Some((
+        format!("{head}$Nodes\n{first}\n"),
+        blocks,
+        format!("$EndNodes\n{tail}"),
+    ))
+}
+
+fn join_blocks(head: &str, blocks: &[(String, Vec<String>, Vec<String>)], tail: &str) -> String {
+    let mut out = head.to_string();
+    for (h, tags, xyz) in blocks {
+        out += h;
+        out.push('\n');
+        for l in tags.iter().chain(xyz) {
+            out += l;
+            out.push('\n');
+        }
+    }
+    out + tail
+}
+
+fn apply_gmsh(bytes: &[u8], m: &GmshMutation) -> Vec<u8> {
+    let text = String::from_utf8_lossy(bytes).into_owned();
+    let edit_blocks = |f: &dyn Fn(&mut Vec<(String, Vec<String>, Vec<String>)>)| -> Vec<u8> {
+        match node_blocks(&text) {
+            Some((head, mut blocks, tail)) => {
+                f(&mut blocks);
+                join_blocks(&head, &blocks, &tail).into_bytes()
+            }
+            None => bytes.to_vec(),
+        }
+    };
+    match m {
+        GmshMutation::Reverse(k) => edit_blocks(&|b| {
+            let n = b.len();
+            if n > 0 {
+                let blk = &mut b[k % n];
+                blk.1.reverse();
+                blk.2.reverse();
+            }
+        }),
+        GmshMutation::RotateTags(k) => edit_blocks(&|b| {
+            let n = b.len();
+            if n > 0 && !b[k % n].1.is_empty() {
+                b[k % n].1.rotate_left(1);
+            }
+        }),
+        GmshMutation::Repeat(k) => edit_blocks(&|b| {
+            let n = b.len();
+            if n > 0 {
+                let blk = &mut b[k % n];
+                if blk.1.len() > 1 {
+                    let i = 1 + k % (blk.1.len() - 1);
+                    blk.1[i] = blk.1[0].clone();
+                }
+            }
+        }),
+        GmshMutation::Sparse(f) => {
+            // Every node tag and every element's node reference times f (the
+            // element tags stay).
+            let scale = |w: &str| {
+                w.parse::<u64>()
+                    .map(|t| (t * f).to_string())
+                    .unwrap_or(w.into())
+            };
+            let mut t = String::from_utf8(edit_blocks(&|b| {
+                for blk in b.iter_mut() {
+                    for tag in blk.1.iter_mut() {
+                        *tag = scale(tag.trim());
+                    }
+                }
+            }))
+            .unwrap_or_default();
+            if let Some((head, rest)) = t.clone().split_once("$Elements\n") {
+                if let Some((body, tail)) = rest.split_once("$EndElements\n") {
+                    let mut lines = body.lines();
+                    let mut out = format!("{head}$Elements\n{}\n", lines.next().unwrap_or(""));
+                    while let Some(h) = lines.next() {
+                        let n: usize = h
+                            .split_whitespace()
+                            .nth(3)
+                            .and_then(|x| x.parse().ok())
+                            .unwrap_or(0);
+                        out += h;
+                        out.push('\n');
+                        for _ in 0..n {
+                            let l = lines.next().unwrap_or("");
+                            let mut w = l.split_whitespace();
+                            let tag = w.next().unwrap_or("");
+                            let rest: Vec<String> = w.map(scale).collect();
+                            out += &format!("{tag} {}\n", rest.join(" "));
+                        }
+                    }
+                    t = out + "$EndElements\n" + tail;
+                }
+            }
+            t.into_bytes()
+        }
+        GmshMutation::Number(k, v) => {
+            let mut count = 0;
+            let mut out = String::new();
+            let mut replaced = false;
+            for line in text.split_inclusive('\n') {
+                if line.starts_with('$') || line.contains('"') || replaced {
+                    out += line;
+                    continue;
+                }
+                let words: Vec<&str> = line.split_whitespace().collect();
+                if count + words.len() > *k {
+                    let mut w: Vec<String> = words.iter().map(|s| s.to_string()).collect();
+                    w[k - count] = v.clone();
+                    out += &(w.join(" ") + "\n");
+                    replaced = true;
+                } else {
+                    out += line;
+                }
+                count += words.len();
+            }
+            out.into_bytes()
+        }
+        GmshMutation::Cut(k) => bytes[..k % bytes.len().max(1)].to_vec(),
+        GmshMutation::Flip(k, b) => {
+            let mut v = bytes.to_vec();
+            if !v.is_empty() {
+                let i = k % v.len();
+                v[i] = *b;
+            }
+            v
+        }
+    }
+}
+
+/// Reads a mutated Gmsh file: an error, or a part whose every node sits where the
+/// original file put the node of its tag (for mutations that keep the geometry).
+fn exercise_gmsh(
+    bytes: &[u8],
+    keeps_geometry: bool,
+    reference: &std::collections::HashMap<u64, [f64; 2]>,
+    scale: u64,
+) -> Result<(), String> {
+    let part = match rothe::mesh::gmsh::parse(bytes).and_then(|p| p.check().map(|_| p)) {
+        Ok(p) => p,
+        Err(e) => {
+            if std::env::var_os("FUZZ_SHOW").is_some() {
+                eprintln!("refused: {e}");
+            }
+            return (!e.is_empty()).then_some(()).ok_or("empty error".into());
+        }
+    };
+    if keeps_geometry {
+        let tags = part.node_tags.as_ref().ok_or("no tags")?;
+        for (t, x) in tags.iter().zip(&part.coords) {
+            let want = reference
+                .get(&(t / scale))
+                .ok_or(format!("tag {t} unknown"))?;
+            if want != x {
+                return Err(format!("node tag {t} at {x:?}, its block says {want:?}"));
+            }
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn mutated_gmsh_files_read_right_or_are_refused() {
+    std::panic::set_hook(Box::new(|_| {}));
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plate_tri.msh");
+    let original = std::fs::read(&path).unwrap();
+    let reference: std::collections::HashMap<u64, [f64; 2]> = {
+        let p = rothe::mesh::gmsh::parse(&original).unwrap();
+        p.node_tags.unwrap().into_iter().zip(p.coords).collect()
+    };
+    let mut config = Config {
+        cases: 300,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
+        config.rng_seed = proptest::test_runner::RngSeed::Fixed(0x5eed_0003);
+    }
+    let mut runner = TestRunner::new(config);
+    runner
+        .run(&gmsh_mutation(), |m| {
+            let bytes = apply_gmsh(&original, &m);
+            let (keeps, scale) = match &m {
+                GmshMutation::Reverse(_) => (true, 1),
+                GmshMutation::Sparse(f) => (true, *f),
+                _ => (false, 1),
+            };
+            match catch_unwind(AssertUnwindSafe(|| {
+                exercise_gmsh(&bytes, keeps, &reference, scale)
+            })) {
+                Ok(Ok(())) => Ok(()),
+                Ok(Err(why)) => Err(TestCaseError::fail(format!("{m:?}: {why}"))),
+                Err(p) => Err(TestCaseError::fail(format!(
+                    "{m:?}: panic: {}",
+                    rothe::run::panic_message(p.as_ref())
+                ))),
+            }
+        })
+        .unwrap_or_else(|e| {
+            eprintln!("{e}");
+            panic!("the Gmsh campaign failed: {e}")
+        });
+}
+
+/// An override for the command line: good and bad paths and values.
+fn override_case() -> impl Strategy<Value = (u8, String)> {
+    let paths = prop_oneof![
+        Just("analysis.dt"),
+        Just("analysis.t_end"),
+        Just("analysis.gravity"),
+        Just("analysis.rayleigh"),
+        Just("analysis.scheme"),
+        Just("analysis.contact_qp"),
+        Just("analysis.omega"),
+        Just("analysis.nothing"),
+        Just("bodies.0.velocity"),
+        Just("bodies.0.thickness"),
+        Just("bodies.9.thickness"),
+        Just("bodies.0.mesh.divisions"),
+        Just("meshing.element_size"),
+        Just("materials"),
+        Just("contact.0.rigid_line"),
+        Just("probes.0.at"),
+        Just("..x"),
+    ];
+    let values = prop_oneof![
+        Just("1e-6"),
+        Just("0"),
+        Just("-1"),
+        Just("nan"),
+        Just("1e300"),
+        Just("[1.0, 2.0]"),
+        Just("[1.0, 2.0, 3.0]"),
+        Just("[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]"),
+        Just("\"central_difference\""),
+        Just("\"full\""),
+        Just("{ a = 1 }"),
+        Just("text"),
+    ];
+    (
+        0..3u8,
+        (paths, values).prop_map(|(p, v)| format!("{p}={v}")),
+    )
+}
+
+#[test]
+fn command_line_overrides_give_a_model_or_an_error() {
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut scenarios = examples("examples/scenarios");
+    scenarios.extend(examples("examples/contact"));
+    let mut config = Config {
+        cases: 200,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
+        config.rng_seed = proptest::test_runner::RngSeed::Fixed(0x5eed_0004);
+    }
+    let mut runner = TestRunner::new(config);
+    let strategy = (
+        0..scenarios.len(),
+        proptest::collection::vec(override_case(), 1..4),
+    );
+    runner
+        .run(&strategy, |(file, cases)| {
+            let (path, _) = &scenarios[file];
+            let outcome = catch_unwind(AssertUnwindSafe(|| {
+                let mut ov = rothe::config::Overrides::none();
+                for (kind, spec) in &cases {
+                    ov = match kind {
+                        0 => ov.set(spec)?,
+                        1 => ov.unset(spec.split('=').next().unwrap_or("")),
+                        _ => ov.variant(spec)?,
+                    };
+                }
+                let opts = LoadOptions {
+                    memory_limit: Some(LIMIT),
+                    allow_unstable: false,
+                };
+                rothe::config::load_with_overrides(path, &opts, &ov).map(|_| ())
+            }));
+            match outcome {
+                Ok(Ok(())) => Ok(()),
+                Ok(Err(e)) if !e.to_string().is_empty() => {
+                    if std::env::var_os("FUZZ_SHOW").is_some() {
+                        eprintln!("refused: {e}");
+                    }
+                    Ok(())
+                }
+                Ok(Err(_)) => Err(TestCaseError::fail("an empty error")),
+                Err(p) => Err(TestCaseError::fail(format!(
+                    "{}: {cases:?}: panic: {}",
+                    path.display(),
+                    rothe::run::panic_message(p.as_ref())
+                ))),
+            }
+        })
+        .unwrap_or_else(|e| {
+            eprintln!("{e}");
+            panic!("the override campaign failed: {e}")
+        });
 }

@@ -808,3 +808,295 @@ fn bodies_overlapping_at_the_start_are_refused_with_the_pair_node_and_depth() {
     let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
     assert!(ok, "{err}");
 }
+
+#[test]
+fn arrays_with_more_or_fewer_entries_than_the_quantity_are_refused() {
+    let text = good();
+    let cases: [(&str, &str, &str); 3] = [
+        (
+            "vtk_every = 5",
+            "vtk_every = 5\ngravity = [0.0, -9.81, 0.0]",
+            "analysis.gravity",
+        ),
+        (
+            "vtk_every = 5",
+            "vtk_every = 5\nrayleigh = [1.0]",
+            "analysis.rayleigh",
+        ),
+        ("at = [2.0, 0.25]", "at = [2.0, 0.25, 7.0]", "probes[0].at"),
+    ];
+    for (from, to, field) in cases {
+        assert!(text.contains(from));
+        refused(&text.replacen(from, to, 1), &[field, "entries, expected"]);
+    }
+    let rigid = tunnelling(true, "backward_euler").replace(
+        "[[-1.0, 0.0], [1.0, 0.0]]",
+        "[[-1.0, 0.0], [1.0, 0.0], [2.0, 0.0]]",
+    );
+    refused(
+        &rigid,
+        &["contact[0].rigid_line", "has 3 entries, expected 2"],
+    );
+    // The same through --set.
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(dir.path(), "s.toml", &good());
+    let (ok, _, err) = rothe(&[
+        "check",
+        sc.to_str().unwrap(),
+        "--set",
+        "bodies.0.velocity=[1.0, 0.0, 3.0]",
+    ]);
+    assert!(
+        !ok && err.contains("bodies[0].velocity") && err.contains("has 3 entries"),
+        "{err}"
+    );
+}
+
+#[test]
+fn overrides_that_would_change_nothing_are_refused_or_warned() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(dir.path(), "s.toml", &good());
+    let s = sc.to_str().unwrap();
+    // --unset of a key the scenario does not have.
+    let (ok, _, err) = rothe(&["check", s, "--unset", "analysis.dtt"]);
+    assert!(!ok && err.contains("`analysis` has no key `dtt`"), "{err}");
+    // meshing.element_size on bodies that give divisions: by --set and by a study.
+    let (ok, _, err) = rothe(&["check", s, "--set", "meshing.element_size=0.1"]);
+    assert!(
+        !ok && err.contains("meshing.element_size") && err.contains("no body takes it"),
+        "{err}"
+    );
+    let out = dir.path().join("study");
+    let (ok, _, err) = rothe(&[
+        "study",
+        "mesh",
+        s,
+        "--sizes",
+        "0.2,0.1",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!ok && err.contains("no body takes it"), "{err}");
+    assert!(
+        !out.join("study.md").exists(),
+        "a refused plan reports nothing"
+    );
+    // --variant twice for one group.
+    let bench = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/benchmarks/two_blocks.toml");
+    let (ok, _, err) = rothe(&[
+        "check",
+        bench.to_str().unwrap(),
+        "--variant",
+        "concrete=elastic",
+        "--variant",
+        "concrete=mazars",
+    ]);
+    assert!(!ok && err.contains("selected twice"), "{err}");
+    // Keys only the other scheme reads: warned of by check and by run (and kept in
+    // summary.json).
+    let text = tunnelling(true, "central_difference").replace(
+        "vtk_every = 0",
+        "vtk_every = 0\ncontact_qp = \"full\"\niteration = \"fixed\"\nomega = 0.5\ndt = 1.0e-7",
+    );
+    let sc = scenario(dir.path(), "x.toml", &text);
+    let (ok, out, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    for key in [
+        "analysis.contact_qp",
+        "analysis.iteration",
+        "analysis.omega",
+    ] {
+        assert!(
+            out.contains(&format!("warning     {key}")),
+            "{key} not warned of: {out}"
+        );
+    }
+    let run_out = dir.path().join("x");
+    let (ok, _, err) = rothe(&[
+        "run",
+        sc.to_str().unwrap(),
+        "--out",
+        run_out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: analysis.contact_qp is read by the implicit schemes only"),
+        "{err}"
+    );
+    assert_eq!(summary(&run_out)["warnings"].as_array().unwrap().len(), 3);
+}
+
+#[test]
+fn messages_name_the_field_the_line_and_the_column() {
+    let text = good();
+    // A type error in the file: the field's path, line and column.
+    let bad = text.replacen("thickness = ", "thickness = \"thin\" #", 1);
+    refused(
+        &bad,
+        &[
+            "bodies[0].thickness (line ",
+            "column ",
+            "invalid type: string \"thin\", expected f64",
+        ],
+    );
+    // A syntax error: line and column.
+    let syntax = text.replacen("vtk_every = 5", "vtk_every = 5 5", 1);
+    refused(&syntax, &["line ", ", column "]);
+    // A type error through --set: the field's path.
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(dir.path(), "s.toml", &text);
+    let (ok, _, err) = rothe(&["check", sc.to_str().unwrap(), "--set", "analysis.dt=fast"]);
+    assert!(
+        !ok && err.contains("analysis.dt (after variants and --set): invalid type"),
+        "{err}"
+    );
+    // A product that overflows: named as such, not as a singular stiffness.
+    let thick = text.replacen("thickness = ", "thickness = 1e300 #", 1);
+    refused(&thick, &["bodies[0].thickness", "overflows"]);
+}
+
+#[test]
+fn an_output_directory_never_mixes_two_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(dir.path(), "s.toml", &good());
+    let s = sc.to_str().unwrap();
+    // A file where the directory should be.
+    let file = dir.path().join("taken");
+    std::fs::write(&file, "x").unwrap();
+    let (ok, _, err) = rothe(&["run", s, "--out", file.to_str().unwrap(), "--quiet"]);
+    assert!(!ok && err.contains("is a file, not a directory"), "{err}");
+    // An earlier run is refused, then replaced with --overwrite: its VTK files go.
+    let out = dir.path().join("o");
+    let o = out.to_str().unwrap();
+    let (ok, _, err) = rothe(&["run", s, "--out", o, "--quiet"]);
+    assert!(ok, "{err}");
+    let vtk_before = out.join("vtk").read_dir().unwrap().count();
+    assert!(vtk_before > 1);
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let (ok, _, err) = rothe(&[
+        "run",
+        s,
+        "--out",
+        o,
+        "--quiet",
+        "--set",
+        "analysis.vtk_every=0",
+    ]);
+    assert!(
+        !ok && err.contains("holds an earlier run") && err.contains("--overwrite"),
+        "{err}"
+    );
+    let (ok, _, err) = rothe(&[
+        "run",
+        s,
+        "--out",
+        o,
+        "--quiet",
+        "--set",
+        "analysis.vtk_every=0",
+        "--overwrite",
+    ]);
+    assert!(ok, "{err}");
+    assert!(!out.join("vtk").exists(), "a stale VTK series stayed");
+    assert!(!out.join("result.pvd").exists());
+    assert_eq!(summary(&out)["status"], "completed");
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
+}
+
+#[test]
+fn sweeps_that_lose_runs_fail_and_name_each_one() {
+    let dir = tempfile::tempdir().unwrap();
+    // compare on a scenario whose runs fail part way (its block is driven into a V
+    // of rigid lines: no motion keeps it out of both). Each failure is printed with
+    // its own error, quiet or not, and the command fails.
+    let vee = r#"
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-5
+vtk_every = 0
+max_cuts = 1
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "block"
+material = "steel"
+thickness = 0.1
+mesh = { kind = "rectangle", origin = [-0.05, 0.06], size = [0.1, 0.1], divisions = [2, 2] }
+[[prescribed]]
+set = "block.bottom"
+component = "y"
+value = -0.1
+function = { kind = "ramp", t0 = 0.0, t1 = 1.0e-4 }
+[[contact]]
+name = "vee_left"
+slave = "block.bottom"
+rigid_line = [[-1.0, 1.0], [0.0, 0.0]]
+[[contact]]
+name = "vee_right"
+slave = "block.bottom"
+rigid_line = [[0.0, 0.0], [1.0, 1.0]]
+"#;
+    let sc = scenario(dir.path(), "vee.toml", vee);
+    let out = dir.path().join("cmp");
+    let (ok, _, err) = rothe(&[
+        "compare",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(!ok, "a sweep with a failed run exits non-zero: {err}");
+    for run in ["implicit", "explicit"] {
+        assert!(
+            err.contains(&format!("run {run} ({run}) failed: time stepping")),
+            "{err}"
+        );
+    }
+    assert!(err.contains("Clarabel status DualInfeasible"), "{err}");
+    // Bad plans are refused before anything runs.
+    let good_sc = scenario(dir.path(), "g.toml", &good());
+    let g = good_sc.to_str().unwrap();
+    for (args, words) in [
+        (vec!["study", "time", g, "--halvings", "40"], "--halvings"),
+        (
+            vec!["study", "time", g, "--halvings", "2", "--jobs", "0"],
+            "--jobs",
+        ),
+        (
+            vec!["study", "time", g, "--h", "1e-5,1e-12"],
+            "steps in all",
+        ),
+    ] {
+        let o = dir.path().join("bad");
+        let mut a = args.clone();
+        a.extend(["--out", o.to_str().unwrap(), "--quiet"]);
+        let (ok, _, err) = rothe(&a);
+        assert!(!ok && err.contains(words), "{args:?}: {err}");
+        assert!(
+            !o.join("runs").exists(),
+            "{args:?} ran before it was refused"
+        );
+    }
+    // collect of a plan whose runs never ran.
+    let emitted = dir.path().join("emitted");
+    let (ok, _, err) = rothe(&[
+        "study",
+        "time",
+        g,
+        "--h",
+        "1e-5,5e-6",
+        "--emit",
+        emitted.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = rothe(&["study", "collect", emitted.to_str().unwrap()]);
+    assert!(!ok && err.contains("run them first"), "{err}");
+}
