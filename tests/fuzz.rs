@@ -396,9 +396,12 @@ fn gmsh_mutation() -> impl Strategy<Value = GmshMutation> {
     ]
 }
 
+/// A node block as text: its header line, its tag lines, its coordinate lines.
+type TextBlock = (String, Vec<String>, Vec<String>);
+
 /// The node blocks of an ASCII MSH 4.1 text: `(header line, tag lines, coordinate
 /// lines)` each, with the text before and after `$Nodes`'s body.
-fn node_blocks(text: &str) -> Option<(String, Vec<(String, Vec<String>, Vec<String>)>, String)> {
+fn node_blocks(text: &str) -> Option<(String, Vec<TextBlock>, String)> {
     let (head, rest) = text.split_once("$Nodes\n")?;
     let (body, tail) = rest.split_once("$EndNodes\n")?;
     let mut lines = body.lines();
@@ -421,7 +424,7 @@ fn node_blocks(text: &str) -> Option<(String, Vec<(String, Vec<String>, Vec<Stri
     ))
 }
 
-fn join_blocks(head: &str, blocks: &[(String, Vec<String>, Vec<String>)], tail: &str) -> String {
+fn join_blocks(head: &str, blocks: &[TextBlock], tail: &str) -> String {
     let mut out = head.to_string();
     for (h, tags, xyz) in blocks {
         out += h;
@@ -436,7 +439,7 @@ fn join_blocks(head: &str, blocks: &[(String, Vec<String>, Vec<String>)], tail: 
 
 fn apply_gmsh(bytes: &[u8], m: &GmshMutation) -> Vec<u8> {
     let text = String::from_utf8_lossy(bytes).into_owned();
-    let edit_blocks = |f: &dyn Fn(&mut Vec<(String, Vec<String>, Vec<String>)>)| -> Vec<u8> {
+    let edit_blocks = |f: &dyn Fn(&mut Vec<TextBlock>)| -> Vec<u8> {
         match node_blocks(&text) {
             Some((head, mut blocks, tail)) => {
                 f(&mut blocks);
