@@ -941,6 +941,12 @@ fn messages_name_the_field_the_line_and_the_column() {
             "invalid type: string \"thin\", expected f64",
         ],
     );
+    // Inside a material (read through its `model` tag): the key is still named.
+    let e_bad = text.replacen("E = 30e9", "E = \"stiff\"", 1);
+    refused(
+        &e_bad,
+        &[".E (line ", "invalid type: string \"stiff\", expected f64"],
+    );
     // A syntax error: line and column.
     let syntax = text.replacen("vtk_every = 5", "vtk_every = 5 5", 1);
     refused(&syntax, &["line ", ", column "]);

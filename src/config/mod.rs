@@ -684,14 +684,71 @@ pub fn parse_with(text: &str, ov: &Overrides) -> Result<Scenario> {
         return parse(text);
     }
     let merged = overrides::apply(table, ov)?;
-    serde_path_to_error::deserialize(toml::Value::Table(merged)).map_err(
+    serde_path_to_error::deserialize(toml::Value::Table(merged.clone())).map_err(
         |e: serde_path_to_error::Error<toml::de::Error>| {
+            let path = within_material(field_path(e.path()), e.inner().message(), || {
+                Some(merged.clone())
+            });
             Error::config(
-                format!("{} (after variants and --set)", field_path(e.path())),
+                format!("{path} (after variants and --set)"),
                 e.inner().message().to_string(),
             )
         },
     )
+}
+
+/// A material is read through its `model` tag, which hides the key inside it from
+/// the path serde reports (`materials.steel`): the path with the key whose value is
+/// what `message` complains of appended, when one key's is (`table` gives the
+/// scenario as read).
+fn within_material(
+    path: String,
+    message: &str,
+    table: impl FnOnce() -> Option<toml::Table>,
+) -> String {
+    let Some(name) = path.strip_prefix("materials.").filter(|n| !n.contains('.')) else {
+        return path;
+    };
+    match table().and_then(|t| key_of_unexpected(&t, name, message)) {
+        Some(key) => format!("{path}.{key}"),
+        None => path,
+    }
+}
+
+/// The key (dotted, within the material's table) of material `name` whose value is
+/// the one a "invalid type: <what>, expected ..." message names, when exactly one
+/// key's value is.
+fn key_of_unexpected(table: &toml::Table, name: &str, message: &str) -> Option<String> {
+    let what = message
+        .strip_prefix("invalid type: ")?
+        .split(", expected")
+        .next()?;
+    let material = table.get("materials")?.get(name)?.as_table()?;
+    fn describe(v: &toml::Value) -> String {
+        match v {
+            toml::Value::String(s) => format!("string {s:?}"),
+            toml::Value::Integer(i) => format!("integer `{i}`"),
+            toml::Value::Float(f) => format!("floating point `{f}`"),
+            toml::Value::Boolean(b) => format!("boolean `{b}`"),
+            toml::Value::Array(_) => "sequence".into(),
+            toml::Value::Table(_) => "map".into(),
+            toml::Value::Datetime(d) => format!("datetime `{d}`"),
+        }
+    }
+    fn search(t: &toml::Table, prefix: &str, what: &str, out: &mut Vec<String>) {
+        for (k, v) in t {
+            let key = format!("{prefix}{k}");
+            if let toml::Value::Table(inner) = v {
+                search(inner, &format!("{key}."), what, out);
+            }
+            if describe(v) == what {
+                out.push(key);
+            }
+        }
+    }
+    let mut found = Vec::new();
+    search(material, "", what, &mut found);
+    (found.len() == 1).then(|| found.remove(0))
 }
 
 /// The dotted path of a field as serde saw it (`bodies[0].thickness`), or
@@ -738,6 +795,7 @@ pub fn parse(text: &str) -> Result<Scenario> {
     serde_path_to_error::deserialize(de).map_err(|e| {
         let path = field_path(e.path());
         let inner = e.into_inner();
+        let path = within_material(path, inner.message(), || toml::from_str(text).ok());
         match inner.span() {
             Some(s) if path != "scenario" => {
                 let (line, column) = line_column(text, s.start);
