@@ -166,6 +166,20 @@ mod tests {
         assert_eq!(r.next_into(&mut u).unwrap(), Some(0.5));
         assert!(u[1].is_nan() && u[2] == 1e-300);
         assert_eq!(r.next_into(&mut u).unwrap(), None);
+        // For a completed run the cut record, a missing state and another mesh are
+        // errors.
+        assert_eq!(r.records(), (2, false));
+        let e = r.expect(2, 3).unwrap_err().to_string();
+        assert!(e.contains("cut short"), "{e}");
+        let mut w = FieldWriter::create(&path, 3).unwrap();
+        w.append(0.0, &[1.0, 2.0, 3.0]).unwrap();
+        drop(w);
+        let r = FieldReader::open(&path).unwrap();
+        assert!(r.expect(1, 3).is_ok());
+        let e = r.expect(2, 3).unwrap_err().to_string();
+        assert!(e.contains("1 states, the completed run recorded 2"), "{e}");
+        let e = r.expect(1, 4).unwrap_err().to_string();
+        assert!(e.contains("3 dofs per state, the model has 4"), "{e}");
         std::fs::write(&path, b"not a fields file").unwrap();
         assert!(FieldReader::open(&path).is_err());
     }
