@@ -151,6 +151,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         solver: SolverSummary {
             backend: opts.backend.name().into(),
             factorizations: 0,
+            reused_factors: 0,
             iterations: 0,
             step_cuts: 0,
             factor_nnz: None,
@@ -206,6 +207,7 @@ fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I
     summary.timing.solve_s = timing.solve_s;
     summary.solver.backend = facts.backend.into();
     summary.solver.factorizations = facts.factorizations;
+    summary.solver.reused_factors = facts.reused_factors;
     summary.solver.factor_nnz = facts.factor_nnz;
 }
 

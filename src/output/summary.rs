@@ -147,6 +147,10 @@ pub struct SolverSummary {
     pub backend: String,
     /// Numeric factorisations.
     pub factorizations: usize,
+    /// Newton iterations that kept the factor because the assembled tangent had not
+    /// changed (every Gauss point elastic or on an unchanged state).
+    #[serde(default)]
+    pub reused_factors: usize,
     /// Linear solves (iterations) over the run.
     pub iterations: usize,
     /// Steps cut back (halved) after non-convergence.

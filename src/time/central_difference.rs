@@ -448,6 +448,7 @@ impl Integrator for CentralDifference<'_> {
         SolverFacts {
             backend: "explicit",
             factorizations: 0,
+            reused_factors: 0,
             factor_nnz: None,
         }
     }

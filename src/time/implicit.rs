@@ -220,7 +220,7 @@ impl Operators {
         model: &Model,
         backend: Backend,
         memory_limit: Option<u64>,
-    ) -> Result<(EffectiveSystem, Factored)> {
+    ) -> Result<(EffectiveSystem, Factored, Option<Vec<f64>>)> {
         let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
         let mut sys = EffectiveSystem::new(
             &self.asm.pattern,
@@ -244,11 +244,12 @@ impl Operators {
                     self.h(),
                     &stores,
                 );
-                self.refactor(&mut sys, &kt)?
+                let f = self.refactor(&mut sys, &kt)?;
+                return Ok((sys, f, Some(kt)));
             }
             _ => self.refactor(&mut sys, &self.kt)?,
         };
-        Ok((sys, factored))
+        Ok((sys, factored, None))
     }
 
     /// Whether the scheme has inertia (backward Euler) or not (statics).
@@ -382,6 +383,14 @@ pub(crate) struct Scratch {
     r: Vec<f64>,
     /// Tangent of the last evaluation (state-dependent materials).
     kt: Vec<f64>,
+    /// The tangent the factor holds, and the factorisation count and coefficients
+    /// `(c_m, c_k, c_t)` it was made at: while a new tangent equals it bit for bit
+    /// (every Gauss point kept its tangent: elastic, or on an unchanged damage
+    /// state) the factor is kept instead of remade ([`ImplicitStep::update_matrix`]).
+    factored_kt: Vec<f64>,
+    kept: Option<(usize, (f64, f64, f64))>,
+    /// Factorisations spared so.
+    reused: usize,
     /// Material totals of the last evaluation.
     totals: PointTotals,
     /// The ledger sums of the last evaluation: the four work integrands (applied
@@ -421,6 +430,9 @@ impl Scratch {
             } else {
                 Vec::new()
             },
+            factored_kt: Vec::new(),
+            kept: None,
+            reused: 0,
             totals: PointTotals::default(),
             ledger_sums: [0.0; 8],
             nl: nonlinear::Scratch::new(n_free, ops.test.max_iterations),
@@ -633,8 +645,23 @@ impl StepProblem for ImplicitStep<'_> {
         &mut self.w.r
     }
 
+    /// Keeps the factor when the new tangent is the one it holds (same factor, same
+    /// coefficients, the same values bit for bit: the solve is then the one a
+    /// refactorisation would give), and refactorises otherwise.
     fn update_matrix(&mut self, sys: &mut EffectiveSystem) -> Result<Factored> {
-        self.ops.refactor(sys, &self.w.kt)
+        let w = &mut *self.w;
+        let key = (sys.factorizations(), self.ops.coefficients());
+        if w.kept == Some(key) && w.factored_kt == w.kt {
+            w.reused += 1;
+            return Ok(Factored::Ok);
+        }
+        let f = self.ops.refactor(sys, &w.kt)?;
+        w.kept = None;
+        if f == Factored::Ok {
+            w.factored_kt.clone_from(&w.kt);
+            w.kept = Some((sys.factorizations(), self.ops.coefficients()));
+        }
+        Ok(f)
     }
 
     fn apply_correction(&mut self, u: &mut [f64], free: &[usize], delta: &[f64]) -> f64 {
@@ -1146,7 +1173,7 @@ impl<'m> Core<'m> {
         let t0 = Instant::now();
         let ops = Operators::new(model, scheme);
         let assembly_s = t0.elapsed().as_secs_f64();
-        let (sys, factored) = ops.initial_system(model, backend, memory_limit)?;
+        let (sys, factored, kt_at_rest) = ops.initial_system(model, backend, memory_limit)?;
         if let Factored::NotPositiveDefinite { dof, message } = factored {
             return Err(Error::Solver {
                 backend: sys.backend(),
@@ -1158,7 +1185,12 @@ impl<'m> Core<'m> {
                 ),
             });
         }
-        let scratch = Scratch::new(model.mesh.n_dofs(), &ops, sys.dofs().n_free());
+        let mut scratch = Scratch::new(model.mesh.n_dofs(), &ops, sys.dofs().n_free());
+        if let Some(kt) = kt_at_rest {
+            // The factor holds the tangent at rest: kept while the points stay there.
+            scratch.factored_kt = kt;
+            scratch.kept = Some((sys.factorizations(), ops.coefficients()));
+        }
         Ok(Core {
             model,
             ops,
@@ -1231,6 +1263,7 @@ impl<'m> Core<'m> {
         super::SolverFacts {
             backend: self.sys.backend(),
             factorizations: self.sys.factorizations(),
+            reused_factors: self.scratch.reused,
             factor_nnz: self.sys.factor_nnz(),
         }
     }

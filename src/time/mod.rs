@@ -110,6 +110,8 @@ pub struct SolverFacts {
     pub backend: &'static str,
     /// Numeric factorisations so far.
     pub factorizations: usize,
+    /// Iterations that kept the factor because the tangent had not changed.
+    pub reused_factors: usize,
     /// Nonzeros of the factor.
     pub factor_nnz: Option<usize>,
 }
