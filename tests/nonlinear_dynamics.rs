@@ -240,3 +240,55 @@ fn vtk_carries_damage_plastic_strain_and_dissipation_density() {
         assert_eq!(array("stress").len(), 3 * 64);
     }
 }
+
+#[test]
+fn a_nonlinear_model_that_stays_elastic_runs_as_the_elastic_one() {
+    // Rankine-Hill and Mazars with strengths far above what the cantilever reaches:
+    // every point stays elastic, so the tangent is the one at rest throughout, the
+    // factor is kept (the same number of factorisations as the elastic model), and
+    // the history is the elastic one to round-off.
+    let strong_rh = "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e12, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e12, post_yield_modulus = 1.65e9 }";
+    let strong_mazars =
+        "model = \"mazars\"\neps_t0 = 1.0\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
+    let dir = tempfile::tempdir().unwrap();
+    let read = |name: &str, material: &str| {
+        let out = dir.path().join(name);
+        let s = run_text(&cantilever(material, ""), &out).unwrap();
+        let text = std::fs::read_to_string(out.join("history.csv")).unwrap();
+        let header: Vec<String> = text
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .map(String::from)
+            .collect();
+        let col = header.iter().position(|h| h == "tip_uy").unwrap();
+        let tip: Vec<f64> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+            .collect();
+        (s, tip)
+    };
+    let (elastic, tip_e) = read("elastic", "model = \"elastic\"");
+    let scale = tip_e.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    assert!(scale > 0.0);
+    for (name, material) in [("rh", strong_rh), ("mazars", strong_mazars)] {
+        let (s, tip) = read(name, material);
+        let worst = tip
+            .iter()
+            .zip(&tip_e)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f64, f64::max);
+        eprintln!(
+            "{name}: {} factorisations ({} kept), elastic {}; largest tip difference {:.2e} of {scale:.3e}",
+            s.solver.factorizations, s.solver.reused_factors, elastic.solver.factorizations, worst
+        );
+        assert!(worst <= 1e-12 * scale, "{name}: tip differs by {worst}");
+        assert_eq!(
+            s.solver.factorizations, elastic.solver.factorizations,
+            "{name}: the factor is remade"
+        );
+        assert!(s.solver.reused_factors > 0);
+    }
+}

@@ -362,6 +362,13 @@ impl Assembler {
     /// the same updates is assembled into it in the same pass (what
     /// [`Assembler::tangent`] would give at `u`). A failed point update is reported in
     /// the totals, not hidden in the forces.
+    ///
+    /// With `tangent_base` (the tangent at rest: every point elastic, assembled by
+    /// [`Assembler::tangent`] from fresh stores at the same step size), the tangent
+    /// is that base plus, element by element, `Σ w Bᵀ(D − C)B` over the points whose
+    /// tangent `D` is not their elastic `C`; elements whose points all stay elastic,
+    /// and blocks of constant-tangent materials, cost nothing. While every point is
+    /// elastic the tangent is the base bit for bit, so a kept factor of it stays.
     #[allow(clippy::too_many_arguments)]
     pub fn internal_force(
         &self,
@@ -373,6 +380,7 @@ impl Assembler {
         f: &mut [f64],
         mut f_pred: Option<&mut [f64]>,
         mut tangent: Option<&mut [f64]>,
+        tangent_base: Option<&[f64]>,
     ) -> PointTotals {
         let u = pass.u;
         // Nonlocal materials: their drivers averaged at `u` first (one more pass; a
@@ -380,9 +388,13 @@ impl Assembler {
         let nonlocal = (!pass.frozen).then(|| self.nonlocal_at(mesh, materials, plane, u, stores));
         f.fill(0.0);
         let kp = tangent.as_mut().map(|k| {
-            k.fill(0.0);
+            match tangent_base {
+                Some(base) => k.copy_from_slice(base),
+                None => k.fill(0.0),
+            }
             SharedValues(k.as_mut_ptr())
         });
+        let by_delta = tangent_base.is_some();
         let fp = Shared(f.as_mut_ptr());
         let predict = f_pred.is_some();
         let pp = f_pred.as_mut().map(|v| {
@@ -414,6 +426,10 @@ impl Assembler {
                     .and_then(|n| n.block(mesh, bi)),
             );
             let ng = points_per_element(block.elements.kind);
+            // With a base, a constant-tangent block adds nothing to it.
+            let block_tangent =
+                kp.is_some() && !(by_delta && materials[block.material].has_constant_tangent());
+            let c_el = cx.c;
             for colour in &self.colours[bi] {
                 // In halves of a fixed tree (`crate::halves`): the same totals in
                 // every run.
@@ -424,6 +440,7 @@ impl Assembler {
                         let mut fe = [0.0; 8];
                         let mut fe_pred = [0.0; 8];
                         let mut ke = [0.0; 64];
+                        let mut changed = !by_delta;
                         let mut q = 0;
                         element_points(
                             &cx,
@@ -447,12 +464,30 @@ impl Assembler {
                                 if predict {
                                     add_bt_sigma(k, x, nodes.len(), w, &sp, &mut fe_pred);
                                 }
-                                if kp.is_some() {
-                                    add_point_tangent(k, x, nodes.len(), w, &r.tangent, &mut ke);
+                                if block_tangent {
+                                    if !by_delta {
+                                        add_point_tangent(
+                                            k,
+                                            x,
+                                            nodes.len(),
+                                            w,
+                                            &r.tangent,
+                                            &mut ke,
+                                        );
+                                    } else if r.tangent != c_el {
+                                        let mut d = r.tangent;
+                                        for (di, ci) in d.iter_mut().zip(&c_el) {
+                                            for (a, b) in di.iter_mut().zip(ci) {
+                                                *a -= b;
+                                            }
+                                        }
+                                        add_point_tangent(k, x, nodes.len(), w, &d, &mut ke);
+                                        changed = true;
+                                    }
                                 }
                             },
                         );
-                        if let Some(kp) = kp {
+                        if let Some(kp) = kp.filter(|_| block_tangent && changed) {
                             self.scatter(nodes, &ke, kp);
                         }
                         for (a, &n) in nodes.iter().enumerate() {

@@ -133,7 +133,7 @@ pub fn damage_law(kappa: f64, kappa0: f64, a: f64, b: f64) -> f64 {
 
 /// Three principal strains, the third being the out-of-plane one.
 fn principal3(eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
-    let (e1, e2, _) = super::principal::principal_strain(eps);
+    let (e1, e2) = super::principal::principal_values(eps[0], eps[1], 0.5 * eps[2]);
     let ezz = match plane {
         Plane::Stress => -nu / (1.0 - nu) * (eps[0] + eps[1]),
         Plane::Strain => 0.0,
@@ -144,7 +144,7 @@ fn principal3(eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
 /// Three principal effective stresses `C ε` (the third out of plane).
 fn principal_stress3(c: &[[f64; 3]; 3], eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
     let s = mul3(c, eps);
-    let (s1, s2, _) = super::principal::principal_stress(&s);
+    let (s1, s2) = super::principal::principal_values(s[0], s[1], s[2]);
     let szz = match plane {
         Plane::Stress => 0.0,
         Plane::Strain => nu * (s[0] + s[1]),

@@ -11,6 +11,16 @@ pub fn principal(xx: f64, yy: f64, xy: f64) -> (f64, f64, f64) {
     (c + r, c - r, if r > 0.0 { 0.5 * xy.atan2(d) } else { 0.0 })
 }
 
+/// Principal values `(a1 ≥ a2)` alone (the same values as [`principal`], without
+/// the angle's `atan2`: for checks that rarely need the frame).
+#[inline]
+pub fn principal_values(xx: f64, yy: f64, xy: f64) -> (f64, f64) {
+    let c = 0.5 * (xx + yy);
+    let d = 0.5 * (xx - yy);
+    let r = (d * d + xy * xy).sqrt();
+    (c + r, c - r)
+}
+
 /// Principal stresses of a Voigt stress `[σ_xx, σ_yy, σ_xy]`.
 #[inline]
 pub fn principal_stress(s: &[f64; 3]) -> (f64, f64, f64) {

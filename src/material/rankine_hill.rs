@@ -15,7 +15,7 @@
 use super::hardening::Hardening;
 use super::linalg::{inverse, solve_in_place, Small, MAX_DIM};
 use super::principal::{
-    principal_stress, strain_from_principal, strain_to_frame, strain_transform,
+    principal_stress, principal_values, strain_from_principal, strain_to_frame, strain_transform,
     stress_from_principal,
 };
 use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
@@ -421,7 +421,8 @@ fn update_once(
         step.eps_n[2] - ep_n[2],
     ];
     let sigma_n = mul3(c, &ee_n);
-    let (s1, s2, theta) = principal_stress(&s_tr);
+    // The trial's principal values decide; the frame is needed only for a return.
+    let (s1, s2) = principal_values(s_tr[0], s_tr[1], s_tr[2]);
     let cc = c[0][0];
     let ctx = Ctx {
         p,
@@ -448,6 +449,7 @@ fn update_once(
     if trial_ok {
         return elastic;
     }
+    let theta = principal_stress(&s_tr).2;
     let Some(ret) = ctx.ret(&[s1, s2]) else {
         // No admissible return (an exhausted strength, or a softening too steep for
         // the element): the trial response, flagged, so the equilibrium loop reports

@@ -172,6 +172,7 @@ impl<'m> CentralDifference<'m> {
                 f,
                 None,
                 None,
+                None,
             ))
         }
     }

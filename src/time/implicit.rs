@@ -74,8 +74,9 @@ pub(crate) struct Operators {
     pub mass: Mass,
     pub gravity: Option<Vec<f64>>,
     pub response: Response,
-    /// The constant tangent of `Response::Constant` and `Response::Nodal` for the
-    /// current step size.
+    /// The tangent at rest for the current step size: the constant tangent of
+    /// `Response::Constant` and `Response::Nodal`, the base of the state-dependent
+    /// tangent of `Response::StateDependent` (empty for elastic models).
     pub kt: Vec<f64>,
     /// The nodal-field laws of `Response::Nodal`.
     pub nodal: Option<NodalLaws>,
@@ -156,10 +157,12 @@ impl Operators {
         self.update_constant_tangent(model);
     }
 
-    /// The tangent of constant-tangent materials at the current step size (it does
-    /// not depend on the state: evaluated at rest from fresh stores).
+    /// The tangent at rest at the current step size, from fresh stores: the whole
+    /// tangent of constant-tangent materials (it does not depend on the state), and
+    /// for state-dependent ones the base their tangent is assembled on (every point
+    /// elastic; `Assembler::internal_force` adds what departs from it).
     fn update_constant_tangent(&mut self, model: &Model) {
-        if matches!(self.response, Response::Constant | Response::Nodal) {
+        if self.response != Response::Elastic {
             let stores = new_stores(&model.mesh, &model.materials);
             let u0 = vec![0.0; model.mesh.n_dofs()];
             self.kt = self.asm.tangent(
@@ -234,18 +237,8 @@ impl Operators {
             .check(memory_limit, "the factorisation")?;
         let factored = match self.response {
             Response::StateDependent(_) => {
-                let stores = new_stores(&model.mesh, &model.materials);
-                let u0 = vec![0.0; model.mesh.n_dofs()];
-                let kt = self.asm.tangent(
-                    &model.mesh,
-                    &model.materials,
-                    model.plane,
-                    &u0,
-                    self.h(),
-                    &stores,
-                );
-                let f = self.refactor(&mut sys, &kt)?;
-                return Ok((sys, f, Some(kt)));
+                let f = self.refactor(&mut sys, &self.kt)?;
+                return Ok((sys, f, Some(self.kt.clone())));
             }
             _ => self.refactor(&mut sys, &self.kt)?,
         };
@@ -278,6 +271,7 @@ impl Operators {
             f,
             f_pred,
             tangent,
+            matches!(self.response, Response::StateDependent(_)).then_some(&self.kt[..]),
         )
     }
 
