@@ -87,6 +87,7 @@ fn element_updates(c: &mut Criterion) {
                             &mut f,
                             None,
                             None,
+                            None,
                         )
                     })
                 });

@@ -82,6 +82,7 @@ fn passes(c: &mut Criterion) {
                         &mut f,
                         None,
                         Some(&mut kt),
+                        None,
                     )
                 })
             });

@@ -86,6 +86,7 @@ fn sls(c: &mut Criterion) {
                     &mut f,
                     Some(&mut fp),
                     None,
+                    None,
                 )
             })
         });

@@ -383,6 +383,7 @@ fn under_a_uniform_strain_nonlocal_is_local() {
                     &mut f,
                     None,
                     None,
+                    None,
                 );
                 let d: Vec<f64> = stores
                     .iter()
