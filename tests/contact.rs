@@ -431,36 +431,9 @@ fn an_infeasible_contact_qp_cuts_the_step_then_stops_naming_the_pair_and_status(
     // motion keeps a bottom node above both lines (the QP is infeasible). Every step
     // cut fails the same way; the run stops naming the step, the pair, Clarabel's
     // status and the worst gap, and keeps what it wrote.
-    let text = r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-5
-vtk_every = 1
-max_cuts = 3
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
-name = "block"
-material = "steel"
-thickness = 0.1
-mesh = { kind = "rectangle", origin = [-0.05, 0.06], size = [0.1, 0.1], divisions = [2, 2] }
-[[prescribed]]
-set = "block.bottom"
-component = "y"
-value = -0.1
-function = { kind = "ramp", t0 = 0.0, t1 = 1.0e-4 }
-[[contact]]
-name = "vee_left"
-slave = "block.bottom"
-rigid_line = [[-1.0, 1.0], [0.0, 0.0]]
-[[contact]]
-name = "vee_right"
-slave = "block.bottom"
-rigid_line = [[0.0, 0.0], [1.0, 1.0]]
-"#;
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/vee.toml"))
+            .unwrap();
     let dir = tempfile::tempdir().unwrap();
     let sc = dir.path().join("vee.toml");
     std::fs::write(&sc, text).unwrap();

@@ -1020,37 +1020,10 @@ fn sweeps_that_lose_runs_fail_and_name_each_one() {
     // compare on a scenario whose runs fail part way (its block is driven into a V
     // of rigid lines: no motion keeps it out of both). Each failure is printed with
     // its own error, quiet or not, and the command fails.
-    let vee = r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-5
-vtk_every = 0
-max_cuts = 1
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
-name = "block"
-material = "steel"
-thickness = 0.1
-mesh = { kind = "rectangle", origin = [-0.05, 0.06], size = [0.1, 0.1], divisions = [2, 2] }
-[[prescribed]]
-set = "block.bottom"
-component = "y"
-value = -0.1
-function = { kind = "ramp", t0 = 0.0, t1 = 1.0e-4 }
-[[contact]]
-name = "vee_left"
-slave = "block.bottom"
-rigid_line = [[-1.0, 1.0], [0.0, 0.0]]
-[[contact]]
-name = "vee_right"
-slave = "block.bottom"
-rigid_line = [[0.0, 0.0], [1.0, 1.0]]
-"#;
-    let sc = scenario(dir.path(), "vee.toml", vee);
+    let vee =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/vee.toml"))
+            .unwrap();
+    let sc = scenario(dir.path(), "vee.toml", &vee);
     let out = dir.path().join("cmp");
     let (ok, _, err) = rothe(&[
         "compare",

@@ -416,22 +416,15 @@ pub fn crossed<X0, X1>(
                         }
                         if let Some((_, k)) = first {
                             let [a, b] = segments[k];
-                            let (xa, xb) = (x1(a), x1(b));
-                            let xi = closest(p1, xa, xb).0.clamp(0.0, 1.0);
-                            let q = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
-                            let n = chain.normal[k];
-                            out.push(Candidate {
-                                pair: pi,
-                                side: si,
-                                slave: s,
-                                master: Contactee::Segment {
-                                    index: k,
-                                    nodes: [a, b],
-                                },
+                            let xi = closest(p1, x1(a), x1(b)).0.clamp(0.0, 1.0);
+                            out.push(segment_candidate(
+                                (pi, si, s),
+                                k,
+                                segments[k],
+                                &x1,
                                 xi,
-                                gap: (p1[0] - q[0]) * n[0] + (p1[1] - q[1]) * n[1],
-                                normal: n,
-                            });
+                                chain.normal[k],
+                            ));
                         }
                     }
                 }
@@ -473,6 +466,33 @@ pub fn crossed<X0, X1>(
     }
     if out.len() > before {
         out.sort_by_key(Candidate::slave_key);
+    }
+}
+
+/// The candidate of slave `key.2` (of pair `key.0`, side `key.1`) against master
+/// segment `k` with nodes `[a, b]` at the geometry `x`: the point at `ξ` on it and
+/// the normal `n`.
+fn segment_candidate<X: Fn(usize) -> [f64; 2]>(
+    key: (usize, usize, usize),
+    k: usize,
+    [a, b]: [usize; 2],
+    x: &X,
+    xi: f64,
+    n: [f64; 2],
+) -> Candidate {
+    let (p, xa, xb) = (x(key.2), x(a), x(b));
+    let q = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
+    Candidate {
+        pair: key.0,
+        side: key.1,
+        slave: key.2,
+        master: Contactee::Segment {
+            index: k,
+            nodes: [a, b],
+        },
+        xi,
+        gap: (p[0] - q[0]) * n[0] + (p[1] - q[1]) * n[1],
+        normal: n,
     }
 }
 
@@ -583,21 +603,7 @@ where
                             None
                         };
                         let candidate = |k: usize, xi: f64, n: [f64; 2]| {
-                            let [a, b] = segments[k];
-                            let (xa, xb) = (x(a), x(b));
-                            let q = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
-                            Candidate {
-                                pair: pi,
-                                side: si,
-                                slave: s,
-                                master: Contactee::Segment {
-                                    index: k,
-                                    nodes: [a, b],
-                                },
-                                xi,
-                                gap: (p[0] - q[0]) * n[0] + (p[1] - q[1]) * n[1],
-                                normal: n,
-                            }
+                            segment_candidate((pi, si, s), k, segments[k], &x, xi, n)
                         };
                         let xi = xi.clamp(0.0, 1.0);
                         match notch {
