@@ -357,9 +357,14 @@ pub fn crossed<X0, X1>(
     X1: Fn(usize) -> [f64; 2],
 {
     let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
-    let known: std::collections::HashSet<(usize, usize, usize)> =
-        out.iter().map(Candidate::slave_key).collect();
+    // `out` is ordered by slave key: a binary search tells a known slave (and no
+    // set is built on this per-iteration path).
     let before = out.len();
+    let known = |out: &[Candidate], key: (usize, usize, usize)| {
+        out[..before]
+            .binary_search_by_key(&key, Candidate::slave_key)
+            .is_ok()
+    };
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
             match &side.master {
@@ -374,8 +379,8 @@ pub fn crossed<X0, X1>(
                         .iter()
                         .copied()
                         .filter(|&s| {
-                            !known.contains(&(pi, si, s))
-                                && dist(x0(s), x1(s)) + master_travel > 0.5 * pair.radius
+                            dist(x0(s), x1(s)) + master_travel > 0.5 * pair.radius
+                                && !known(out, (pi, si, s))
                         })
                         .collect();
                     if movers.is_empty() {
@@ -434,16 +439,14 @@ pub fn crossed<X0, X1>(
                     let gap = |p: [f64; 2]| (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
                     let along = |p: [f64; 2]| ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
                     for &s in &side.slaves {
-                        if known.contains(&(pi, si, s))
-                            || rigid.beneath.binary_search(&(pi, si, s)).is_ok()
-                        {
-                            continue;
-                        }
                         let (p0, p1) = (x0(s), x1(s));
                         let (g0, g1) = (gap(p0), gap(p1));
                         // Moving into the line and behind it at the end (a slave resting
                         // on it starts at a gap of round-off, of either sign).
-                        if !(g1 < 0.0 && g1 < g0) {
+                        if !(g1 < 0.0 && g1 < g0)
+                            || known(out, (pi, si, s))
+                            || rigid.beneath.binary_search(&(pi, si, s)).is_ok()
+                        {
                             continue;
                         }
                         let c = if g0 > 0.0 { g0 / (g0 - g1) } else { 0.0 };
