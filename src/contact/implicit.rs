@@ -202,7 +202,7 @@ impl<'m> ContactCorrection<'m> {
         // those it holds stay on it a little beyond its ends.
         let coords = &self.model.mesh.coords;
         // The geometry at the start of the step: a slave's motion from it is swept
-        // for crossings ([`super::detect::crossed`]).
+        // for crossings ([`super::sweep::crossed`]).
         self.x0.clear();
         self.x0.extend(
             coords
@@ -304,7 +304,7 @@ impl<'m> ContactCorrection<'m> {
         );
         if !self.x0.is_empty() {
             let x0 = &self.x0;
-            super::detect::crossed(
+            super::sweep::crossed(
                 self.pairs,
                 |n| [x0[2 * n], x0[2 * n + 1]],
                 |n| [x[2 * n], x[2 * n + 1]],

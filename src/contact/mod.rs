@@ -20,6 +20,7 @@ pub mod detect;
 pub mod implicit;
 pub mod kinematic;
 mod qp;
+pub mod sweep;
 
 pub use detect::{gap_matrix, Candidate, Contactee};
 pub use implicit::{ContactCorrection, ContactState, PairRecord};
