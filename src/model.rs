@@ -190,6 +190,9 @@ pub struct Analysis {
     pub displacement_tolerance: f64,
     /// How a state-dependent tangent is followed.
     pub iteration: IterationMethod,
+    /// Keep the factor while the iterations converge on it (`refactor_rate`), or
+    /// refactorise whenever the tangent changed (`None`).
+    pub refactor_rate: Option<f64>,
     /// Step cuts allowed (each halves `h`) before a run stops.
     pub max_cuts: usize,
     /// Fill-reducing ordering for the faer backend.
@@ -246,6 +249,10 @@ pub enum IterationMethod {
     /// stiffness change to the right-hand side.
     Fixed,
 }
+
+/// The default `analysis.refactor_rate`: the ratio of successive residuals above
+/// which a kept factor is remade.
+pub const DEFAULT_REFACTOR_RATE: f64 = 0.1;
 
 impl Analysis {
     /// Number of steps `m = round(T / h)`.

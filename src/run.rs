@@ -152,26 +152,36 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             backend: opts.backend.name().into(),
             factorizations: 0,
             reused_factors: 0,
+            keep_factor: a.refactor_rate.is_some(),
+            fallbacks: 0,
             iterations: 0,
+            iterations_per_step: 0.0,
+            max_step_iterations: 0,
             step_cuts: 0,
             factor_nnz: None,
         },
     };
     let summary_path = opts.out.join("summary.json");
     summary.write(&summary_path)?;
-    let result = catch_unwind(AssertUnwindSafe(|| match (a.kind, a.scheme) {
-        (AnalysisKind::Dynamic, TimeScheme::CentralDifference) => CentralDifference::new(model)
-            .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
-        (AnalysisKind::Dynamic, TimeScheme::BackwardEuler) => {
-            BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
-                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
-        }
-        (AnalysisKind::Static, _) => {
-            Statics::with_memory_limit(model, opts.backend, opts.memory_limit)
-                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
-        }
-    }))
-    .unwrap_or_else(|p| Err(Error::Internal(panic_message(p.as_ref()))));
+    // The march runs on a worker of the thread pool, so that its parallel passes
+    // hand work to the other workers instead of waking the pool from outside and
+    // blocking on it for each pass (which costs a pair of futex calls per pass and
+    // keeps one more thread than cores runnable).
+    let result = rayon::scope(|_| {
+        catch_unwind(AssertUnwindSafe(|| match (a.kind, a.scheme) {
+            (AnalysisKind::Dynamic, TimeScheme::CentralDifference) => CentralDifference::new(model)
+                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
+            (AnalysisKind::Dynamic, TimeScheme::BackwardEuler) => {
+                BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
+                    .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
+            }
+            (AnalysisKind::Static, _) => {
+                Statics::with_memory_limit(model, opts.backend, opts.memory_limit)
+                    .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
+            }
+        }))
+        .unwrap_or_else(|p| Err(Error::Internal(panic_message(p.as_ref()))))
+    });
     summary.probes = rec.probes().clone();
     summary.timing.total_s = start.elapsed().as_secs_f64();
     match result {
@@ -208,7 +218,49 @@ fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I
     summary.solver.backend = facts.backend.into();
     summary.solver.factorizations = facts.factorizations;
     summary.solver.reused_factors = facts.reused_factors;
+    summary.solver.fallbacks = facts.fallbacks;
     summary.solver.factor_nnz = facts.factor_nnz;
+}
+
+/// Steps between refreshes of the progress line's solver counts.
+const PROGRESS_EVERY: usize = 50;
+
+/// Iterations over the accepted steps.
+#[derive(Default)]
+struct Counts {
+    iterations: usize,
+    steps: usize,
+    max: usize,
+}
+
+impl Counts {
+    fn add(&mut self, iterations: usize) {
+        self.iterations += iterations;
+        self.steps += 1;
+        self.max = self.max.max(iterations);
+    }
+
+    fn per_step(&self) -> f64 {
+        self.iterations as f64 / self.steps.max(1) as f64
+    }
+
+    fn fill(&self, summary: &mut Summary, step_cuts: usize) {
+        summary.solver.iterations = self.iterations;
+        summary.solver.iterations_per_step = self.per_step();
+        summary.solver.max_step_iterations = self.max;
+        summary.solver.step_cuts = step_cuts;
+    }
+
+    /// The progress line's account of the solver.
+    fn progress(&self, facts: &crate::time::SolverFacts) -> String {
+        format!(
+            "{:.2} iterations/step (max {}), {} factorisations, {} reused",
+            self.per_step(),
+            self.max,
+            facts.factorizations,
+            facts.reused_factors
+        )
+    }
 }
 
 /// Marches `integrator` from its initial state to the end time, recording every
@@ -239,12 +291,16 @@ fn integrate<I: Integrator>(
     let n_steps = model.analysis.n_steps();
     let pb = progress(n_steps, opts.progress);
     let t_end = model.analysis.t_end;
-    let (mut iterations, mut step_cuts) = (0, 0);
+    let mut counts = Counts::default();
+    let mut step_cuts = 0;
     let control = StepControl::of(model);
     let outcome = march(integrator, &mut s, control, |integrator, s, m| {
         match m {
             Marched::Step(report) => {
-                iterations += report.iterations;
+                counts.add(report.iterations);
+                if s.step % PROGRESS_EVERY == 0 {
+                    pb.set_message(counts.progress(&integrator.solver()));
+                }
                 let built = output_points(integrator, s);
                 let snap = snapshot(s, built.as_deref(), report.iterations, report.nl_residual);
                 rec.record(model, &snap)?;
@@ -252,8 +308,7 @@ fn integrate<I: Integrator>(
                 let on_cadence = vtk_every > 0 && s.step % vtk_every == 0;
                 if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {
                     fill(summary, s, integrator, rec);
-                    summary.solver.iterations = iterations;
-                    summary.solver.step_cuts = step_cuts;
+                    counts.fill(summary, step_cuts);
                     summary.write(&summary_path)?;
                     last_write = Instant::now();
                 }
@@ -267,7 +322,6 @@ fn integrate<I: Integrator>(
     });
     pb.finish_and_clear();
     fill(summary, &s, integrator, rec);
-    summary.solver.iterations = iterations;
-    summary.solver.step_cuts = step_cuts;
+    counts.fill(summary, step_cuts);
     outcome
 }

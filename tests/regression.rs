@@ -90,12 +90,38 @@ fn dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/regression")
 }
 
+/// The nonlinear cases again with the factor kept while the iterations converge on
+/// it (`analysis.keep_factor`, the default; the cases above run with
+/// `keep_factor = false`, full Newton, which wrote the references). A modified
+/// Newton iteration may stop anywhere below the equilibrium tolerance where full
+/// Newton lands near round-off; on these cantilevers both stay far below it
+/// (largest difference 8e-13 of the column's scale), so the same bound holds.
+const KEPT_CASES: [(&str, f64); 2] = [
+    ("mazars_cantilever", 1e-9),
+    ("rankine_hill_cantilever", 1e-9),
+];
+
 #[test]
 fn histories_match_their_references() {
-    let bless = std::env::var_os("ROTHE_BLESS").is_some();
+    compare_with_references(&CASES, false);
+}
+
+#[test]
+fn kept_factor_histories_match_the_references_to_the_iteration_tolerance() {
+    compare_with_references(&KEPT_CASES, true);
+}
+
+/// Runs each case (with the factor kept while it serves when `kept`, refactorising
+/// at every changed tangent otherwise) and compares its history with the reference.
+fn compare_with_references(cases: &[(&str, f64)], kept: bool) {
+    let bless = std::env::var_os("ROTHE_BLESS").is_some() && !kept;
     let tmp = tempfile::tempdir().unwrap();
-    for (name, tol) in CASES {
-        let model = rothe::config::load(&dir().join(format!("{name}.toml"))).unwrap();
+    let mut largest: f64 = 0.0;
+    for &(name, tol) in cases {
+        let mut model = rothe::config::load(&dir().join(format!("{name}.toml"))).unwrap();
+        if !kept {
+            model.analysis.refactor_rate = None;
+        }
         let out = tmp.path().join(name);
         run(
             &model,
@@ -140,6 +166,7 @@ fn histories_match_their_references() {
                     .iter()
                     .position(|&x| (x - t).abs() <= 1e-9 * t.abs().max(1e-12))
                     .unwrap_or_else(|| panic!("{name}: no row at t = {t}"));
+                largest = largest.max((have[j] - v).abs() / scale.max(1e-300));
                 assert!(
                     (have[j] - v).abs() <= tol * scale + 1e-300,
                     "{name}: {col} at row {i} (t = {t:e}) is {} against {v} (scale {scale:e}, tolerance {tol:e})",
@@ -149,4 +176,5 @@ fn histories_match_their_references() {
         }
         assert!(want["t"].len() >= 10, "{name}: reference too short");
     }
+    eprintln!("largest relative difference from the references: {largest:.2e}");
 }

@@ -206,6 +206,17 @@ pub struct AnalysisSpec {
     /// per step).
     #[serde(default)]
     pub iteration: Option<crate::model::IterationMethod>,
+    /// Keep the factor of the effective matrix while the iterations converge on it
+    /// (modified Newton) instead of refactorising whenever the tangent of a damage
+    /// or plasticity model changed: `true` (default for dynamics) or `false`
+    /// (default for statics: full Newton with `iteration = "newton"`, a factor per
+    /// step with `"fixed"`).
+    #[serde(default)]
+    pub keep_factor: Option<bool>,
+    /// With a kept factor: the ratio of two successive relative residuals above
+    /// which the next iterate refactorises with its tangent. Default 0.1.
+    #[serde(default)]
+    pub refactor_rate: Option<f64>,
     /// Step cuts (each halving `h`) allowed before the run stops. Default 8.
     #[serde(default = "default_max_cuts")]
     pub max_cuts: usize,

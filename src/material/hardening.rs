@@ -117,34 +117,80 @@ impl Hardening {
                 // Yield where the secant of the curve meets E: k − η = (k/1.05)(1 + (k−2)η).
                 let eta_y = (k - k / 1.05) / (1.0 + k / 1.05 * (k - 2.0));
                 let eps_y = eta_y * eps_c1;
-                // Solve ε − σ(ε)/E = κ for ε on [ε_y, ε_cu1] (monotone there).
-                let kap = |eps: f64| eps - ec2_curve(f_cm, eps_c1, k, eps).0 / e;
-                if kappa >= kap(eps_cu1) {
-                    return (ec2_curve(f_cm, eps_c1, k, eps_cu1).0, 0.0);
+                let (s_cu, _) = ec2_curve(f_cm, eps_c1, k, eps_cu1);
+                if kappa >= eps_cu1 - s_cu / e {
+                    return (s_cu, 0.0);
                 }
-                let (mut lo, mut hi) = (eps_y, eps_cu1);
-                let mut eps = eps_y + kappa;
-                for _ in 0..100 {
-                    let (s, ds) = ec2_curve(f_cm, eps_c1, k, eps);
-                    let g = eps - s / e - kappa;
-                    if g.abs() < 1e-15 * eps_cu1 {
-                        break;
-                    }
-                    if g > 0.0 {
-                        hi = eps;
-                    } else {
-                        lo = eps;
-                    }
-                    let next = eps - g / (1.0 - ds / e);
-                    eps = if next > lo && next < hi {
-                        next
-                    } else {
-                        0.5 * (lo + hi)
-                    };
-                }
+                // ε − σ(ε)/E = κ is, with η = ε/ε_c1 and the curve's denominator
+                // multiplied out, the quadratic a η² + b η + c = 0 with
+                // a = E ε_c1 (k − 2) + f_cm > 0 (k² − 2k + 1.05 has no real root),
+                // b = E ε_c1 − E κ (k − 2) − f_cm k and c = −E κ ≤ 0: its roots have
+                // opposite signs (or are 0 and η_y at κ = 0), and the curve's branch
+                // is the positive one, taken in the form without cancellation.
+                let a = e * eps_c1 * (k - 2.0) + f_cm;
+                let b = e * eps_c1 - e * kappa * (k - 2.0) - f_cm * k;
+                let c = -e * kappa;
+                let q = -0.5 * (b + b.signum() * (b * b - 4.0 * a * c).max(0.0).sqrt());
+                let eta = if q == 0.0 { 0.0 } else { (q / a).max(c / q) };
+                let eps = (eta * eps_c1).max(eps_y);
                 let (s, ds) = ec2_curve(f_cm, eps_c1, k, eps);
                 (s, ds / (1.0 - ds / e))
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Eurocode 2 strength in closed form: at every `κ` up to the ultimate strain
+    /// the strain `ε` it comes from satisfies `ε − σ(ε)/E = κ` (found here by
+    /// bisection, independently of the quadratic), the strength is `σ(ε)`, and the
+    /// slope is the finite difference of the strength.
+    #[test]
+    fn the_ec2_strength_inverts_the_plastic_strain_of_the_curve() {
+        let (f_cm, eps_c1, eps_cu1) = (38e6, 2.2e-3, 3.5e-3);
+        for e in [33e9, 25e9, 40e9] {
+            let law = Hardening::Ec2 {
+                f_cm,
+                eps_c1,
+                eps_cu1,
+            };
+            let k = 1.05 * e * eps_c1 / f_cm;
+            let kap = |eps: f64| eps - ec2_curve(f_cm, eps_c1, k, eps).0 / e;
+            let kappa_u = kap(eps_cu1);
+            let eta_y = (k - k / 1.05) / (1.0 + k / 1.05 * (k - 2.0));
+            let (s0, _) = law.strength(0.0, e, 1.0);
+            assert!((s0 - e * eta_y * eps_c1).abs() <= 1e-9 * s0, "{s0}");
+            for i in 0..40 {
+                let kappa = kappa_u * i as f64 / 40.0;
+                let (mut lo, mut hi) = (eta_y * eps_c1, eps_cu1);
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if kap(mid) > kappa {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                let expected = ec2_curve(f_cm, eps_c1, k, 0.5 * (lo + hi)).0;
+                let (s, h) = law.strength(kappa, e, 1.0);
+                assert!(
+                    (s - expected).abs() <= 1e-9 * f_cm,
+                    "E = {e}, kappa = {kappa}: {s} against {expected}"
+                );
+                let dk = 1e-7 * kappa_u;
+                let fd = (law.strength(kappa + dk, e, 1.0).0 - law.strength(kappa, e, 1.0).0) / dk;
+                assert!(
+                    (h - fd).abs() <= 1e-4 * h.abs() + 1e-6 * e,
+                    "E = {e}, kappa = {kappa}: slope {h} against {fd}"
+                );
+            }
+            // Beyond the ultimate strain the strength stays at the curve's end.
+            let (s_end, h_end) = law.strength(2.0 * kappa_u, e, 1.0);
+            assert_eq!(h_end, 0.0);
+            assert!((s_end - ec2_curve(f_cm, eps_c1, k, eps_cu1).0).abs() <= 1e-9 * f_cm);
         }
     }
 }

@@ -269,6 +269,20 @@ pub fn update(
     let (k1n, k2n, dn) = (state_n[0], state_n[1], state_n[2]);
     let e = principal3(&step.eps, nu, plane);
     let drv = averaged.unwrap_or_else(|| drivers_of(p, nu, &e));
+    // Below both thresholds, now and before: the damage law gives 0 (its argument
+    // is its threshold), so the point keeps its damage without the principal
+    // stresses, the split and the exponentials (what `damage` returns there).
+    let (k1, k2) = match p.variant {
+        MazarsVariant::Paper => (k1n.max(drv[0]).max(p.eps_t0), k2n.max(drv[1]).max(p.eps_c0)),
+        MazarsVariant::Classic => (k1n.max(drv[0]).max(p.eps_t0), 0.0),
+    };
+    if k1 == p.eps_t0 && (p.variant == MazarsVariant::Classic || k2 == p.eps_c0) {
+        let d = dn.clamp(0.0, p.d_max);
+        state[0] = k1;
+        state[1] = k2;
+        state[2] = d;
+        return secant_response(c, step, dn, d);
+    }
     let law = p.tension_law(e_modulus(c, nu, plane), step.length);
     let (dcand, k1, k2) = damage(p, c, nu, plane, &step.eps, &e, drv, law, k1n, k2n);
     let d = dcand.max(dn).clamp(0.0, p.d_max);

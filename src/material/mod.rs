@@ -259,6 +259,17 @@ impl Material {
         matches!(self.model, Model::Elastic)
     }
 
+    /// True when the stress depends on the strain path but not on its rate
+    /// (elasticity, damage, plasticity): at an unchanged strain the committed
+    /// stress is the stress of any step, so an implicit step starting at an
+    /// unchanged displacement knows its internal force without a pass.
+    pub fn is_rate_independent(&self) -> bool {
+        matches!(
+            self.model,
+            Model::Elastic | Model::Mazars(_) | Model::RankineHill(_)
+        )
+    }
+
     /// Number of history values stored per Gauss point (at most [`MAX_STATE`]).
     pub fn n_state(&self) -> usize {
         match self.model {

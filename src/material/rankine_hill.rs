@@ -27,6 +27,21 @@ pub struct RankineHillParams {
     pub tension: Hardening,
     /// Compression law (von Mises surface).
     pub compression: Hardening,
+    /// The laws' strengths before any plastic flow (`κ = 0`) at the material's
+    /// Young's modulus: the elastic check of a point that never yielded reads them
+    /// instead of evaluating the laws ([`RankineHillParams::new`] sets them).
+    pub initial: [f64; 2],
+}
+
+impl RankineHillParams {
+    /// The parameters of the two laws for a material of Young's modulus `e`.
+    pub fn new(tension: Hardening, compression: Hardening, e: f64) -> Self {
+        RankineHillParams {
+            tension,
+            compression,
+            initial: [tension.initial(e), compression.initial(e)],
+        }
+    }
 }
 
 /// Surfaces of the composite criterion.
@@ -145,17 +160,14 @@ impl Ctx<'_> {
         (kt, kc)
     }
 
-    /// Closest-point projection for a fixed active set; `None` if Newton fails.
-    fn project(&self, s_tr: &[f64; 2], active: &[Surface]) -> Option<Projection> {
+    /// Closest-point projection for a fixed active set (`f_t0` the initial tensile
+    /// strength); `None` if Newton fails.
+    fn project(&self, s_tr: &[f64; 2], active: &[Surface], f_t0: f64) -> Option<Projection> {
         let m = active.len();
         let n = 2 + m;
         let mut s = *s_tr;
         let mut dl = [0.0; 3];
-        let scale = s_tr[0]
-            .abs()
-            .max(s_tr[1].abs())
-            .max(self.p.tension.initial(self.e))
-            .max(1.0);
+        let scale = s_tr[0].abs().max(s_tr[1].abs()).max(f_t0).max(1.0);
         for _ in 0..60 {
             let (kt, kc) = self.kappas(active, &dl[..m]);
             // Residuals.
@@ -254,13 +266,8 @@ impl Ctx<'_> {
     /// Active-set return: starts from the surfaces violated at the trial state, drops
     /// surfaces with negative multipliers, adds violated ones, until KKT holds.
     fn ret(&self, s_tr: &[f64; 2]) -> Option<Return> {
-        let tol = 1e-10
-            * self
-                .p
-                .compression
-                .initial(self.e)
-                .max(self.p.tension.initial(self.e))
-                .max(1.0);
+        let f_t0 = self.p.tension.initial(self.e);
+        let tol = 1e-10 * self.p.compression.initial(self.e).max(f_t0).max(1.0);
         let all = [Surface::R1, Surface::R2, Surface::Vm];
         let mut active = Active::of(&[]);
         for s in all {
@@ -279,7 +286,7 @@ impl Ctx<'_> {
             &[Surface::R1, Surface::R2, Surface::Vm],
         ];
         let admissible = |set: &[Surface]| -> Option<Return> {
-            let (dl, s, d_alg) = self.project(s_tr, set)?;
+            let (dl, s, d_alg) = self.project(s_tr, set, f_t0)?;
             let dl = &dl[..set.len()];
             if dl.iter().any(|&l| l < -tol / self.d[0][0]) {
                 return None;
@@ -444,8 +451,18 @@ fn update_once(
         },
         status: PointStatus::Ok,
     };
-    let trial_ok = ctx.f(Surface::R1, &[s1, s2], kt_n, kc_n).0 <= 0.0
-        && ctx.f(Surface::Vm, &[s1, s2], kt_n, kc_n).0 <= 0.0;
+    // The strengths of the committed state: read, for a point that never yielded.
+    let y_t = if kt_n == 0.0 {
+        p.initial[0]
+    } else {
+        p.tension.strength(kt_n, e, step.length).0
+    };
+    let y_c = if kc_n == 0.0 {
+        p.initial[1]
+    } else {
+        p.compression.strength(kc_n, e, step.length).0
+    };
+    let trial_ok = s1 - y_t <= 0.0 && q_and_n(&[s1, s2]).0 - y_c <= 0.0;
     if trial_ok {
         return elastic;
     }

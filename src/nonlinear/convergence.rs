@@ -41,6 +41,11 @@ pub struct Convergence {
     pub penetration_tolerance: f64,
     /// Largest open gap under a force accepted (m).
     pub complementarity_tolerance: f64,
+    /// Keep the factor while each evaluation's relative residual is at most this
+    /// ratio of the one before (modified Newton): a slower iteration has the next
+    /// evaluation assemble its tangent and refactorise. `None`: the problem's
+    /// tangent is refactorised whenever it asks for one (full Newton).
+    pub refactor_rate: Option<f64>,
 }
 
 impl Convergence {

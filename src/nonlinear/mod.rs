@@ -68,12 +68,16 @@ pub trait StepProblem {
     /// Whether one correction from the predicted residual is exact (affine problem
     /// with a constant, already factorised effective matrix).
     fn is_affine(&self) -> bool;
-    /// For an affine problem: writes `−r(u)` on the free dofs (`free[eq]` the dof of
-    /// equation `eq`) into `rhs` without evaluating the materials, and returns true;
-    /// false when no exact prediction is at hand.
+    /// Writes `−r(u)` at the start of the step on the free dofs (`free[eq]` the dof
+    /// of equation `eq`) into `rhs` without evaluating the materials, and returns
+    /// true; false when no exact prediction is at hand. An affine problem predicts
+    /// its residual exactly for any step; a rate-independent one at an unchanged
+    /// displacement, where its internal force is the committed one.
     fn predict(&mut self, u: &[f64], free: &[usize], rhs: &mut Vec<f64>) -> bool;
-    /// Whether the evaluation of iteration `iteration` should assemble the tangent.
-    fn wants_tangent(&self, iteration: usize) -> bool;
+    /// Whether the evaluation of iteration `iteration` should assemble the tangent;
+    /// `slow` says the last evaluation contracted the residual less than
+    /// [`Convergence::refactor_rate`] asks of an iteration on a kept factor.
+    fn wants_tangent(&mut self, iteration: usize, slow: bool) -> bool;
     /// Evaluates the residual at `u` (all dofs: on constrained dofs it is the reaction
     /// the supports must supply), with the tangent when `tangent`.
     fn evaluate(&mut self, u: &[f64], tangent: bool) -> Evaluation;
@@ -221,10 +225,18 @@ where
     let affine = problem.is_affine();
     let mut iterations = 0;
     let mut last_correction: Option<f64> = None;
-    let mut predicted = affine && problem.predict(u, &sys.dofs().free, &mut scratch.rhs);
+    let mut predicted = problem.predict(u, &sys.dofs().free, &mut scratch.rhs);
+    // The first iterate of a predicted start comes from the data and the factor
+    // alone, as an affine step's does.
+    let predicted_start = predicted;
+    // The last evaluation's `Σ r²`, and whether the iterations on the kept factor
+    // contracted the residual too slowly.
+    let mut previous: Option<f64> = None;
+    let mut slow = false;
     loop {
         if !predicted {
-            let ev = problem.evaluate(u, problem.wants_tangent(iterations));
+            let want = problem.wants_tangent(iterations, slow);
+            let ev = problem.evaluate(u, want);
             if let Some(f) = ev.failure {
                 return Ok(Outcome::MaterialFailure(f));
             }
@@ -238,7 +250,7 @@ where
                 || last_correction
                     .is_none_or(|c| c <= test.displacement_tolerance * ev.increment2.sqrt());
             let finite = nl.is_finite() && ev.magnitude2.is_finite() && ev.increment2.is_finite();
-            if !finite && (iterations == 0 || affine) {
+            if !finite && (iterations == 0 || affine || (predicted_start && iterations == 1)) {
                 // Nothing an iteration did: the loads, the state or the materials.
                 let (dof, value) = match worst {
                     Some((d, r)) if !r.is_finite() => (Some(d), r),
@@ -268,6 +280,13 @@ where
                     worst,
                 });
             }
+            // The contraction of the residual itself: its relative value can stay
+            // near 1 when the forces it is measured against vanish with it
+            // (displacement control in statics).
+            if let (Some(rate), Some(before)) = (test.refactor_rate, previous) {
+                slow = !ev.tangent && r2 > rate * rate * before;
+            }
+            previous = Some(r2);
             if ev.tangent {
                 if let Factored::NotPositiveDefinite { dof, message } =
                     problem.update_matrix(sys)?

@@ -147,12 +147,21 @@ pub struct SolverSummary {
     pub backend: String,
     /// Numeric factorisations.
     pub factorizations: usize,
-    /// Newton iterations that kept the factor because the assembled tangent had not
+    /// Refactorisations asked for and spared because the assembled tangent had not
     /// changed (every Gauss point elastic or on an unchanged state).
     #[serde(default)]
     pub reused_factors: usize,
+    /// Whether damage and plasticity iterate on a kept factor (`analysis.keep_factor`).
+    pub keep_factor: bool,
+    /// Steps whose iterations on a kept factor failed and were redone refactorising
+    /// at every changed tangent.
+    pub fallbacks: usize,
     /// Linear solves (iterations) over the run.
     pub iterations: usize,
+    /// Iterations per accepted step: mean and largest.
+    pub iterations_per_step: f64,
+    /// The most iterations an accepted step took.
+    pub max_step_iterations: usize,
     /// Steps cut back (halved) after non-convergence.
     pub step_cuts: usize,
     /// Nonzeros of the Cholesky factor.

@@ -450,6 +450,7 @@ impl Integrator for CentralDifference<'_> {
             backend: "explicit",
             factorizations: 0,
             reused_factors: 0,
+            fallbacks: 0,
             factor_nnz: None,
         }
     }

@@ -85,6 +85,8 @@ pub(crate) struct Operators {
     /// branch).
     pub free_mask: Vec<f64>,
     pub test: Convergence,
+    /// Every material is rate-independent ([`crate::material::Material::is_rate_independent`]).
+    pub rate_independent: bool,
 }
 
 impl Operators {
@@ -120,12 +122,14 @@ impl Operators {
             nodal: None,
             scheme,
             free_mask,
+            rate_independent: model.materials.iter().all(|m| m.is_rate_independent()),
             test: Convergence {
                 tolerance: a.tolerance,
                 displacement_tolerance: a.displacement_tolerance,
                 max_iterations: a.max_iterations,
                 penetration_tolerance: a.contact_tolerance,
                 complementarity_tolerance: a.contact_tolerance,
+                refactor_rate: a.refactor_rate,
             },
         };
         if response == Response::Nodal {
@@ -385,6 +389,17 @@ pub(crate) struct Scratch {
     kept: Option<(usize, (f64, f64, f64))>,
     /// Factorisations spared so.
     reused: usize,
+    /// With a kept factor and the fixed point: a step contracted too slowly, so the
+    /// next step starts with a refactorisation.
+    refresh_pending: bool,
+    /// Steps whose iterations on a kept factor failed and were redone refactorising
+    /// at every changed tangent.
+    fallbacks: usize,
+    /// The factor can be solved with (its last factorisation succeeded).
+    factor_valid: bool,
+    /// Corrections taken over the run (a step's count includes a failed attempt on
+    /// a kept factor).
+    corrections: usize,
     /// Material totals of the last evaluation.
     totals: PointTotals,
     /// The ledger sums of the last evaluation: the four work integrands (applied
@@ -427,6 +442,10 @@ impl Scratch {
             factored_kt: Vec::new(),
             kept: None,
             reused: 0,
+            refresh_pending: false,
+            fallbacks: 0,
+            factor_valid: true,
+            corrections: 0,
             totals: PointTotals::default(),
             ledger_sums: [0.0; 8],
             nl: nonlinear::Scratch::new(n_free, ops.test.max_iterations),
@@ -446,6 +465,12 @@ struct ImplicitStep<'a> {
     /// The next evaluation keeps the histories committed (the first of a step with
     /// moving prescribed displacements and a material with a frozen form).
     frozen_first: bool,
+    /// The factor is kept while the iterations converge on it
+    /// ([`Convergence::refactor_rate`]); otherwise every tangent the iteration
+    /// method asks for is refactorised.
+    kept: bool,
+    /// No evaluation of this step has run yet.
+    first: bool,
 }
 
 impl StepProblem for ImplicitStep<'_> {
@@ -462,6 +487,13 @@ impl StepProblem for ImplicitStep<'_> {
             Response::Elastic => &s.f_int,
             Response::Nodal => &w.f_pred_np1,
             Response::Constant if s.f_pred_h == ops.h() && !s.f_pred.is_empty() => &s.f_pred,
+            // Damage and plasticity at the unchanged start of the step: the committed
+            // force (with a kept factor; full Newton starts from an evaluation).
+            Response::StateDependent(_)
+                if self.kept && !self.moving && ops.rate_independent && w.factor_valid =>
+            {
+                &s.f_int
+            }
             _ => return false,
         };
         let _ = u; // The start of the step: its increment Δu_c is in `w.du`.
@@ -495,10 +527,24 @@ impl StepProblem for ImplicitStep<'_> {
         true
     }
 
-    fn wants_tangent(&self, iteration: usize) -> bool {
-        match self.ops.response {
-            Response::StateDependent(IterationMethod::Newton) => true,
-            Response::StateDependent(IterationMethod::Fixed) => iteration == 0,
+    fn wants_tangent(&mut self, iteration: usize, slow: bool) -> bool {
+        let first = std::mem::take(&mut self.first);
+        match (self.ops.response, self.kept) {
+            (Response::StateDependent(IterationMethod::Newton), false) => true,
+            (Response::StateDependent(IterationMethod::Fixed), false) => iteration == 0,
+            // A kept factor is remade with the tangent of the iterate after a slow
+            // iteration (Newton), or at the start of the step after a slow one (the
+            // fixed point keeps one factor through a step).
+            // The paper's first estimate (the committed damage at the jump of the
+            // prescribed values) is a secant solve: it gets its own factor.
+            (Response::StateDependent(IterationMethod::Newton), true) => {
+                slow || self.frozen_first || !self.w.factor_valid
+            }
+            (Response::StateDependent(IterationMethod::Fixed), true) => {
+                let w = &mut *self.w;
+                w.refresh_pending |= slow;
+                !w.factor_valid || (first && std::mem::take(&mut w.refresh_pending))
+            }
             _ => false,
         }
     }
@@ -650,6 +696,7 @@ impl StepProblem for ImplicitStep<'_> {
             return Ok(Factored::Ok);
         }
         let f = self.ops.refactor(sys, &w.kt)?;
+        w.factor_valid = f == Factored::Ok;
         w.kept = None;
         if f == Factored::Ok {
             w.factored_kt.clone_from(&w.kt);
@@ -659,6 +706,7 @@ impl StepProblem for ImplicitStep<'_> {
     }
 
     fn apply_correction(&mut self, u: &mut [f64], free: &[usize], delta: &[f64]) -> f64 {
+        self.w.corrections += 1;
         nonlinear::add_on_free(free, delta, u, Some(&mut self.w.du))
     }
 }
@@ -822,29 +870,20 @@ pub(crate) fn step(
     correction: &mut Corrector,
     s: &mut State,
 ) -> Result<StepOutcome> {
-    correction.begin_step(s, ops.dynamic().map(|(h, _, _)| h));
     let h = ops.h();
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
-    // The start of the iteration: u_n with the prescribed values of t_{n+1}, and its
-    // increment Δu_c (zero on the free dofs).
-    w.u_np1.copy_from_slice(&s.u);
-    w.du.fill(0.0);
-    let mut moving = false;
-    for c in &model.constraints {
-        let target = c.at(t1);
-        if target != s.u[c.dof] {
-            w.u_np1[c.dof] = target;
-            w.du[c.dof] = target - s.u[c.dof];
-            moving = true;
-        }
-    }
     let mut u = std::mem::take(&mut w.u_np1);
+    let corrections_before = w.corrections;
+    let moving = start_iterate(model, s, t1, &mut u, &mut w.du);
     let mut nl = std::mem::take(&mut w.nl);
-    let outcome = {
-        let frozen_first = moving
-            && matches!(ops.response, Response::StateDependent(_))
-            && model.materials.iter().any(|m| m.has_frozen_form());
+    let frozen_first = moving
+        && matches!(ops.response, Response::StateDependent(_))
+        && model.materials.iter().any(|m| m.has_frozen_form());
+    let kept =
+        ops.test.refactor_rate.is_some() && matches!(ops.response, Response::StateDependent(_));
+    let mut attempt = |kept: bool, u: &mut [f64], w: &mut Scratch, s: &mut State| {
+        correction.begin_step(s, ops.dynamic().map(|(h, _, _)| h));
         let mut problem = ImplicitStep {
             model,
             ops,
@@ -852,17 +891,37 @@ pub(crate) fn step(
             w,
             moving,
             frozen_first,
+            kept,
+            first: true,
         };
-        nonlinear::solve(&mut problem, correction, sys, &ops.test, &mut u, &mut nl)
+        let test = Convergence {
+            refactor_rate: ops.test.refactor_rate.filter(|_| kept),
+            ..ops.test
+        };
+        nonlinear::solve(&mut problem, correction, sys, &test, u, &mut nl)
     };
+    let mut outcome = attempt(kept, &mut u, w, s)?;
+    if kept
+        && matches!(
+            outcome,
+            Outcome::NotConverged { .. }
+                | Outcome::MaterialFailure(_)
+                | Outcome::ConstraintFailure(_)
+                | Outcome::NotPositiveDefinite { .. }
+        )
+    {
+        // The iterations on a kept factor failed where refactorising at every
+        // changed tangent may not: the step again from its start, as full Newton
+        // (or the fixed point with a factor per step) would take it.
+        w.fallbacks += 1;
+        start_iterate(model, s, t1, &mut u, &mut w.du);
+        outcome = attempt(false, &mut u, w, s)?;
+    }
     w.u_np1 = u;
     w.nl = nl;
-    let report = match outcome? {
-        Outcome::Converged {
-            iterations,
-            residual,
-        } => StepReport {
-            iterations,
+    let report = match outcome {
+        Outcome::Converged { residual, .. } => StepReport {
+            iterations: w.corrections - corrections_before,
             nl_residual: residual,
         },
         Outcome::NonFinite { dof, value, .. } => {
@@ -915,6 +974,24 @@ pub(crate) fn step(
         });
     }
     Ok(StepOutcome::Accepted(report))
+}
+
+/// Sets the start of a step's iteration: `u` is `u_n` with the prescribed values of
+/// `t1`, `du` its increment `Δu_c` (zero on the free dofs). Returns whether a
+/// prescribed value moves.
+fn start_iterate(model: &Model, s: &State, t1: f64, u: &mut [f64], du: &mut [f64]) -> bool {
+    u.copy_from_slice(&s.u);
+    du.fill(0.0);
+    let mut moving = false;
+    for c in &model.constraints {
+        let target = c.at(t1);
+        if target != s.u[c.dof] {
+            u[c.dof] = target;
+            du[c.dof] = target - s.u[c.dof];
+            moving = true;
+        }
+    }
+    moving
 }
 
 /// The first non-finite entry of the named vectors, in order.
@@ -1227,10 +1304,19 @@ impl<'m> Core<'m> {
         self.ops.set_h(self.model, h);
         let static_elastic = matches!(self.ops.scheme, Scheme::Static { .. })
             && self.ops.response == Response::Elastic;
-        if static_elastic || matches!(self.ops.response, Response::StateDependent(_)) {
+        let state_dependent = matches!(self.ops.response, Response::StateDependent(_));
+        if static_elastic || (state_dependent && self.ops.test.refactor_rate.is_none()) {
             // The static stiffness does not depend on the load step; a state-dependent
-            // matrix is rebuilt at the next step anyway.
-            // The matrix follows the state: it is rebuilt at the next step anyway.
+            // matrix refactorised at every changed tangent is rebuilt at the next
+            // step anyway.
+            return Ok(());
+        }
+        if state_dependent {
+            // A kept factor belongs to its step size (the mass term `M/h²`): the
+            // tangent at rest of the new size replaces it, and the iterations remake
+            // it from there when they need to.
+            let f = self.ops.refactor(&mut self.sys, &self.ops.kt)?;
+            self.scratch.factor_valid = f == Factored::Ok;
             return Ok(());
         }
         match self.ops.refactor(&mut self.sys, &self.ops.kt)? {
@@ -1258,6 +1344,7 @@ impl<'m> Core<'m> {
             backend: self.sys.backend(),
             factorizations: self.sys.factorizations(),
             reused_factors: self.scratch.reused,
+            fallbacks: self.scratch.fallbacks,
             factor_nnz: self.sys.factor_nnz(),
         }
     }

@@ -112,6 +112,9 @@ pub struct SolverFacts {
     pub factorizations: usize,
     /// Iterations that kept the factor because the tangent had not changed.
     pub reused_factors: usize,
+    /// Steps redone refactorising at every changed tangent after the iterations on a
+    /// kept factor failed.
+    pub fallbacks: usize,
     /// Nonzeros of the factor.
     pub factor_nnz: Option<usize>,
 }

@@ -39,6 +39,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
             max_iterations: 30,
             displacement_tolerance: 1e-6,
             iteration: rothe::model::IterationMethod::Newton,
+            refactor_rate: Some(rothe::model::DEFAULT_REFACTOR_RATE),
             max_cuts: 8,
             ordering: rothe::model::Ordering::Auto,
             contact_tolerance: 1e-6,

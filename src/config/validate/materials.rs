@@ -553,10 +553,11 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                 e,
                 nu,
                 rho,
-                Model::RankineHill(crate::material::RankineHillParams {
+                Model::RankineHill(crate::material::RankineHillParams::new(
                     tension,
                     compression,
-                }),
+                    e,
+                )),
             )?;
             m.identified_from = from;
             Ok(m)

@@ -146,6 +146,13 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             max_iterations: a.max_iterations,
             displacement_tolerance: a.displacement_tolerance,
             iteration: a.iteration.unwrap_or_default(),
+            refactor_rate: a
+                .keep_factor
+                .unwrap_or(a.kind == crate::model::AnalysisKind::Dynamic)
+                .then(|| {
+                    a.refactor_rate
+                        .unwrap_or(crate::model::DEFAULT_REFACTOR_RATE)
+                }),
             max_cuts: a.max_cuts,
             ordering: a.ordering,
             contact_tolerance,
@@ -254,6 +261,8 @@ fn unread_keys(a: &super::AnalysisSpec) -> Vec<String> {
         let implicit_only = [
             ("analysis.contact_qp", a.contact_qp.is_some()),
             ("analysis.iteration", a.iteration.is_some()),
+            ("analysis.keep_factor", a.keep_factor.is_some()),
+            ("analysis.refactor_rate", a.refactor_rate.is_some()),
             (
                 "analysis.viscoelastic_state",
                 a.viscoelastic_state.is_some(),
@@ -386,6 +395,23 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
     checks::non_negative("analysis.zeta", a.zeta)?;
     positive("analysis.tolerance", a.tolerance)?;
     positive("analysis.displacement_tolerance", a.displacement_tolerance)?;
+    if let Some(rate) = a.refactor_rate {
+        if !(rate > 0.0 && rate < 1.0) {
+            return Err(Error::config(
+                "analysis.refactor_rate",
+                format!(
+                    "must lie strictly between 0 and 1 (the residual ratio of two \
+                     iterations above which the factor is remade), got {rate:?}"
+                ),
+            ));
+        }
+        if a.keep_factor == Some(false) {
+            return Err(Error::config(
+                "analysis.refactor_rate",
+                "is read only with a kept factor, but analysis.keep_factor = false",
+            ));
+        }
+    }
     checks::count_in(
         "analysis.max_iterations",
         a.max_iterations,
