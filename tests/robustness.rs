@@ -1079,3 +1079,50 @@ fn sweeps_that_lose_runs_fail_and_name_each_one() {
     let (ok, _, err) = rothe(&["study", "collect", emitted.to_str().unwrap()]);
     assert!(!ok && err.contains("run them first"), "{err}");
 }
+
+#[test]
+fn the_kept_factor_settings_are_checked_and_default_by_the_kind_of_analysis() {
+    let with = |lines: &str| good().replace("vtk_every = 5", &format!("vtk_every = 5\n{lines}"));
+    for bad in ["0.0", "1.0", "-0.5", "nan", "2.0"] {
+        refused(
+            &with(&format!("refactor_rate = {bad}")),
+            &["analysis.refactor_rate", "between 0 and 1"],
+        );
+    }
+    refused(
+        &with("keep_factor = false\nrefactor_rate = 0.2"),
+        &["analysis.refactor_rate", "keep_factor = false"],
+    );
+    // Dynamics keep the factor by default, statics refactorise at every changed
+    // tangent unless told otherwise (theory/equilibrium.md says why).
+    let load = |text: &str| rothe::config::from_str(text, Path::new(".")).unwrap();
+    let dynamic = load(&good());
+    assert_eq!(
+        dynamic.analysis.refactor_rate,
+        Some(rothe::model::DEFAULT_REFACTOR_RATE)
+    );
+    assert_eq!(
+        load(&with("refactor_rate = 0.3")).analysis.refactor_rate,
+        Some(0.3)
+    );
+    assert_eq!(
+        load(&with("keep_factor = false")).analysis.refactor_rate,
+        None
+    );
+    let statics = good().replace("[analysis]", "[analysis]\nkind = \"static\"");
+    assert_eq!(load(&statics).analysis.refactor_rate, None);
+    let kept_statics = statics.replace("vtk_every = 5", "vtk_every = 5\nkeep_factor = true");
+    assert!(load(&kept_statics).analysis.refactor_rate.is_some());
+    // Central differences do not read them: a warning names each.
+    let explicit = with("keep_factor = true\nrefactor_rate = 0.2")
+        .replace("[analysis]", "[analysis]\nscheme = \"central_difference\"")
+        .replace("dt = 1.0e-5\n", "");
+    let m = load(&explicit);
+    for key in ["analysis.keep_factor", "analysis.refactor_rate"] {
+        assert!(
+            m.warnings.iter().any(|w| w.contains(key)),
+            "{key} not warned: {:?}",
+            m.warnings
+        );
+    }
+}
