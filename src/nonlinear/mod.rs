@@ -63,6 +63,10 @@ pub struct Evaluation {
 /// tens of products lose about `1e-14` of their terms' size; `1e-12` leaves a margin.
 pub const ROUNDOFF: f64 = 1e-12;
 
+/// Iterations on a kept factor its observed contraction may still need to reach the
+/// tolerance before a refactorisation (and Newton's two or three iterations) pays.
+pub const KEPT_ITERATIONS: i32 = 3;
+
 /// The nonlinear problem of one step.
 pub trait StepProblem {
     /// Whether one correction from the predicted residual is exact (affine problem
@@ -284,7 +288,9 @@ where
             // near 1 when the forces it is measured against vanish with it
             // (displacement control in statics).
             if let (Some(rate), Some(before)) = (test.refactor_rate, previous) {
-                slow = !ev.tangent && r2 > rate * rate * before;
+                let rho = (r2 / before).sqrt();
+                let projected = nl * rho.powi(KEPT_ITERATIONS);
+                slow = !ev.tangent && (rho > rate || projected > test.tolerance);
             }
             previous = Some(r2);
             if ev.tangent {
