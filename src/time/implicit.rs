@@ -389,8 +389,9 @@ pub(crate) struct Scratch {
     kept: Option<(usize, (f64, f64, f64))>,
     /// Factorisations spared so.
     reused: usize,
-    /// With a kept factor and the fixed point: a step contracted too slowly, so the
-    /// next step starts with a refactorisation.
+    /// With a kept factor: the last step took too many iterations on it (Newton) or
+    /// contracted too slowly (the fixed point), so the next step's first evaluation
+    /// refactorises.
     refresh_pending: bool,
     /// Steps whose iterations on a kept factor failed and were redone refactorising
     /// at every changed tangent.
@@ -538,7 +539,10 @@ impl StepProblem for ImplicitStep<'_> {
             // The paper's first estimate (the committed damage at the jump of the
             // prescribed values) is a secant solve: it gets its own factor.
             (Response::StateDependent(IterationMethod::Newton), true) => {
-                slow || self.frozen_first || !self.w.factor_valid
+                let w = &mut *self.w;
+                slow || self.frozen_first
+                    || !w.factor_valid
+                    || (first && std::mem::take(&mut w.refresh_pending))
             }
             (Response::StateDependent(IterationMethod::Fixed), true) => {
                 let w = &mut *self.w;
@@ -920,10 +924,21 @@ pub(crate) fn step(
     w.u_np1 = u;
     w.nl = nl;
     let report = match outcome {
-        Outcome::Converged { residual, .. } => StepReport {
-            iterations: w.corrections - corrections_before,
-            nl_residual: residual,
-        },
+        Outcome::Converged {
+            residual,
+            iterations,
+        } => {
+            // A step that needed more iterations on the kept factor than a refreshed
+            // one would: the factor no longer fits the state (points that yielded and
+            // now unload, a zone that stopped growing), so the next step remakes it.
+            if kept && iterations > nonlinear::KEPT_ITERATIONS as usize + 1 {
+                w.refresh_pending = true;
+            }
+            StepReport {
+                iterations: w.corrections - corrections_before,
+                nl_residual: residual,
+            }
+        }
         Outcome::NonFinite { dof, value, .. } => {
             // Name the vector the non-finite value came from: the loads first, then
             // the committed state, then what the evaluation produced.
