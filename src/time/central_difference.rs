@@ -178,7 +178,7 @@ impl<'m> CentralDifference<'m> {
     }
 
     fn rejected(&self, outcome: Outcome, t1: f64) -> StepOutcome {
-        let message = super::implicit::describe(self.model, &outcome, t1, self.h);
+        let message = super::diagnostics::describe(self.model, &outcome, t1, self.h);
         StepOutcome::Rejected(Rejection { outcome, message })
     }
 }

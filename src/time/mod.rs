@@ -11,6 +11,7 @@
 pub mod backward_euler;
 pub mod central_difference;
 pub mod cfl;
+mod diagnostics;
 pub mod forces;
 mod implicit;
 pub mod march;

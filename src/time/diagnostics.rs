@@ -1,0 +1,131 @@
+//! What a rejected step and a failed first factorisation say: the outcome of the
+//! equilibrium loop as a message naming the time, the dof, node or element at
+//! fault, and the likely cause of an effective matrix that is not positive
+//! definite at the start.
+
+use super::implicit::{Operators, Scheme};
+use crate::linsolve::LowerCsc;
+use crate::model::Model;
+use crate::nonlinear::Outcome;
+use crate::system::DofMap;
+
+/// A message for a rejected step: what failed, when, and where.
+pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> String {
+    let when = format!("at t = {t1:.6e} (h = {h:.3e})");
+    match outcome {
+        Outcome::Converged { .. } => format!("converged {when}"),
+        Outcome::NotConverged {
+            iterations,
+            history,
+            worst,
+        } => {
+            let worst = worst
+                .map(|(d, r)| {
+                    format!(
+                        "; largest residual {:.3e} N at {}",
+                        r.abs(),
+                        model.describe_dof(d)
+                    )
+                })
+                .unwrap_or_default();
+            format!(
+                "no convergence {when} after {iterations} iterations; relative residuals [{}]{worst}",
+                history
+                    .iter()
+                    .map(|r| format!("{r:.2e}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        }
+        Outcome::NotPositiveDefinite { dof, message } => format!(
+            "the effective matrix lost positive definiteness {when}{} ({message})",
+            dof.map(|d| format!(" at {}", model.describe_dof(d)))
+                .unwrap_or_default()
+        ),
+        Outcome::MaterialFailure(f) => format!(
+            "the material update found no admissible state {when} at {}",
+            model.describe_point(f.block, f.element)
+        ),
+        Outcome::ConstraintFailure(why) => format!("the constraint solve failed {when}: {why}"),
+        Outcome::NonFinite {
+            quantity,
+            dof,
+            value,
+        } => format!(
+            "{quantity} is {value} {when}{}",
+            dof.map(|d| format!(" at {}", model.describe_dof(d)))
+                .unwrap_or_default()
+        ),
+    }
+}
+
+/// Why the initial effective matrix is not positive definite, as far as can be told:
+/// a step size that takes the mass term out of the floating-point range, a free dof
+/// with nothing on its diagonal (a node of no element), or, in statics, a body whose
+/// supports do not stop its rigid motion.
+pub(crate) fn likely_cause(
+    model: &Model,
+    ops: &Operators,
+    k_eff: &LowerCsc,
+    dofs: &DofMap,
+) -> String {
+    let (c_m, _, _) = ops.coefficients();
+    if let Scheme::BackwardEuler { h, .. } = ops.scheme {
+        if !c_m.is_finite() || c_m == 0.0 {
+            return format!(
+                "the step h = {h:e} s puts 1/h² = {:e} outside the floating-point range",
+                1.0 / (h * h)
+            );
+        }
+    }
+    if let Some(eq) = (0..k_eff.n).find(|&j| k_eff.diagonal(j).is_nan() || k_eff.diagonal(j) <= 0.0)
+    {
+        return format!(
+            "{} has a zero or negative diagonal entry: a node that no element holds, or a \
+             material with no stiffness",
+            model.describe_dof(dofs.free[eq])
+        );
+    }
+    match ops.scheme {
+        Scheme::Static { .. } => {
+            let mut free_bodies = Vec::new();
+            for (b, body) in model.bodies.iter().enumerate() {
+                let mut held = [0usize; 2];
+                let mut nodes = std::collections::BTreeSet::new();
+                for c in &model.constraints {
+                    if model.mesh.node_body[c.dof / 2] == b {
+                        held[c.dof % 2] += 1;
+                        nodes.insert(c.dof / 2);
+                    }
+                }
+                let why = if held == [0, 0] {
+                    Some("has no supports".to_string())
+                } else if held[0] == 0 {
+                    Some("is free to move in x".to_string())
+                } else if held[1] == 0 {
+                    Some("is free to move in y".to_string())
+                } else if nodes.len() < 2 {
+                    Some("is held at one node only and free to rotate".to_string())
+                } else {
+                    None
+                };
+                if let Some(why) = why {
+                    free_bodies.push(format!("body `{}` {why}", body.name));
+                }
+            }
+            if free_bodies.is_empty() {
+                "in a static analysis every body needs supports that stop its rigid motion".into()
+            } else {
+                format!(
+                    "in a static analysis every body needs supports that stop its rigid motion, \
+                     and {}",
+                    free_bodies.join(", ")
+                )
+            }
+        }
+        Scheme::BackwardEuler { h, .. } => format!(
+            "with h = {h:e} s the mass term 1/h² M is too small against the stiffness of an \
+             unsupported body; use a smaller step or supports"
+        ),
+    }
+}
