@@ -42,6 +42,10 @@ pub struct Report {
     pub stable: Option<(f64, usize, usize)>,
     /// The time scheme (for a dynamic analysis).
     pub scheme: Option<crate::model::TimeScheme>,
+    /// How an implicit step of damage or plasticity iterates: the method and the
+    /// kept factor's rate (`None` when every material has a constant tangent or the
+    /// scheme is explicit).
+    pub iteration: Option<(crate::model::IterationMethod, Option<f64>)>,
     /// nnz of the effective matrix (lower) and of the factor.
     pub nnz: (usize, usize),
     /// Whether the ordering is nested dissection.
@@ -186,6 +190,9 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         cfl,
         stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
         scheme: (a.kind == crate::model::AnalysisKind::Dynamic).then_some(a.scheme),
+        iteration: (a.scheme == crate::model::TimeScheme::BackwardEuler
+            && model.materials.iter().any(|m| !m.has_constant_tangent()))
+        .then_some((a.iteration, a.refactor_rate)),
         nnz: (system.matrix().row_idx.len(), nnz_l),
         nested_dissection: system.nested_dissection(),
         memory,
@@ -238,6 +245,21 @@ impl fmt::Display for Report {
                         "central differences (explicit, lumped mass, kinematic contact)",
                 }
             )?;
+        }
+        if let Some((method, rate)) = self.iteration {
+            let method = match method {
+                crate::model::IterationMethod::Newton => "newton (the material tangent)",
+                crate::model::IterationMethod::Fixed => "fixed (the tangent of the step's start)",
+            };
+            let factor = match rate {
+                Some(r) => {
+                    let fold = format!("{:.3}", 1.0 / r);
+                    let fold = fold.trim_end_matches('0').trim_end_matches('.');
+                    format!("the factor kept while each iteration divides the residual by {fold} or more")
+                }
+                None => "refactorised at every changed tangent".into(),
+            };
+            writeln!(f, "iteration   {method}; {factor}")?;
         }
         writeln!(f, "steps       {steps} of h = {dt:e} s to T = {t_end:e} s")?;
         writeln!(

@@ -1113,6 +1113,28 @@ fn the_kept_factor_settings_are_checked_and_default_by_the_kind_of_analysis() {
     assert_eq!(load(&statics).analysis.refactor_rate, None);
     let kept_statics = statics.replace("vtk_every = 5", "vtk_every = 5\nkeep_factor = true");
     assert!(load(&kept_statics).analysis.refactor_rate.is_some());
+    // `check` says how the steps will iterate.
+    let mazars = good().replace(
+        "model = \"elastic\"",
+        "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    for (text, words) in [
+        (mazars.clone(), "divides the residual by 10 or more"),
+        (
+            mazars.replace("vtk_every = 5", "vtk_every = 5\nkeep_factor = false"),
+            "refactorised at every changed tangent",
+        ),
+    ] {
+        let sc = scenario(dir.path(), "m.toml", &text);
+        let (ok, out, err) = rothe(&["check", sc.to_str().unwrap()]);
+        assert!(ok, "{err}");
+        let line = out
+            .lines()
+            .find(|l| l.starts_with("iteration"))
+            .unwrap_or_else(|| panic!("no iteration line: {out}"));
+        assert!(line.contains(words), "{line}");
+    }
     // Central differences do not read them: a warning names each.
     let explicit = with("keep_factor = true\nrefactor_rate = 0.2")
         .replace("[analysis]", "[analysis]\nscheme = \"central_difference\"")
