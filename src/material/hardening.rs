@@ -112,31 +112,110 @@ impl Hardening {
                 f_cm,
                 eps_c1,
                 eps_cu1,
-            } => {
-                let k = 1.05 * e * eps_c1 / f_cm;
-                // Yield where the secant of the curve meets E: k − η = (k/1.05)(1 + (k−2)η).
-                let eta_y = (k - k / 1.05) / (1.0 + k / 1.05 * (k - 2.0));
-                let eps_y = eta_y * eps_c1;
-                let (s_cu, _) = ec2_curve(f_cm, eps_c1, k, eps_cu1);
-                if kappa >= eps_cu1 - s_cu / e {
-                    return (s_cu, 0.0);
-                }
-                // ε − σ(ε)/E = κ is, with η = ε/ε_c1 and the curve's denominator
-                // multiplied out, the quadratic a η² + b η + c = 0 with
-                // a = E ε_c1 (k − 2) + f_cm > 0 (k² − 2k + 1.05 has no real root),
-                // b = E ε_c1 − E κ (k − 2) − f_cm k and c = −E κ ≤ 0: its roots have
-                // opposite signs (or are 0 and η_y at κ = 0), and the curve's branch
-                // is the positive one, taken in the form without cancellation.
-                let a = e * eps_c1 * (k - 2.0) + f_cm;
-                let b = e * eps_c1 - e * kappa * (k - 2.0) - f_cm * k;
-                let c = -e * kappa;
-                let q = -0.5 * (b + b.signum() * (b * b - 4.0 * a * c).max(0.0).sqrt());
-                let eta = if q == 0.0 { 0.0 } else { (q / a).max(c / q) };
-                let eps = (eta * eps_c1).max(eps_y);
-                let (s, ds) = ec2_curve(f_cm, eps_c1, k, eps);
-                (s, ds / (1.0 - ds / e))
-            }
+            } => Ec2Curve::new(f_cm, eps_c1, eps_cu1, e).strength(kappa),
         }
+    }
+
+    /// The law with what depends only on its parameters and `e` worked out once
+    /// (the Eurocode 2 curve's constants); the others as they are.
+    pub fn prepared(&self, e: f64) -> PreparedLaw {
+        match *self {
+            Hardening::Ec2 {
+                f_cm,
+                eps_c1,
+                eps_cu1,
+            } => PreparedLaw::Ec2(Ec2Curve::new(f_cm, eps_c1, eps_cu1, e)),
+            law => PreparedLaw::Law(law),
+        }
+    }
+}
+
+/// A strength law ready for a material's Young's modulus ([`Hardening::prepared`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PreparedLaw {
+    /// The Eurocode 2 curve with its constants.
+    Ec2(Ec2Curve),
+    /// A law that has nothing to prepare.
+    Law(Hardening),
+}
+
+impl PreparedLaw {
+    /// `(σ̄(κ), dσ̄/dκ)` for Young's modulus `e` (the one it was prepared for, when it
+    /// was) and element size `h`: the same values as [`Hardening::strength`].
+    #[inline]
+    pub fn strength(&self, kappa: f64, e: f64, h: f64) -> (f64, f64) {
+        match self {
+            PreparedLaw::Ec2(c) => c.strength(kappa),
+            PreparedLaw::Law(law) => law.strength(kappa, e, h),
+        }
+    }
+}
+
+/// The Eurocode 2 compression curve for one Young's modulus, with its constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ec2Curve {
+    f_cm: f64,
+    eps_c1: f64,
+    e: f64,
+    /// `k = 1.05 E ε_c1 / f_cm`.
+    k: f64,
+    /// The strain where the curve's secant meets `E` (yield).
+    eps_y: f64,
+    /// The strength at the ultimate strain, and its `κ`.
+    s_cu: f64,
+    kappa_cu: f64,
+    /// `a = E ε_c1 (k − 2) + f_cm` of the quadratic below.
+    a: f64,
+}
+
+impl Ec2Curve {
+    /// The curve of `f_cm, ε_c1, ε_cu1` for Young's modulus `e`.
+    pub fn new(f_cm: f64, eps_c1: f64, eps_cu1: f64, e: f64) -> Self {
+        let k = 1.05 * e * eps_c1 / f_cm;
+        // Yield where the secant of the curve meets E: k − η = (k/1.05)(1 + (k−2)η).
+        let eta_y = (k - k / 1.05) / (1.0 + k / 1.05 * (k - 2.0));
+        let (s_cu, _) = ec2_curve(f_cm, eps_c1, k, eps_cu1);
+        Ec2Curve {
+            f_cm,
+            eps_c1,
+            e,
+            k,
+            eps_y: eta_y * eps_c1,
+            s_cu,
+            kappa_cu: eps_cu1 - s_cu / e,
+            a: e * eps_c1 * (k - 2.0) + f_cm,
+        }
+    }
+
+    /// `(σ̄(κ), dσ̄/dκ)`, constant beyond the ultimate strain.
+    #[inline]
+    pub fn strength(&self, kappa: f64) -> (f64, f64) {
+        let Ec2Curve {
+            f_cm,
+            eps_c1,
+            e,
+            k,
+            eps_y,
+            s_cu,
+            kappa_cu,
+            a,
+        } = *self;
+        if kappa >= kappa_cu {
+            return (s_cu, 0.0);
+        }
+        // ε − σ(ε)/E = κ is, with η = ε/ε_c1 and the curve's denominator multiplied
+        // out, the quadratic a η² + b η + c = 0 with a = E ε_c1 (k − 2) + f_cm > 0
+        // (k² − 2k + 1.05 has no real root), b = E ε_c1 − E κ (k − 2) − f_cm k and
+        // c = −E κ ≤ 0: its roots have opposite signs (or are 0 and η_y at κ = 0),
+        // and the curve's branch is the positive one, taken in the form without
+        // cancellation.
+        let b = e * eps_c1 - e * kappa * (k - 2.0) - f_cm * k;
+        let c = -e * kappa;
+        let q = -0.5 * (b + b.signum() * (b * b - 4.0 * a * c).max(0.0).sqrt());
+        let eta = if q == 0.0 { 0.0 } else { (q / a).max(c / q) };
+        let eps = (eta * eps_c1).max(eps_y);
+        let (s, ds) = ec2_curve(f_cm, eps_c1, k, eps);
+        (s, ds / (1.0 - ds / e))
     }
 }
 

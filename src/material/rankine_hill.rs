@@ -12,7 +12,7 @@
 //! `½(σⁿ + σⁿ⁺¹):Δεᵖ` evaluated per surface as `½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ`, each stress
 //! paired with its own flow direction. See `theory/plasticity.md`.
 
-use super::hardening::Hardening;
+use super::hardening::{Hardening, PreparedLaw};
 use super::linalg::{inverse, solve_in_place, Small, MAX_DIM};
 use super::principal::{
     principal_stress, principal_values, strain_from_principal, strain_to_frame, strain_transform,
@@ -31,6 +31,9 @@ pub struct RankineHillParams {
     /// Young's modulus: the elastic check of a point that never yielded reads them
     /// instead of evaluating the laws ([`RankineHillParams::new`] sets them).
     pub initial: [f64; 2],
+    /// The tension and compression laws prepared for that modulus (the returns
+    /// evaluate them at every iteration).
+    pub prepared: [PreparedLaw; 2],
 }
 
 impl RankineHillParams {
@@ -40,6 +43,7 @@ impl RankineHillParams {
             tension,
             compression,
             initial: [tension.initial(e), compression.initial(e)],
+            prepared: [tension.prepared(e), compression.prepared(e)],
         }
     }
 }
@@ -135,15 +139,15 @@ impl Ctx<'_> {
     fn f(&self, surf: Surface, s: &[f64; 2], kt: f64, kc: f64) -> (f64, f64) {
         match surf {
             Surface::R1 => {
-                let (y, hh) = self.p.tension.strength(kt, self.e, self.h);
+                let (y, hh) = self.p.prepared[0].strength(kt, self.e, self.h);
                 (s[0] - y, hh)
             }
             Surface::R2 => {
-                let (y, hh) = self.p.tension.strength(kt, self.e, self.h);
+                let (y, hh) = self.p.prepared[0].strength(kt, self.e, self.h);
                 (s[1] - y, hh)
             }
             Surface::Vm => {
-                let (y, hh) = self.p.compression.strength(kc, self.e, self.h);
+                let (y, hh) = self.p.prepared[1].strength(kc, self.e, self.h);
                 (q_and_n(s).0 - y, hh)
             }
         }
@@ -455,12 +459,12 @@ fn update_once(
     let y_t = if kt_n == 0.0 {
         p.initial[0]
     } else {
-        p.tension.strength(kt_n, e, step.length).0
+        p.prepared[0].strength(kt_n, e, step.length).0
     };
     let y_c = if kc_n == 0.0 {
         p.initial[1]
     } else {
-        p.compression.strength(kc_n, e, step.length).0
+        p.prepared[1].strength(kc_n, e, step.length).0
     };
     let trial_ok = s1 - y_t <= 0.0 && q_and_n(&[s1, s2]).0 - y_c <= 0.0;
     if trial_ok {
@@ -526,10 +530,10 @@ fn update_once(
     // ½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ. Equal to the literal form for steps that start on the
     // surface with fixed principal axes (and a radial path for von Mises), never
     // above it, and non-negative always (theory/plasticity.md).
-    let (yt0, _) = p.tension.strength(kt_n, e, step.length);
-    let (yt1, _) = p.tension.strength(state[3], e, step.length);
-    let (yc0, _) = p.compression.strength(kc_n, e, step.length);
-    let (yc1, _) = p.compression.strength(state[4], e, step.length);
+    let (yt0, _) = p.prepared[0].strength(kt_n, e, step.length);
+    let (yt1, _) = p.prepared[0].strength(state[3], e, step.length);
+    let (yc0, _) = p.prepared[1].strength(kc_n, e, step.length);
+    let (yc1, _) = p.prepared[1].strength(state[4], e, step.length);
     let plastic =
         0.5 * (yt0 + yt1) * (ret.dlambda[0] + ret.dlambda[1]) + 0.5 * (yc0 + yc1) * ret.dlambda[2];
     let de = [
