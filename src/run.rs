@@ -152,7 +152,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             backend: opts.backend.name().into(),
             factorizations: 0,
             reused_factors: 0,
-            keep_factor: a.refactor_rate.is_some(),
+            keep_factor: a.scheme == TimeScheme::BackwardEuler && a.refactor_rate.is_some(),
             fallbacks: 0,
             iterations: 0,
             iterations_per_step: 0.0,

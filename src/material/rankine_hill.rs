@@ -270,8 +270,8 @@ impl Ctx<'_> {
     /// Active-set return: starts from the surfaces violated at the trial state, drops
     /// surfaces with negative multipliers, adds violated ones, until KKT holds.
     fn ret(&self, s_tr: &[f64; 2]) -> Option<Return> {
-        let f_t0 = self.p.tension.initial(self.e);
-        let tol = 1e-10 * self.p.compression.initial(self.e).max(f_t0).max(1.0);
+        let [f_t0, f_c0] = self.p.initial;
+        let tol = 1e-10 * f_c0.max(f_t0).max(1.0);
         let all = [Surface::R1, Surface::R2, Surface::Vm];
         let mut active = Active::of(&[]);
         for s in all {
