@@ -313,6 +313,21 @@ pub struct ContactSide {
     pub slaves: Vec<usize>,
     /// The master surface.
     pub master: Master,
+    /// The slave's segments (oriented with its body on their left) when the side is
+    /// enforced by mortar weighted gaps; empty for node-to-segment.
+    pub mortar: Vec<[usize; 2]>,
+}
+
+/// How a deformable pair's impenetrability is written (`theory/contact.md`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Formulation {
+    /// Segment to segment: one weighted gap per slave node, the integral of its
+    /// shape function against the gap to the projected master.
+    #[default]
+    Mortar,
+    /// Each slave node against its closest master segment.
+    NodeToSegment,
 }
 
 /// A named contact pair: one side, or two (both ways), or a unilateral support.
@@ -327,6 +342,10 @@ pub struct ContactPair {
     pub radius: f64,
     /// Central differences: friction interpolation `β` (0 frictionless, 1 sticking).
     pub friction: f64,
+    /// Coulomb's friction coefficient `μ` (0: frictionless).
+    pub mu: f64,
+    /// How the gaps are written.
+    pub formulation: Formulation,
     /// Central differences: weight `w` of the pre-impact velocity in the position
     /// update over the time to impact.
     pub position_weight: f64,

@@ -114,8 +114,8 @@ pub struct MeshingSpec {
 }
 
 /// `[[contact]]`: a slave node or edge set against a master edge set of another body
-/// (frictionless node-to-segment contact), or against a rigid line (a unilateral
-/// support: it resists motion into it and lets the body lift off).
+/// (mortar or node-to-segment, with Coulomb friction `mu`), or against a rigid line
+/// (a unilateral support: it resists motion into it and lets the body lift off).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
@@ -142,6 +142,15 @@ pub struct ContactSpec {
     /// the impact in the position update over the time to impact. Default 0.5.
     #[serde(default)]
     pub position_weight: Option<f64>,
+    /// Coulomb's friction coefficient `μ ≥ 0` (default 0, frictionless): the
+    /// tangential force of a pressed node at most `μ` times its normal force.
+    #[serde(default)]
+    pub mu: Option<f64>,
+    /// How a pair with a deformable master writes its gaps: `mortar` (default when
+    /// the slave is an edge set: segment to segment, one weighted gap per slave node)
+    /// or `node_to_segment`. Rigid lines and the explicit path are node to segment.
+    #[serde(default)]
+    pub formulation: Option<crate::model::Formulation>,
 }
 
 fn default_vtk_every() -> usize {

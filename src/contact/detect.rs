@@ -38,10 +38,76 @@ pub enum Contactee {
     },
     /// The rigid line of the pair's side.
     Rigid,
+    /// The master segments the slave node's shape function sees (mortar: the
+    /// weighted gap of the node, [`super::mortar`]).
+    Mortar,
 }
 
-/// A candidate constraint: the gap of one slave node to one master, linearised as
-/// `g(u + δ) ≈ g + n·(δ_s − (1−ξ) δ_a − ξ δ_b)`.
+/// The most nodes one gap row spans: a mortar row holds the slave node, its two
+/// neighbours and the master nodes facing its two segments (validation keeps the
+/// mesh ratio of a mortar pair within this).
+pub const ROW_NODES: usize = 16;
+
+/// The nodes of a gap row and their weights: the gap is
+/// `n · Σ w_k x_k` (slave weights summing to 1, master weights to −1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weights {
+    len: u8,
+    entries: [(u32, f64); ROW_NODES],
+}
+
+impl Weights {
+    /// No nodes.
+    pub const EMPTY: Weights = Weights {
+        len: 0,
+        entries: [(0, 0.0); ROW_NODES],
+    };
+
+    /// Adds `w` to node `node`'s weight (a new entry if it has none). False, and
+    /// nothing added, when the row is full.
+    pub fn add(&mut self, node: usize, w: f64) -> bool {
+        let n = self.len as usize;
+        if let Some(e) = self.entries[..n].iter_mut().find(|e| e.0 as usize == node) {
+            e.1 += w;
+            return true;
+        }
+        if n == ROW_NODES {
+            return false;
+        }
+        self.entries[n] = (node as u32, w);
+        self.len += 1;
+        true
+    }
+
+    /// `(node, weight)` pairs.
+    pub fn iter(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.entries[..self.len as usize]
+            .iter()
+            .map(|&(n, w)| (n as usize, w))
+    }
+
+    /// Multiplies every weight by `f`.
+    pub fn scale(&mut self, f: f64) {
+        for e in &mut self.entries[..self.len as usize] {
+            e.1 *= f;
+        }
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.len as usize
+    }
+
+    /// Whether the row has no node.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// A candidate constraint: the gap of one slave node to its master, linearised as
+/// `g(u + δ) ≈ g + n · Σ w_k δ_k` over the row's nodes (node to segment: `+1` on the
+/// slave, `−(1−ξ)` and `−ξ` on the segment's ends; mortar: the normalised integrals
+/// of the slave node's shape function, [`super::mortar`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Candidate {
     /// Pair index.
@@ -50,23 +116,36 @@ pub struct Candidate {
     pub side: usize,
     /// Slave node.
     pub slave: usize,
-    /// Master segment or rigid line.
+    /// Master segment, rigid line or the mortar projection.
     pub master: Contactee,
-    /// Local coordinate of the closest point on the segment, in `[0, 1]`.
+    /// Local coordinate of the closest point on the segment, in `[0, 1]` (0 for a
+    /// mortar row).
     pub xi: f64,
     /// Gap along the normal (m): positive open, negative penetrating.
     pub gap: f64,
-    /// Unit outward normal of the master.
+    /// Unit outward normal of the master (mortar: opposite to the slave's nodal
+    /// normal).
     pub normal: [f64; 2],
+    /// The row's nodes and weights.
+    pub weights: Weights,
+    /// The length (m) the row's gap stands for: the slave's tributary length, the
+    /// integral of its shape function over the part facing the master (mortar), or
+    /// 0 (node to segment: the tributary length of the node is used).
+    pub length: f64,
 }
+
+/// The key of a mortar row's master in [`Candidate::key`].
+pub const MORTAR_KEY: usize = usize::MAX - 1;
 
 impl Candidate {
     /// The key of the constraint: pair, side, slave node and master segment (the
-    /// segment's index in the side, `usize::MAX` for a rigid line).
+    /// segment's index in the side, `usize::MAX` for a rigid line, [`MORTAR_KEY`]
+    /// for a mortar row).
     pub fn key(&self) -> (usize, usize, usize, usize) {
         let master = match self.master {
             Contactee::Segment { index, .. } => index,
             Contactee::Rigid => usize::MAX,
+            Contactee::Mortar => MORTAR_KEY,
         };
         (self.pair, self.side, self.slave, master)
     }
@@ -76,23 +155,63 @@ impl Candidate {
         (self.pair, self.side, self.slave)
     }
 
+    /// The unit tangent `t = (n_y, −n_x)`: the direction of the tangential row and of
+    /// the friction force on the slave.
+    pub fn tangent(&self) -> [f64; 2] {
+        [self.normal[1], -self.normal[0]]
+    }
+
     /// The nonzeros `(dof, coefficient)` of the linearised gap row (all dofs).
-    pub fn row(&self) -> ([(usize, f64); 6], usize) {
-        let [nx, ny] = self.normal;
-        let s = self.slave;
-        let mut r = [(0usize, 0.0f64); 6];
-        r[0] = (2 * s, nx);
-        r[1] = (2 * s + 1, ny);
-        match self.master {
-            Contactee::Segment { nodes: [a, b], .. } => {
-                let (wa, wb) = (1.0 - self.xi, self.xi);
-                r[2] = (2 * a, -wa * nx);
-                r[3] = (2 * a + 1, -wa * ny);
-                r[4] = (2 * b, -wb * nx);
-                r[5] = (2 * b + 1, -wb * ny);
-                (r, 6)
-            }
-            Contactee::Rigid => (r, 2),
+    pub fn row(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.along(self.normal)
+    }
+
+    /// The nonzeros of the tangential row: the relative tangential displacement of
+    /// the slave and its master, `t · Σ w_k δ_k`.
+    pub fn tangent_row(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.along(self.tangent())
+    }
+
+    /// `d · Σ w_k δ_k` as `(dof, coefficient)`.
+    fn along(&self, d: [f64; 2]) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.weights
+            .iter()
+            .flat_map(move |(n, w)| [(2 * n, w * d[0]), (2 * n + 1, w * d[1])])
+    }
+
+    /// `Σ w_k p_k` of the nodal vectors `p(node)`.
+    pub fn combine(&self, p: impl Fn(usize) -> [f64; 2]) -> [f64; 2] {
+        self.weights.iter().fold([0.0, 0.0], |a, (n, w)| {
+            let q = p(n);
+            [a[0] + w * q[0], a[1] + w * q[1]]
+        })
+    }
+
+    /// A node-to-segment or rigid-line candidate: the weights `+1` on the slave and
+    /// `−(1−ξ), −ξ` on a segment's ends.
+    pub fn nodal(
+        (pair, side, slave): (usize, usize, usize),
+        master: Contactee,
+        xi: f64,
+        gap: f64,
+        normal: [f64; 2],
+    ) -> Candidate {
+        let mut weights = Weights::EMPTY;
+        weights.add(slave, 1.0);
+        if let Contactee::Segment { nodes: [a, b], .. } = master {
+            weights.add(a, -(1.0 - xi));
+            weights.add(b, -xi);
+        }
+        Candidate {
+            pair,
+            side,
+            slave,
+            master,
+            xi,
+            gap,
+            normal,
+            weights,
+            length: 0.0,
         }
     }
 }
@@ -122,20 +241,7 @@ pub fn gap_matrix(
     let mut values = Vec::with_capacity(6 * cands.len());
     offsets.push(0);
     for c in cands {
-        let (row, k) = c.row();
-        let start = cols.len();
-        for &(d, v) in &row[..k] {
-            let j = columns[d];
-            if j != usize::MAX {
-                match cols[start..].iter().position(|&x| x == j) {
-                    Some(p) => values[start + p] += v,
-                    None => {
-                        cols.push(j);
-                        values.push(v);
-                    }
-                }
-            }
-        }
+        gap_row(c.row(), columns, &mut cols, &mut values);
         offsets.push(cols.len());
     }
     nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(
@@ -146,6 +252,57 @@ pub fn gap_matrix(
         values,
     )
     .expect("distinct in-range columns per row")
+}
+
+/// The gap rows of `cands` followed by their tangential rows (rows `cands.len() + i`),
+/// as [`gap_matrix`].
+pub fn gap_and_tangent_matrix(
+    cands: &[Candidate],
+    columns: &[usize],
+    ncols: usize,
+) -> nalgebra_sparse::CsrMatrix<f64> {
+    let mut offsets = Vec::with_capacity(2 * cands.len() + 1);
+    let mut cols = Vec::with_capacity(2 * ROW_NODES * cands.len());
+    let mut values = Vec::with_capacity(2 * ROW_NODES * cands.len());
+    offsets.push(0);
+    for c in cands {
+        gap_row(c.row(), columns, &mut cols, &mut values);
+        offsets.push(cols.len());
+    }
+    for c in cands {
+        gap_row(c.tangent_row(), columns, &mut cols, &mut values);
+        offsets.push(cols.len());
+    }
+    nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(
+        2 * cands.len(),
+        ncols,
+        offsets,
+        cols,
+        values,
+    )
+    .expect("distinct in-range columns per row")
+}
+
+/// Appends one row's entries, summed by column, leaving out dofs without a column.
+fn gap_row(
+    row: impl Iterator<Item = (usize, f64)>,
+    columns: &[usize],
+    cols: &mut Vec<usize>,
+    values: &mut Vec<f64>,
+) {
+    let start = cols.len();
+    for (d, v) in row {
+        let j = columns[d];
+        if j != usize::MAX {
+            match cols[start..].iter().position(|&x| x == j) {
+                Some(p) => values[start + p] += v,
+                None => {
+                    cols.push(j);
+                    values.push(v);
+                }
+            }
+        }
+    }
 }
 
 /// Projection of `p` on the line of the segment `a`-`b`: the unclamped `ξ` and the
@@ -348,18 +505,16 @@ pub(super) fn segment_candidate<X: Fn(usize) -> [f64; 2]>(
 ) -> Candidate {
     let (p, xa, xb) = (x(key.2), x(a), x(b));
     let q = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
-    Candidate {
-        pair: key.0,
-        side: key.1,
-        slave: key.2,
-        master: Contactee::Segment {
+    Candidate::nodal(
+        key,
+        Contactee::Segment {
             index: k,
             nodes: [a, b],
         },
         xi,
-        gap: (p[0] - q[0]) * n[0] + (p[1] - q[1]) * n[1],
-        normal: n,
-    }
+        (p[0] - q[0]) * n[0] + (p[1] - q[1]) * n[1],
+        n,
+    )
 }
 
 /// The slaves rigid lines hold at the geometry `x(node)` (committed): lying within
@@ -412,6 +567,17 @@ where
         let r2 = pair.radius * pair.radius;
         for (si, side) in pair.sides.iter().enumerate() {
             match &side.master {
+                Master::Segments(segments) if !side.mortar.is_empty() => {
+                    super::mortar::rows(
+                        (pi, si),
+                        &side.slaves,
+                        &side.mortar,
+                        segments,
+                        pair.radius,
+                        &x,
+                        out,
+                    );
+                }
                 Master::Segments(segments) => {
                     let chain = Chain::new(segments, &x);
                     let tree = RTree::bulk_load(
@@ -498,15 +664,13 @@ where
                         let within =
                             within_ends(xi) || rigid.held.binary_search(&(pi, si, s)).is_ok();
                         if within && gap * gap <= r2 {
-                            out.push(Candidate {
-                                pair: pi,
-                                side: si,
-                                slave: s,
-                                master: Contactee::Rigid,
-                                xi: xi.clamp(0.0, 1.0),
+                            out.push(Candidate::nodal(
+                                (pi, si, s),
+                                Contactee::Rigid,
+                                xi.clamp(0.0, 1.0),
                                 gap,
-                                normal: *n,
-                            });
+                                *n,
+                            ));
                         }
                     }
                 }
@@ -537,9 +701,12 @@ mod tests {
             sides: vec![ContactSide {
                 slaves: vec![3, 4, 5],
                 master: Master::Segments(vec![[0, 1], [1, 2]]),
+                mortar: Vec::new(),
             }],
             radius: 1.0,
             friction: 0.0,
+            mu: 0.0,
+            formulation: crate::model::Formulation::NodeToSegment,
             position_weight: 0.5,
         };
         let mut out = Vec::new();
@@ -565,8 +732,8 @@ mod tests {
         );
         assert!((c4.gap + 0.01).abs() < 1e-14, "penetrating: {}", c4.gap);
         // The linearised row: +n on the slave, −(1−ξ)n and −ξn on the segment.
-        let (row, k) = c3.row();
-        assert_eq!(k, 6);
+        let row: Vec<_> = c3.row().collect();
+        assert_eq!(row.len(), 6);
         assert_eq!(row[1], (7, 1.0));
         assert_eq!(row[3], (3, -0.5));
         assert_eq!(row[5], (5, -0.5));
@@ -590,9 +757,12 @@ mod tests {
             sides: vec![ContactSide {
                 slaves,
                 master: Master::Segments(segments),
+                mortar: Vec::new(),
             }],
             radius: 1.0,
             friction: 0.0,
+            mu: 0.0,
+            formulation: crate::model::Formulation::NodeToSegment,
             position_weight: 0.5,
         };
         let mut out = Vec::new();
@@ -641,9 +811,12 @@ mod tests {
                     b: [0.23, 0.0],
                     n: [0.0, 1.0],
                 },
+                mortar: Vec::new(),
             }],
             radius: 0.1,
             friction: 0.0,
+            mu: 0.0,
+            formulation: crate::model::Formulation::NodeToSegment,
             position_weight: 0.5,
         };
         let mut out = Vec::new();
@@ -652,7 +825,7 @@ mod tests {
         assert_eq!(out.len(), 1);
         assert_eq!(out[0].slave, 2);
         assert!((out[0].gap + 0.001).abs() < 1e-15);
-        assert_eq!(out[0].row().1, 2);
+        assert_eq!(out[0].row().count(), 2);
         // Node 2 lies below the line within its ends: held, not passed over, unless
         // it came around the end (it was passed over at the last step).
         let pairs = [pair];

@@ -51,6 +51,10 @@ const GUESS_GAP_TOLERANCE: f64 = 1e-9;
 /// Multipliers below this fraction of the largest count as inactive.
 const ACTIVE_FRACTION: f64 = 1e-6;
 
+/// A pressed node sticks when its tangential force is below `1 − STICK_MARGIN` of
+/// the cone's bound (the cone program ends within its tolerance of the bound).
+const STICK_MARGIN: f64 = 1e-6;
+
 /// One pair's contact at the end of a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct PairRecord {
@@ -60,6 +64,13 @@ pub struct PairRecord {
     pub active: usize,
     /// Largest penetration (m), zero when none.
     pub penetration: f64,
+    /// Total tangential (friction) force `Σ λ_T` on the slaves, along each row's
+    /// tangent (N).
+    pub tangential_force: f64,
+    /// Pressed nodes of a frictional pair that stick (`|λ_T| < μ λ_N`).
+    pub stick: usize,
+    /// Pressed nodes of a frictional pair that slip (on the cone).
+    pub slip: usize,
 }
 
 /// The contact state a step leaves: kept in `time::State`, so a cut-back restores
@@ -75,6 +86,13 @@ pub struct ContactState {
     pub gap: Vec<f64>,
     /// Contact pressure at each node (Pa): its force over its tributary area.
     pub pressure: Vec<f64>,
+    /// The tangential multipliers (N) of the frictional rows, by key.
+    pub tangential: Vec<(Key, f64)>,
+    /// Tangential traction at each node (Pa), along its row's tangent.
+    pub traction: Vec<f64>,
+    /// Slip path of each node (m): the sum of the magnitudes of its relative
+    /// tangential displacement over the steps it was pressed in.
+    pub slip: Vec<f64>,
 }
 
 /// Time spent in the contact correction.
@@ -110,6 +128,18 @@ pub struct ContactCorrection<'m> {
     cands: Vec<Candidate>,
     /// Current multipliers by key (positive ones only).
     lambda: BTreeMap<Key, f64>,
+    /// Current tangential multipliers by key (frictional rows).
+    lambda_t: BTreeMap<Key, f64>,
+    /// Whether any pair has friction.
+    frictional: bool,
+    /// The friction part of `f_c`.
+    f_t: Vec<f64>,
+    /// Displacements at the start of the step (slips are measured from them).
+    u0: Vec<f64>,
+    /// Normal rows of the last QP (the tangential ones follow them), and each
+    /// tangential row's normal row and `μ`.
+    normal_rows: usize,
+    cones: Vec<(usize, f64)>,
     /// Active constraints (multipliers above the threshold) of the previous QP (or of
     /// the last step) and of the last one, sorted. The active set has settled when
     /// the same slaves are held (a slave in a notch may share its force between
@@ -165,6 +195,12 @@ impl<'m> ContactCorrection<'m> {
             dofs: crate::system::DofMap::new(n, model.constraints.iter().map(|c| c.dof)),
             cands: Vec::new(),
             lambda: BTreeMap::new(),
+            lambda_t: BTreeMap::new(),
+            frictional: model.contacts.iter().any(|p| p.mu > 0.0),
+            f_t: vec![0.0; n],
+            u0: Vec::new(),
+            normal_rows: 0,
+            cones: Vec::new(),
             previous: Vec::new(),
             current: Vec::new(),
             f_c: vec![0.0; n],
@@ -231,6 +267,9 @@ impl<'m> ContactCorrection<'m> {
                 .extend(self.dofs.free.iter().map(|&d| self.lead_all[d]));
         }
         self.lambda = committed.active.iter().copied().collect();
+        self.lambda_t = committed.tangential.iter().copied().collect();
+        self.u0.clear();
+        self.u0.extend_from_slice(u);
         let values: Vec<f64> = committed.active.iter().map(|(_, l)| *l).collect();
         let threshold = self.active_threshold(&values);
         self.current = committed
@@ -252,11 +291,13 @@ impl<'m> ContactCorrection<'m> {
     }
 
     /// Ends an accepted step with increment `du`: writes the contact state and returns
-    /// the work `Δu·f_c` of the contact forces of the step (the ledger books its
-    /// negative as `D_contact`).
-    pub fn finish(&mut self, du: &[f64], out: &mut ContactState) -> f64 {
+    /// the work `Δu·f` of the normal and of the tangential contact forces of the step
+    /// (the ledger books their negatives as `D_contact` and `D_friction`).
+    pub fn finish(&mut self, du: &[f64], out: &mut ContactState) -> (f64, f64) {
         let work: f64 = du.iter().zip(&self.f_c).map(|(d, f)| d * f).sum();
+        let friction: f64 = du.iter().zip(&self.f_t).map(|(d, f)| d * f).sum();
         out.active = self.lambda.iter().map(|(k, l)| (*k, *l)).collect();
+        out.tangential = self.lambda_t.iter().map(|(k, l)| (*k, *l)).collect();
         out.pairs.clear();
         out.pairs.resize(self.pairs.len(), PairRecord::default());
         let n_nodes = self.model.mesh.n_nodes();
@@ -264,22 +305,54 @@ impl<'m> ContactCorrection<'m> {
         out.gap.resize(n_nodes, f64::NAN);
         out.pressure.clear();
         out.pressure.resize(n_nodes, 0.0);
+        out.traction.clear();
+        out.traction.resize(n_nodes, 0.0);
+        out.slip.resize(n_nodes, 0.0);
+        let threshold = self.active_threshold(&self.lambda.values().copied().collect::<Vec<_>>());
         for c in &self.cands {
             let rec = &mut out.pairs[c.pair];
             rec.penetration = rec.penetration.max(-c.gap);
             let g = &mut out.gap[c.slave];
             *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
+            let area = self.area_of(c);
             if let Some(&l) = self.lambda.get(&c.key()) {
                 rec.force += l;
-                if self.area[c.slave] > 0.0 {
-                    out.pressure[c.slave] += l / self.area[c.slave];
+                if area > 0.0 {
+                    out.pressure[c.slave] += l / area;
+                }
+                let mu = self.pairs[c.pair].mu;
+                if mu > 0.0 && l > threshold {
+                    let lt = self.lambda_t.get(&c.key()).copied().unwrap_or(0.0);
+                    rec.tangential_force += lt;
+                    if area > 0.0 {
+                        out.traction[c.slave] += lt / area;
+                    }
+                    if lt.abs() < (1.0 - STICK_MARGIN) * mu * l {
+                        rec.stick += 1;
+                    } else {
+                        rec.slip += 1;
+                    }
+                    let t = c.tangent();
+                    let d = c.combine(|n| [du[2 * n], du[2 * n + 1]]);
+                    out.slip[c.slave] += (d[0] * t[0] + d[1] * t[1]).abs();
                 }
             }
         }
         for (pair, _, _) in slaves(&self.current) {
             out.pairs[pair].active += 1;
         }
-        work
+        (work - friction, friction)
+    }
+
+    /// The area (m²) a row's force spreads over: the covered length of a mortar row
+    /// times the slave body's thickness, else the node's tributary area.
+    fn area_of(&self, c: &Candidate) -> f64 {
+        if c.length > 0.0 {
+            let mesh = &self.model.mesh;
+            c.length * self.model.bodies[mesh.node_body[c.slave]].thickness
+        } else {
+            self.area[c.slave]
+        }
     }
 
     /// Time and counts so far.
@@ -315,17 +388,34 @@ impl<'m> ContactCorrection<'m> {
         self.stats.detect_s += t.elapsed().as_secs_f64();
     }
 
-    /// `Gᵀλ` of the current multipliers at the current candidates, into `f_c`.
+    /// `Gᵀλ` of the current multipliers at the current candidates, into `f_c` (the
+    /// tangential ones' part also into `f_t`).
     fn forces(&mut self) {
         self.f_c.fill(0.0);
+        self.f_t.fill(0.0);
         for c in &self.cands {
             if let Some(&l) = self.lambda.get(&c.key()) {
-                let (row, k) = c.row();
-                for &(d, v) in &row[..k] {
+                for (d, v) in c.row() {
                     self.f_c[d] += l * v;
                 }
             }
+            if let Some(&l) = self.lambda_t.get(&c.key()) {
+                for (d, v) in c.tangent_row() {
+                    self.f_t[d] += l * v;
+                }
+            }
         }
+        for (c, t) in self.f_c.iter_mut().zip(&self.f_t) {
+            *c += t;
+        }
+    }
+
+    /// The relative tangential displacement of a row since the start of the step at
+    /// displacements `u`: `t · Σ w_k (u_k − u0_k)`.
+    fn slip(&self, c: &Candidate, u: &[f64]) -> f64 {
+        let t = c.tangent();
+        let d = c.combine(|n| [u[2 * n] - self.u0[2 * n], u[2 * n + 1] - self.u0[2 * n + 1]]);
+        d[0] * t[0] + d[1] * t[1]
     }
 
     /// The threshold below which a multiplier counts as zero: a millionth of the
@@ -358,6 +448,22 @@ impl Correction for ContactCorrection<'_> {
             }
             keep
         });
+        // A tangential force follows its normal one to the slave's remaining row.
+        let mut moved_t = Vec::new();
+        self.lambda_t.retain(|k, l| {
+            let keep = found(k);
+            if !keep {
+                moved_t.push((*k, *l));
+            }
+            keep
+        });
+        for (k, l) in moved_t {
+            let slave = (k.0, k.1, k.2);
+            let at = self.cands.partition_point(|c| c.slave_key() < slave);
+            if let Some(c) = self.cands.get(at).filter(|c| c.slave_key() == slave) {
+                *self.lambda_t.entry(c.key()).or_insert(0.0) += l;
+            }
+        }
         for &(k, l) in &self.moved {
             let slave = (k.0, k.1, k.2);
             let at = self.cands.partition_point(|c| c.slave_key() < slave);
@@ -427,8 +533,14 @@ impl Correction for ContactCorrection<'_> {
         // G over the free dofs (nalgebra-sparse CSR). The rows: predicted to close, or
         // active before; rows the free dofs cannot move are left out (nothing can
         // enforce them).
-        let g = super::detect::gap_matrix(&self.cands, eq, free.len());
+        let n_cands = self.cands.len();
+        let g = if self.frictional {
+            super::detect::gap_and_tangent_matrix(&self.cands, eq, free.len())
+        } else {
+            super::detect::gap_matrix(&self.cands, eq, free.len())
+        };
         self.rows.clear();
+        self.cones.clear();
         self.c.clear();
         self.gaps.clear();
         for (i, c) in self.cands.iter().enumerate() {
@@ -456,9 +568,33 @@ impl Correction for ContactCorrection<'_> {
                 self.c.push(predicted);
             }
         }
+        // The tangential rows of the frictional pairs' rows, after the normal ones:
+        // the slip since the start of the step, predicted.
+        self.normal_rows = self.rows.len();
+        if self.frictional {
+            for j in 0..self.normal_rows {
+                let i = self.rows[j];
+                let c = &self.cands[i];
+                let mu = self.pairs[c.pair].mu;
+                if mu > 0.0 {
+                    let row = g.row(n_cands + i);
+                    let moved: f64 = row
+                        .col_indices()
+                        .iter()
+                        .zip(row.values())
+                        .map(|(&e, v)| v * self.delta0[e])
+                        .sum();
+                    let slip = self.slip(c, u) + moved;
+                    self.rows.push(n_cands + i);
+                    self.c.push(slip);
+                    self.cones.push((j, mu));
+                }
+            }
+        }
         let m = self.rows.len();
         self.previous = std::mem::take(&mut self.current);
         self.lambda.clear();
+        self.lambda_t.clear();
         if m == 0 {
             rhs.copy_from_slice(&self.delta0);
             return Ok(Corrected::Ok);
@@ -526,14 +662,22 @@ impl Correction for ContactCorrection<'_> {
                 // The previous active set first: accepted only if it satisfies the
                 // KKT conditions, so the QP's solution either way.
                 self.guess.clear();
-                for (j, &i) in self.rows.iter().enumerate() {
+                for (j, &i) in self.rows[..self.normal_rows].iter().enumerate() {
                     if self.previous.binary_search(&self.cands[i].key()).is_ok() {
                         self.guess.push(j);
                     }
                 }
                 let gap_tol =
                     GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-                let r = if !self.guess.is_empty()
+                let r = if !self.cones.is_empty() {
+                    super::coulomb::solve(
+                        &self.w,
+                        &self.c,
+                        self.normal_rows,
+                        &self.cones,
+                        &mut self.lambda_rows,
+                    )
+                } else if !self.guess.is_empty()
                     && solve_by_active_set(
                         &self.w,
                         &self.c,
@@ -541,7 +685,8 @@ impl Correction for ContactCorrection<'_> {
                         gap_tol,
                         &mut self.lambda_rows,
                         &mut self.guess_work,
-                    ) {
+                    )
+                {
                     self.stats.guessed += 1;
                     Ok(QpStats::default())
                 } else {
@@ -579,6 +724,7 @@ impl Correction for ContactCorrection<'_> {
                 r.map(|_| ())
             }
             ContactQp::Full => {
+                debug_assert!(self.cones.is_empty(), "validation: friction is condensed");
                 let t = Instant::now();
                 let r_free: Vec<f64> = free
                     .iter()
@@ -631,7 +777,11 @@ impl Correction for ContactCorrection<'_> {
                 })
                 .unwrap_or_default();
             let pairs: Vec<&str> = {
-                let mut p: Vec<usize> = self.rows.iter().map(|&i| self.cands[i].pair).collect();
+                let mut p: Vec<usize> = self
+                    .rows
+                    .iter()
+                    .map(|&i| self.cands[i % n_cands].pair)
+                    .collect();
                 p.sort_unstable();
                 p.dedup();
                 p.iter().map(|&i| self.pairs[i].name.as_str()).collect()
@@ -644,8 +794,9 @@ impl Correction for ContactCorrection<'_> {
         // Every positive multiplier acts as a force (dropping small ones would leave
         // their force out of the balance); the active set, for the test that it has
         // settled and for complementarity, holds the significant ones.
-        let threshold = self.active_threshold(&self.lambda_rows);
-        for (j, &i) in self.rows.iter().enumerate() {
+        let nr = self.normal_rows;
+        let threshold = self.active_threshold(&self.lambda_rows[..nr]);
+        for (j, &i) in self.rows[..nr].iter().enumerate() {
             let l = self.lambda_rows[j];
             let key = self.cands[i].key();
             if l > 0.0 {
@@ -653,6 +804,12 @@ impl Correction for ContactCorrection<'_> {
             }
             if l > threshold {
                 self.current.push(key);
+            }
+        }
+        for (k, &(j, _)) in self.cones.iter().enumerate() {
+            let l = self.lambda_rows[nr + k];
+            if l != 0.0 && self.lambda_rows[j] > 0.0 {
+                self.lambda_t.insert(self.cands[self.rows[j]].key(), l);
             }
         }
         self.current.sort_unstable();

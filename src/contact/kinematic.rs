@@ -452,8 +452,12 @@ impl<'m> KinematicContact<'m> {
                 if c.gap >= 0.0 {
                     continue;
                 }
-                let (row, k) = c.row();
-                let row = (row, k);
+                // The explicit path's candidates are node to segment (three nodes).
+                let mut row = ([(0usize, 0.0f64); 6], 0usize);
+                for (e, x) in c.row().take(6) {
+                    row.0[row.1] = (e, x);
+                    row.1 += 1;
+                }
                 let w = coupling(&row, &row, m_inv);
                 if w.is_nan() || w <= 0.0 {
                     continue;

@@ -16,9 +16,11 @@
 
 pub mod collision;
 mod compliance;
+mod coulomb;
 pub mod detect;
 pub mod implicit;
 pub mod kinematic;
+pub mod mortar;
 mod qp;
 pub mod sweep;
 

@@ -22,7 +22,7 @@ use crate::linsolve::LowerCsc;
 /// and tolerances of 1e-9 on the data scaled to order one: the gaps they leave are
 /// 1e-9 of the largest predicted gap, far below the contact tolerance. (Tighter
 /// tolerances end in `InsufficientProgress` on well-posed problems.)
-fn settings() -> DefaultSettings<f64> {
+pub(super) fn settings() -> DefaultSettings<f64> {
     DefaultSettingsBuilder::default()
         .verbose(false)
         .presolve_enable(false)
@@ -35,7 +35,7 @@ fn settings() -> DefaultSettings<f64> {
         .expect("valid Clarabel settings")
 }
 
-fn accept(status: SolverStatus) -> Result<(), String> {
+pub(super) fn accept(status: SolverStatus) -> Result<(), String> {
     match status {
         SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(()),
         other => Err(format!("Clarabel status {other:?}")),
@@ -43,7 +43,7 @@ fn accept(status: SolverStatus) -> Result<(), String> {
 }
 
 /// The upper triangle of a dense symmetric `m x m` matrix (column-major) in CSC.
-fn dense_upper(w: &[f64], m: usize, scale: f64) -> CscMatrix<f64> {
+pub(super) fn dense_upper(w: &[f64], m: usize, scale: f64) -> CscMatrix<f64> {
     let mut colptr = Vec::with_capacity(m + 1);
     let mut rowval = Vec::with_capacity(m * (m + 1) / 2);
     let mut nzval = Vec::with_capacity(m * (m + 1) / 2);

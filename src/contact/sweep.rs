@@ -126,15 +126,13 @@ pub fn crossed<X0, X1>(
                         let c = if g0 > 0.0 { g0 / (g0 - g1) } else { 0.0 };
                         let pc = [p0[0] + c * (p1[0] - p0[0]), p0[1] + c * (p1[1] - p0[1])];
                         if within_ends(along(pc)) {
-                            out.push(Candidate {
-                                pair: pi,
-                                side: si,
-                                slave: s,
-                                master: Contactee::Rigid,
-                                xi: along(p1).clamp(0.0, 1.0),
-                                gap: g1,
-                                normal: *n,
-                            });
+                            out.push(Candidate::nodal(
+                                (pi, si, s),
+                                Contactee::Rigid,
+                                along(p1).clamp(0.0, 1.0),
+                                g1,
+                                *n,
+                            ));
                         }
                     }
                 }

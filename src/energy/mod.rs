@@ -38,8 +38,10 @@ pub struct Dissipation {
     pub damage: f64,
     /// Plasticity.
     pub plastic: f64,
-    /// Contact.
+    /// Contact: the work the normal contact forces take out (impacts).
     pub contact: f64,
+    /// Friction: the work of the tangential contact forces on the slip, `≥ 0`.
+    pub friction: f64,
     /// Mass and Rayleigh damping `∫ v·C v dt`.
     pub mass: f64,
     /// The time scheme's own numerical loss. At a material point:
@@ -52,7 +54,13 @@ pub struct Dissipation {
 impl Dissipation {
     /// Sum over all mechanisms, numerical loss included.
     pub fn total(&self) -> f64 {
-        self.viscous + self.damage + self.plastic + self.contact + self.mass + self.numerical
+        self.viscous
+            + self.damage
+            + self.plastic
+            + self.contact
+            + self.friction
+            + self.mass
+            + self.numerical
     }
 
     /// Physical material dissipation: viscous + damage + plastic.
@@ -67,18 +75,20 @@ impl Dissipation {
             damage: w * self.damage,
             plastic: w * self.plastic,
             contact: w * self.contact,
+            friction: w * self.friction,
             mass: w * self.mass,
             numerical: w * self.numerical,
         }
     }
 
     /// The lines as `(name, value)` pairs, in the order of `history.csv`.
-    pub fn lines(&self) -> [(&'static str, f64); 6] {
+    pub fn lines(&self) -> [(&'static str, f64); 7] {
         [
             ("viscous", self.viscous),
             ("damage", self.damage),
             ("plastic", self.plastic),
             ("contact", self.contact),
+            ("friction", self.friction),
             ("mass", self.mass),
             ("numerical", self.numerical),
         ]
@@ -91,6 +101,7 @@ impl AddAssign for Dissipation {
         self.damage += o.damage;
         self.plastic += o.plastic;
         self.contact += o.contact;
+        self.friction += o.friction;
         self.mass += o.mass;
         self.numerical += o.numerical;
     }
@@ -120,6 +131,8 @@ pub struct StepIncrements {
     pub scheme_loss: f64,
     /// Energy taken out by constraints (contact) in the step.
     pub contact: f64,
+    /// Energy taken out by friction in the step.
+    pub friction: f64,
 }
 
 /// The running ledger. Fields are read through accessors; only [`Ledger::record`]
@@ -159,6 +172,7 @@ impl Ledger {
         self.elastic = s.elastic;
         let mut step = s.material;
         step.contact += s.contact;
+        step.friction += s.friction;
         step.mass += s.work.damping;
         step.numerical += s.scheme_loss - s.work.load_jump;
         self.dissipated += step;
@@ -256,13 +270,15 @@ mod tests {
             damage: 2.0,
             plastic: 3.0,
             contact: 4.0,
+            friction: 7.0,
             mass: 5.0,
             numerical: 6.0,
         };
         let mut b = a.scaled(0.5);
         b += a;
         assert_eq!(b.plastic, 4.5);
-        assert_eq!((a + a).total(), 42.0);
+        assert_eq!(b.friction, 10.5);
+        assert_eq!((a + a).total(), 56.0);
         assert_eq!(a.material(), 6.0);
     }
 
@@ -284,6 +300,7 @@ mod tests {
             },
             scheme_loss: 0.5,
             contact: 1.0,
+            friction: 0.0,
         });
         // ΔE_kin + ΔE_el + D − W = −6 + 3 + (1 + 1 + 1) − 0 = 0.
         assert_eq!(l.residual(), 0.0);

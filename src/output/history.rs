@@ -8,7 +8,7 @@ use crate::energy::Ledger;
 use crate::error::{Error, Result};
 
 /// The fixed ledger columns.
-pub const LEDGER_COLUMNS: [&str; 12] = [
+pub const LEDGER_COLUMNS: [&str; 13] = [
     "t",
     "E_kin",
     "E_int",
@@ -18,6 +18,7 @@ pub const LEDGER_COLUMNS: [&str; 12] = [
     "D_damage",
     "D_plastic",
     "D_contact",
+    "D_friction",
     "D_mass",
     "D_num",
     "residual",
@@ -31,8 +32,10 @@ pub struct History {
 
 impl History {
     /// Creates the file and writes the header (ledger columns, solver columns, then
-    /// `<probe>_ux, <probe>_uy` per probe, then `<pair>_force, <pair>_active` per
-    /// contact pair).
+    /// `<probe>_ux, <probe>_uy` per probe, then `<pair>_force, <pair>_active`,
+    /// `<pair>_tangential_force, <pair>_stick, <pair>_slip` per contact pair: the
+    /// normal force, the pressed nodes, the friction force and how many pressed
+    /// nodes stick and slip).
     pub fn create(path: &Path, probes: &[String], pairs: &[String]) -> Result<Self> {
         let file = File::create(path).map_err(|e| Error::io(path, e))?;
         let mut h = History {
@@ -49,6 +52,9 @@ impl History {
         for p in pairs {
             cols.push(format!("{p}_force"));
             cols.push(format!("{p}_active"));
+            cols.push(format!("{p}_tangential_force"));
+            cols.push(format!("{p}_stick"));
+            cols.push(format!("{p}_slip"));
         }
         writeln!(h.out, "{}", cols.join(",")).map_err(|e| Error::io(&h.path, e))?;
         h.flush()?;
@@ -67,15 +73,18 @@ impl History {
     ) -> Result<()> {
         let d = l.dissipated();
         let mut line = format!(
-            "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
+            "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
             l.kinetic(), l.internal(), l.external_work(), l.elastic(), d.viscous, d.damage, d.plastic,
-            d.contact, d.mass, d.numerical, l.residual()
+            d.contact, d.friction, d.mass, d.numerical, l.residual()
         );
         for p in probes {
             line.push_str(&format!(",{:.12e},{:.12e}", p[0], p[1]));
         }
         for p in pairs {
-            line.push_str(&format!(",{:.12e},{}", p.force, p.active));
+            line.push_str(&format!(
+                ",{:.12e},{},{:.12e},{},{}",
+                p.force, p.active, p.tangential_force, p.stick, p.slip
+            ));
         }
         writeln!(self.out, "{line}").map_err(|e| Error::io(&self.path, e))?;
         self.flush()

@@ -131,21 +131,23 @@ impl RunData {
 }
 
 /// The dissipation lines of `summary.json`.
-pub const DISSIPATION_LINES: [&str; 6] = [
+pub const DISSIPATION_LINES: [&str; 7] = [
     "viscous",
     "damage",
     "plastic",
     "contact",
+    "friction",
     "mass",
     "numerical",
 ];
 
 /// The dissipation columns of `history.csv`.
-pub const DISSIPATION_COLUMNS: [&str; 6] = [
+pub const DISSIPATION_COLUMNS: [&str; 7] = [
     "D_viscous",
     "D_damage",
     "D_plastic",
     "D_contact",
+    "D_friction",
     "D_mass",
     "D_num",
 ];

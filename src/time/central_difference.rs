@@ -404,7 +404,9 @@ impl Integrator for CentralDifference<'_> {
             work,
             material,
             scheme_loss: -h * h / 8.0 * (ama1 - ama0),
+            // The kinematic method's impacts, friction interpolation included.
             contact,
+            friction: 0.0,
         });
         if let Some((quantity, value)) = ledger.first_non_finite() {
             let outcome = Outcome::NonFinite {

@@ -834,12 +834,15 @@ impl Corrector<'_> {
         }
     }
 
-    /// The energy the constraints took in the accepted step (`−Δu·f_c`), with their
-    /// state written into `s.contact`.
-    fn finish(&mut self, du: &[f64], s: &mut State) -> f64 {
+    /// The energy the constraints took in the accepted step (`−Δu·f` of the normal
+    /// and of the friction forces), with their state written into `s.contact`.
+    fn finish(&mut self, du: &[f64], s: &mut State) -> (f64, f64) {
         match self {
-            Corrector::Linear(_) => 0.0,
-            Corrector::Contact(c) => -c.finish(du, &mut s.contact),
+            Corrector::Linear(_) => (0.0, 0.0),
+            Corrector::Contact(c) => {
+                let (normal, friction) = c.finish(du, &mut s.contact);
+                (-normal, -friction)
+            }
         }
     }
 }
@@ -1024,7 +1027,14 @@ fn first_non_finite(
 /// Books the converged step and makes it the state. The last evaluation summed the
 /// step's ledger terms with the applied loads; the reactions (the residual on the
 /// constrained dofs) are added here, with their part of the work terms.
-fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f64, contact: f64) {
+fn finish(
+    ops: &Operators,
+    dofs: &DofMap,
+    w: &mut Scratch,
+    s: &mut State,
+    t1: f64,
+    (contact, friction): (f64, f64),
+) {
     let mut sums = w.ledger_sums;
     for &d in &dofs.constrained {
         let reaction = w.r[d];
@@ -1052,6 +1062,7 @@ fn finish(ops: &Operators, dofs: &DofMap, w: &mut Scratch, s: &mut State, t1: f6
         material,
         scheme_loss: sums[5],
         contact,
+        friction,
     });
     std::mem::swap(&mut s.u, &mut w.u_np1);
     std::mem::swap(&mut s.f_int, &mut w.f_int_np1);

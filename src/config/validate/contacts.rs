@@ -5,7 +5,7 @@ use super::checks::{finite, positive};
 use crate::config::{ContactSpec, Scenario};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use crate::model::{ContactPair, ContactSide, Master};
+use crate::model::{ContactPair, ContactSide, Formulation, Master};
 
 fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
     ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
@@ -72,6 +72,36 @@ fn master_edges(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<[usize; 2]>>
     }
 }
 
+/// Refuses a mortar pair whose rows could span more than
+/// [`crate::contact::detect::ROW_NODES`] nodes: a slave node's two segments facing
+/// more master segments than a row holds (the master much finer than the slave).
+fn mortar_reach(
+    mesh: &Mesh,
+    field: &str,
+    slave_segments: &[[usize; 2]],
+    master: &[[usize; 2]],
+) -> Result<()> {
+    let len = |e: &[usize; 2]| dist(mesh.coords[e[0]], mesh.coords[e[1]]);
+    let longest_slave = slave_segments.iter().map(len).fold(0.0, f64::max);
+    let shortest_master = master.iter().map(len).fold(f64::INFINITY, f64::min);
+    // Three slave nodes, and the master nodes under two slave segments (one more
+    // than the segments they hold, one more for a segment only partly under).
+    let needed = 3.0 + (2.0 * longest_slave / shortest_master).ceil() + 2.0;
+    if needed > crate::contact::detect::ROW_NODES as f64 {
+        return Err(Error::config(
+            field,
+            format!(
+                "the master is too fine for mortar against this slave (slave segments up to \
+                 {longest_slave:.3e} m, master segments down to {shortest_master:.3e} m: a row \
+                 would hold {needed} nodes, at most {} fit); refine the slave side or give \
+                 `formulation = \"node_to_segment\"`",
+                crate::contact::detect::ROW_NODES
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The body of a set of nodes, if they all belong to one.
 fn body_of(mesh: &Mesh, nodes: &[usize]) -> Option<usize> {
     let b = mesh.node_body[*nodes.first()?];
@@ -97,7 +127,24 @@ pub(super) fn contacts(
             both_ways,
             friction,
             position_weight,
+            mu,
+            formulation,
         } = c;
+        let mu = mu.unwrap_or(0.0);
+        if !(mu.is_finite() && mu >= 0.0) {
+            return Err(Error::config(
+                format!("{field}.mu"),
+                format!("{mu:?} is not a friction coefficient (finite, 0 or more)"),
+            ));
+        }
+        let explicit = scheme == crate::model::TimeScheme::CentralDifference;
+        if explicit && mu > 0.0 {
+            return Err(Error::config(
+                format!("{field}.mu"),
+                "Coulomb friction is enforced by the implicit schemes; the explicit kinematic \
+                 contact takes the paper's friction interpolation `friction` (beta)",
+            ));
+        }
         let friction = friction.unwrap_or(0.0);
         let position_weight = position_weight.unwrap_or(0.5);
         for (what, v) in [("friction", friction), ("position_weight", position_weight)] {
@@ -117,7 +164,7 @@ pub(super) fn contacts(
                     return Err(Error::config(
                         format!("{field}.{what}"),
                         "belongs to the explicit kinematic contact (analysis.scheme = \"central_difference\"); \
-                         the implicit contact is frictionless",
+                         the implicit contact's friction is Coulomb's `mu`",
                     ));
                 }
             }
@@ -170,9 +217,50 @@ pub(super) fn contacts(
                     radius = radius.max(l);
                     shortest = shortest.min(l);
                 }
+                let mortar = match (formulation, explicit) {
+                    (Some(Formulation::Mortar), true) => {
+                        return Err(Error::config(
+                            format!("{field}.formulation"),
+                            "the explicit kinematic contact is node to segment; \
+                             mortar belongs to the implicit schemes",
+                        ))
+                    }
+                    (Some(Formulation::Mortar), false) | (None, false) => {
+                        match mesh.edge_sets.get(slave) {
+                            Some(e) => Some(e.clone()),
+                            None if formulation.is_some() => {
+                                return Err(Error::config(
+                                    format!("{field}.formulation"),
+                                    format!(
+                                        "mortar needs the slave `{slave}` to be an edge set \
+                                         (its segments carry the weights); it is a node set"
+                                    ),
+                                ))
+                            }
+                            None => None,
+                        }
+                    }
+                    _ => None,
+                };
+                if let Some(slave_segments) = &mortar {
+                    if *both_ways {
+                        return Err(Error::config(
+                            format!("{field}.both_ways"),
+                            "a mortar pair is one pass (its weighted gaps hold both surfaces); \
+                             give `formulation = \"node_to_segment\"` for two passes",
+                        ));
+                    }
+                    mortar_reach(
+                        mesh,
+                        &format!("{field}.formulation"),
+                        slave_segments,
+                        &edges,
+                    )?;
+                }
                 sides.push(ContactSide {
                     slaves: slaves.clone(),
                     master: Master::Segments(edges.clone()),
+                    mortar: mortar.clone().unwrap_or_default(),
                 });
                 if *both_ways {
                     let back =
@@ -193,6 +281,7 @@ pub(super) fn contacts(
                     sides.push(ContactSide {
                         slaves: nodes,
                         master: Master::Segments(back),
+                        mortar: Vec::new(),
                     });
                 }
             }
@@ -210,6 +299,13 @@ pub(super) fn contacts(
                     return Err(Error::config(
                         format!("{field}.both_ways"),
                         "a rigid line is a master only",
+                    ));
+                }
+                if *formulation == Some(Formulation::Mortar) {
+                    return Err(Error::config(
+                        format!("{field}.formulation"),
+                        "a rigid line is straight: its gaps are the slave nodes' own \
+                         (node to segment); mortar is for a deformable master",
                     ));
                 }
                 // The normal points to the side of the slave body's centroid.
@@ -232,6 +328,7 @@ pub(super) fn contacts(
                 sides.push(ContactSide {
                     slaves,
                     master: Master::Rigid { a: *a, b: *b, n },
+                    mortar: Vec::new(),
                 });
             }
             _ => {
@@ -241,11 +338,18 @@ pub(super) fn contacts(
                 ))
             }
         }
+        let formulation = if sides.iter().any(|s| !s.mortar.is_empty()) {
+            Formulation::Mortar
+        } else {
+            Formulation::NodeToSegment
+        };
         pairs.push(ContactPair {
             name: name.clone(),
             sides,
             radius,
             friction,
+            mu,
+            formulation,
             position_weight,
         });
     }

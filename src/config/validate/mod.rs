@@ -112,6 +112,18 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let loads = constraints::loads(s, &mesh, &bodies)?;
     let probes = constraints::probes(s, &mesh)?;
     let (contacts, shortest) = contacts::contacts(s, &mesh, a.scheme)?;
+    if a.contact_qp == Some(crate::model::ContactQp::Full) {
+        if let Some((i, p)) = contacts.iter().enumerate().find(|(_, p)| p.mu > 0.0) {
+            return Err(Error::config(
+                "analysis.contact_qp",
+                format!(
+                    "the full QP is the frictionless reference; contact[{i}] (`{}`) has \
+                     friction (mu = {}): use the condensed QP (the default)",
+                    p.name, p.mu
+                ),
+            ));
+        }
+    }
     let contact_tolerance = match a.contact_tolerance {
         Some(t) => {
             positive("analysis.contact_tolerance", t)?;
@@ -191,6 +203,7 @@ fn initial_overlap(model: &Model) -> Result<()> {
         crate::contact::detect::Contactee::Segment { nodes, .. } => {
             format!("the master segment of nodes {} and {}", nodes[0], nodes[1])
         }
+        crate::contact::detect::Contactee::Mortar => "the master surface (mortar)".to_string(),
     };
     Err(Error::config(
         format!("contact[{}]", c.pair),

@@ -1,0 +1,186 @@
+//! Coulomb friction in the condensed dual: a sequence of second-order cone programs
+//! (De Saxcé's fixed point), solved with Clarabel.
+//!
+//! The rows are the normal gaps (`n` of them, first) and, for the pressed nodes of
+//! frictional pairs, their tangential slips (after them). With `W = G A⁻¹ Gᵀ` and
+//! `c` the predicted gaps and slips, the forces `Λ` give the gaps and slips
+//! `y = c + WΛ`. Coulomb's law at a frictional node (`λ_N`, `λ_T`, gap `g`, slip `s`):
+//! `λ_N ≥ 0`, `g ≥ 0`, `λ_N g = 0`; `|λ_T| ≤ μ λ_N`; sticking (`|λ_T| < μ λ_N`) means
+//! `s = 0`, slipping means `s = −α λ_T` with `α ≥ 0`.
+//!
+//! With the shift `σ = μ |s|` fixed, the program
+//!
+//! `min ½ ΛᵀWΛ + Λᵀ(c + σ e_N)   over   Λ ∈ K = {λ_N ≥ 0, |λ_T| ≤ μ λ_N}`
+//!
+//! has the optimality conditions `K ∋ Λ ⊥ y + σ e_N ∈ K*`, `K* = {μ |y_T| ≤ y_N}`:
+//! with `σ = μ|s|` they are exactly Coulomb's law (the modified velocity of De
+//! Saxcé and Feng). The shift is updated from the slips of the solution until it
+//! settles (`theory/contact.md`); each cone `(μ λ_N, λ_T)` is Clarabel's second-order
+//! cone of dimension 2, the frictionless rows its nonnegative cone. Data scaled to
+//! order one as the frictionless dual.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSolver, IPSolver, SupportedConeT};
+
+use super::qp::{accept, dense_upper, settings, QpStats};
+
+/// Fixed-point iterations on the shift before the solve is given up.
+pub const MAX_SHIFT_ITERATIONS: usize = 100;
+
+/// The shift has settled when no entry moved by more than this fraction of the
+/// largest predicted gap or slip between two solves (Clarabel's own tolerance is
+/// 1e-9 of it).
+pub const SHIFT_TOLERANCE: f64 = 1e-8;
+
+/// Solves Coulomb's law for the rows: `w` column-major `m x m`, `c` the predicted
+/// gaps then slips, the first `n` rows normal, `cones[k] = (j, μ)` the normal row
+/// `j` and coefficient of tangential row `n + k`. Writes the forces into `lambda`
+/// and returns the Clarabel iterations summed over the shift iterations.
+pub(crate) fn solve(
+    w: &[f64],
+    c: &[f64],
+    n: usize,
+    cones: &[(usize, f64)],
+    lambda: &mut Vec<f64>,
+) -> Result<QpStats, String> {
+    let m = c.len();
+    debug_assert_eq!(m, n + cones.len());
+    lambda.clear();
+    lambda.resize(m, 0.0);
+    // No force when no gap would close: Λ = 0 with σ = μ|c_T| satisfies the law.
+    if c[..n].iter().all(|&x| x >= 0.0) {
+        return Ok(QpStats::default());
+    }
+    let w_bar = (0..m).map(|i| w[i + i * m]).sum::<f64>() / m as f64;
+    let ell = c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    if !(w_bar > 0.0 && w_bar.is_finite() && ell.is_finite()) {
+        return Err(format!(
+            "the condensed matrix is not positive (mean diagonal {w_bar:e})"
+        ));
+    }
+    let p = dense_upper(w, m, 1.0 / w_bar);
+    // Constraints s = b − AΛ ∈ K: the frictionless normal rows in the nonnegative
+    // cone, then (μ λ_N, λ_T) per frictional node.
+    let mut frictional = vec![false; n];
+    for &(j, _) in cones {
+        frictional[j] = true;
+    }
+    let mut entries: Vec<(usize, usize, f64)> = Vec::with_capacity(m);
+    let mut row = 0;
+    for (j, &f) in frictional.iter().enumerate() {
+        if !f {
+            entries.push((row, j, -1.0));
+            row += 1;
+        }
+    }
+    let free = row;
+    for (k, &(j, mu)) in cones.iter().enumerate() {
+        entries.push((row, j, -mu));
+        entries.push((row + 1, n + k, -1.0));
+        row += 2;
+    }
+    let a = csc(row, m, &mut entries);
+    let b = vec![0.0; row];
+    let mut kinds = Vec::with_capacity(1 + cones.len());
+    if free > 0 {
+        kinds.push(SupportedConeT::NonnegativeConeT(free));
+    }
+    kinds.extend(cones.iter().map(|_| SupportedConeT::SecondOrderConeT(2)));
+    let mut shift = vec![0.0; cones.len()];
+    let mut q: Vec<f64> = c.iter().map(|x| x / ell).collect();
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &kinds, settings())
+        .map_err(|e| format!("Clarabel setup: {e}"))?;
+    let mut stats = QpStats::default();
+    let f = ell / w_bar;
+    for _ in 0..MAX_SHIFT_ITERATIONS {
+        solver.solve();
+        accept(solver.solution.status)?;
+        stats.iterations += solver.solution.iterations;
+        stats.solve_s += solver.solution.solve_time;
+        for (l, x) in lambda.iter_mut().zip(&solver.solution.x) {
+            *l = f * x;
+        }
+        // The slips of the solution, and the shift they ask for.
+        let mut moved: f64 = 0.0;
+        for (k, &(j, mu)) in cones.iter().enumerate() {
+            let t = n + k;
+            let slip = c[t] + (0..m).map(|i| w[t + i * m] * lambda[i]).sum::<f64>();
+            let s = mu * slip.abs();
+            moved = moved.max((s - shift[k]).abs());
+            shift[k] = s;
+            q[j] = (c[j] + s) / ell;
+        }
+        if moved <= SHIFT_TOLERANCE * ell {
+            for l in &mut lambda[..n] {
+                *l = l.max(0.0);
+            }
+            return Ok(stats);
+        }
+        solver
+            .update_q(&q)
+            .map_err(|e| format!("Clarabel update: {e:?}"))?;
+    }
+    Err(format!(
+        "the friction shift did not settle in {MAX_SHIFT_ITERATIONS} cone programs"
+    ))
+}
+
+/// A CSC matrix from `(row, column, value)` triplets (distinct positions).
+fn csc(rows: usize, cols: usize, entries: &mut [(usize, usize, f64)]) -> CscMatrix<f64> {
+    entries.sort_unstable_by_key(|&(r, c, _)| (c, r));
+    let mut colptr = vec![0usize; cols + 1];
+    for &(_, c, _) in entries.iter() {
+        colptr[c + 1] += 1;
+    }
+    for j in 0..cols {
+        colptr[j + 1] += colptr[j];
+    }
+    CscMatrix::new(
+        rows,
+        cols,
+        colptr,
+        entries.iter().map(|e| e.0).collect(),
+        entries.iter().map(|e| e.2).collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One node on a rigid support, compliance `w_n` normal and `w_t` tangential (no
+    /// coupling): pressed by a predicted penetration and pushed sideways by a
+    /// predicted slip.
+    fn one(mu: f64, c_n: f64, c_t: f64) -> (f64, f64, f64) {
+        let (wn, wt) = (2.0e-9, 3.0e-9);
+        let w = [wn, 0.0, 0.0, wt];
+        let mut l = Vec::new();
+        solve(&w, &[c_n, c_t], 1, &[(0, mu)], &mut l).unwrap();
+        let slip = c_t + wt * l[1];
+        (l[0], l[1], slip)
+    }
+
+    #[test]
+    fn a_pressed_node_sticks_below_the_cone_and_slides_on_it() {
+        // Normal force 1e6 N from the penetration; sticking needs 1e5 N sideways.
+        let (n, t, s) = one(0.5, -2.0e-3, 3.0e-4);
+        assert!((n - 1.0e6).abs() < 1e-3 * 1e6, "{n}");
+        assert!(
+            (t + 1.0e5).abs() < 1e-3 * 1e5 && s.abs() < 1e-9,
+            "stick: {t} {s}"
+        );
+        // With μ = 0.05 the cone allows 5e4 N: it slides, the force opposes the slip.
+        let (n, t, s) = one(0.05, -2.0e-3, 3.0e-4);
+        assert!((n - 1.0e6).abs() < 1e-3 * 1e6, "{n}");
+        assert!((t + 5.0e4).abs() < 1e-6 * 5e4, "slide: {t}");
+        let expect = 3.0e-4 - 3.0e-9 * 5.0e4;
+        // Clarabel stops at 1e-9 of the scaled data: the slip to 1e-7 of itself.
+        assert!(
+            (s - expect).abs() < 1e-7 * 3e-4,
+            "slip {s} against {expect}"
+        );
+        // Open: no force at all.
+        let (n, t, _) = one(0.5, 1.0e-3, 3.0e-4);
+        assert_eq!((n, t), (0.0, 0.0));
+    }
+}

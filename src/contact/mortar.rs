@@ -1,0 +1,284 @@
+//! Mortar (segment-to-segment) gap rows: one weighted gap per slave node.
+//!
+//! For slave node `j` with the linear shape function `N_j` of the slave surface,
+//! the weighted gap is
+//!
+//! `g̃_j = ∫ N_j n_j · (x_s(ξ) − x_m(η(ξ))) ds = n_j · (Σ_k D_jk x_k − Σ_l M_jl x_l)`,
+//!
+//! `D_jk = ∫ N_j N_k ds` over the slave nodes `k`, `M_jl = ∫ N_j N̂_l ds` over the
+//! master nodes `l` (their shape functions carried to the slave by the projection),
+//! both over the part of the slave surface that faces a master segment. Each row is
+//! divided by `W_j = Σ_l M_jl = Σ_k D_jk` (the covered integral of `N_j`), so its gap
+//! is in metres (a weighted average of the gap over the support of `N_j`), its
+//! slave weights sum to 1 and its master weights to −1, and its multiplier is the
+//! force the node's share of the interface carries (`λ_j / (W_j t)` is the
+//! pressure). A uniform pressure `p` then gives every slave node `p t ∫ N_k` and every
+//! master node `p t ∫ N̂_l`: the consistent loads of both sides, whatever the meshes
+//! (the contact patch test, `theory/contact.md`).
+//!
+//! Projection: per slave segment, along its own normal (the master's ends are
+//! projected orthogonally onto the slave segment's line, and between them the map
+//! from slave to master coordinate is affine), so the products `N_j N̂_l` are
+//! quadratic in the slave coordinate and two Gauss points integrate them exactly.
+//! The row's normal is the slave's nodal normal (the normalised sum of its segments'
+//! outward normals) reversed, so that, as for node-to-segment, it points from the
+//! master towards the slave.
+
+use rstar::primitives::{GeomWithData, Line, Rectangle};
+use rstar::{RTree, RTreeObject};
+
+use super::detect::{Candidate, Contactee, Weights};
+
+/// The least covered fraction of a slave node's shape-function integral for the node
+/// to get a row: below it the node sees the master over a sliver of its support
+/// only (a master edge ending just inside its segment), too little to weigh a gap
+/// on. A millionth: far below any fraction a real overlap leaves.
+pub const COVERED_FRACTION: f64 = 1e-6;
+
+/// Outward unit normal of a segment with its body on the left.
+fn outward(a: [f64; 2], b: [f64; 2]) -> ([f64; 2], f64) {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l = d[0].hypot(d[1]);
+    if l > 0.0 {
+        ([d[1] / l, -d[0] / l], l)
+    } else {
+        ([0.0, 0.0], 0.0)
+    }
+}
+
+/// What one slave node gathers over its segments.
+#[derive(Clone, Copy)]
+struct Gathered {
+    weights: Weights,
+    /// `W_j`, the covered integral of `N_j`.
+    covered: f64,
+    /// `∫ N_j ds` over the node's whole support.
+    total: f64,
+    /// Sum of the outward normals of the node's segments.
+    normal: [f64; 2],
+    /// A row overflowed [`super::detect::ROW_NODES`].
+    overflow: bool,
+}
+
+/// The mortar rows of one side (`key`: pair and side) against the master
+/// `segments` at the geometry `x`, appended to `out` in slave order. `slaves` are the
+/// side's slave nodes (sorted), `slave_segments` its slave surface; master segments
+/// farther than `radius` from a slave segment are not looked at.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn rows<X: Fn(usize) -> [f64; 2]>(
+    key: (usize, usize),
+    slaves: &[usize],
+    slave_segments: &[[usize; 2]],
+    segments: &[[usize; 2]],
+    radius: f64,
+    x: &X,
+    out: &mut Vec<Candidate>,
+) {
+    let mut gathered = vec![
+        Gathered {
+            weights: Weights::EMPTY,
+            covered: 0.0,
+            total: 0.0,
+            normal: [0.0, 0.0],
+            overflow: false,
+        };
+        slaves.len()
+    ];
+    let slot = |n: usize| slaves.binary_search(&n).ok();
+    let tree = RTree::bulk_load(
+        segments
+            .iter()
+            .enumerate()
+            .map(|(k, &[a, b])| GeomWithData::new(Line::new(x(a), x(b)), k))
+            .collect(),
+    );
+    // Gauss points on [0, 1].
+    let g = 0.5 / 3f64.sqrt();
+    let gauss = [0.5 - g, 0.5 + g];
+    for &[s1, s2] in slave_segments {
+        let (p1, p2) = (x(s1), x(s2));
+        let (nu, len) = outward(p1, p2);
+        if len == 0.0 {
+            continue;
+        }
+        let (Some(j1), Some(j2)) = (slot(s1), slot(s2)) else {
+            continue;
+        };
+        for j in [j1, j2] {
+            gathered[j].total += 0.5 * len;
+            gathered[j].normal[0] += nu[0];
+            gathered[j].normal[1] += nu[1];
+        }
+        let d = [p2[0] - p1[0], p2[1] - p1[1]];
+        let along = |q: [f64; 2]| ((q[0] - p1[0]) * d[0] + (q[1] - p1[1]) * d[1]) / (len * len);
+        let lo = [p1[0].min(p2[0]) - radius, p1[1].min(p2[1]) - radius];
+        let hi = [p1[0].max(p2[0]) + radius, p1[1].max(p2[1]) + radius];
+        let reach = Rectangle::from_corners(lo, hi).envelope();
+        for hit in tree.locate_in_envelope_intersecting(reach) {
+            let [m1, m2] = segments[hit.data];
+            if [m1, m2].iter().any(|&m| m == s1 || m == s2) {
+                continue;
+            }
+            let (q1, q2) = (x(m1), x(m2));
+            let (nm, lm) = outward(q1, q2);
+            // Only a master facing the slave (normals opposed) carries it.
+            if lm == 0.0 || nm[0] * nu[0] + nm[1] * nu[1] >= 0.0 {
+                continue;
+            }
+            let (e1, e2) = (along(q1), along(q2));
+            if e1 == e2 {
+                continue;
+            }
+            let (a, b) = (e1.min(e2).max(0.0), e1.max(e2).min(1.0));
+            if b - a <= 1e-12 {
+                continue;
+            }
+            // The gap along the slave normal at the overlap's ends: beyond the radius
+            // on both, the master is out of reach.
+            let eta = |xi: f64| (xi - e1) / (e2 - e1);
+            let gap_at = |xi: f64| {
+                let (e, s) = (eta(xi), xi);
+                let xs = [p1[0] + s * d[0], p1[1] + s * d[1]];
+                let xm = [q1[0] + e * (q2[0] - q1[0]), q1[1] + e * (q2[1] - q1[1])];
+                -((xs[0] - xm[0]) * nu[0] + (xs[1] - xm[1]) * nu[1])
+            };
+            if gap_at(a).abs() > radius && gap_at(b).abs() > radius {
+                continue;
+            }
+            for &gp in &gauss {
+                let xi = a + (b - a) * gp;
+                let w = 0.5 * (b - a) * len;
+                let e = eta(xi);
+                let ns = [1.0 - xi, xi];
+                let nm = [1.0 - e, e];
+                for (jj, &j) in [j1, j2].iter().enumerate() {
+                    let gj = &mut gathered[j];
+                    let wj = w * ns[jj];
+                    gj.covered += wj;
+                    let mut ok = true;
+                    for (k, &node) in [s1, s2].iter().enumerate() {
+                        ok &= gj.weights.add(node, wj * ns[k]);
+                    }
+                    for (l, &node) in [m1, m2].iter().enumerate() {
+                        ok &= gj.weights.add(node, -wj * nm[l]);
+                    }
+                    gj.overflow |= !ok;
+                }
+            }
+        }
+    }
+    let (pair, side) = key;
+    for (j, gj) in gathered.iter_mut().enumerate() {
+        if gj.covered <= COVERED_FRACTION * gj.total || gj.total == 0.0 {
+            continue;
+        }
+        debug_assert!(!gj.overflow, "a mortar row spans more than ROW_NODES nodes");
+        let l = gj.normal[0].hypot(gj.normal[1]);
+        if l == 0.0 {
+            continue;
+        }
+        let n = [-gj.normal[0] / l, -gj.normal[1] / l];
+        gj.weights.scale(1.0 / gj.covered);
+        let mut c = Candidate::nodal((pair, side, slaves[j]), Contactee::Mortar, 0.0, 0.0, n);
+        c.weights = gj.weights;
+        c.length = gj.covered;
+        let p = c.combine(x);
+        c.gap = p[0] * n[0] + p[1] * n[1];
+        out.push(c);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A slave strip of `ns` segments on top of a master strip of `nm`, both on
+    /// [0, 1], the slave `gap` above: nodes, slave segments (body above, on the left
+    /// of segments running left to right), master segments (body below: right to
+    /// left).
+    fn strips(
+        ns: usize,
+        nm: usize,
+        gap: f64,
+    ) -> (Vec<[f64; 2]>, Vec<usize>, Vec<[usize; 2]>, Vec<[usize; 2]>) {
+        let mut x = Vec::new();
+        for i in 0..=ns {
+            x.push([i as f64 / ns as f64, gap]);
+        }
+        for i in 0..=nm {
+            x.push([i as f64 / nm as f64, 0.0]);
+        }
+        let slaves: Vec<usize> = (0..=ns).collect();
+        let slave_segs = (0..ns).map(|i| [i, i + 1]).collect();
+        let master_segs = (0..nm).map(|i| [ns + 2 + i, ns + 1 + i]).collect();
+        (x, slaves, slave_segs, master_segs)
+    }
+
+    #[test]
+    fn weighted_gaps_of_parallel_strips_are_the_gap_and_loads_are_consistent() {
+        for (ns, nm) in [(2, 3), (3, 2), (4, 4), (5, 2)] {
+            let (x, slaves, ss, ms) = strips(ns, nm, 0.01);
+            let mut out = Vec::new();
+            rows((0, 0), &slaves, &ss, &ms, 0.5, &|n| x[n], &mut out);
+            assert_eq!(out.len(), ns + 1);
+            let mut master_load = vec![0.0; x.len()];
+            let mut slave_load = vec![0.0; x.len()];
+            for c in &out {
+                assert!((c.gap - 0.01).abs() < 1e-14, "{c:?}");
+                assert!((c.normal[1] - 1.0).abs() < 1e-14);
+                let (sum_s, sum_m) = c.weights.iter().fold((0.0, 0.0), |(s, m), (n, w)| {
+                    if n <= ns {
+                        (s + w, m)
+                    } else {
+                        (s, m + w)
+                    }
+                });
+                assert!((sum_s - 1.0).abs() < 1e-14 && (sum_m + 1.0).abs() < 1e-14);
+                // A unit pressure: λ_j = W_j.
+                for (n, w) in c.weights.iter() {
+                    if n <= ns {
+                        slave_load[n] += c.length * w;
+                    } else {
+                        master_load[n] -= c.length * w;
+                    }
+                }
+            }
+            // Consistent nodal loads: half a segment at the ends, a whole inside.
+            for (n, &f) in master_load.iter().enumerate().skip(ns + 1) {
+                let k = n - ns - 1;
+                let expect = if k == 0 || k == nm { 0.5 } else { 1.0 } / nm as f64;
+                assert!((f - expect).abs() < 1e-14, "{ns}/{nm}: master {k}: {f}");
+            }
+            for (n, &f) in slave_load.iter().enumerate().take(ns + 1) {
+                let expect = if n == 0 || n == ns { 0.5 } else { 1.0 } / ns as f64;
+                assert!((f - expect).abs() < 1e-14, "{ns}/{nm}: slave {n}: {f}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_tilted_master_gives_the_averaged_gap_and_partial_cover_is_weighted() {
+        // The master from x = 0.25 to 1 at height 0, the slave over [0, 1] at 0.1:
+        // node 0 is not covered, node 1 (x = 0.5) half of its left segment.
+        let x = [[1.0, 0.1], [0.5, 0.1], [0.0, 0.1], [0.25, 0.0], [1.0, 0.0]];
+        let mut out = Vec::new();
+        rows(
+            (0, 0),
+            &[0, 1, 2],
+            &[[2, 1], [1, 0]],
+            &[[4, 3]],
+            0.5,
+            &|n| x[n],
+            &mut out,
+        );
+        let slaves: Vec<usize> = out.iter().map(|c| c.slave).collect();
+        assert_eq!(slaves, [0, 1, 2]);
+        for c in &out {
+            assert!((c.gap - 0.1).abs() < 1e-14, "{c:?}");
+        }
+        // Node 2 (x = 0) sees the master over [0.25, 0.5] of its segment, where its
+        // shape function is 1 - 2x: its integral 1/16.
+        assert!((out[2].length - 1.0 / 16.0).abs() < 1e-14, "{:?}", out[2]);
+        assert!((out[0].length - 0.25).abs() < 1e-14);
+    }
+}

@@ -1,0 +1,260 @@
+//! Coulomb friction in the implicit path: a block on an incline sticks below the
+//! friction angle and slides above it with the closed-form acceleration, the
+//! friction line of the ledger equals the friction force times the slip, and an
+//! oblique impact of two free blocks keeps its tangential impulse within the cone
+//! and conserves momentum.
+
+use std::path::Path;
+
+use rothe::linsolve::Backend;
+use rothe::model::Model;
+use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::{Integrator, State};
+
+fn model(text: &str) -> Model {
+    rothe::config::from_str(text, Path::new(".")).unwrap()
+}
+
+const G: f64 = 9.81;
+
+/// A steel block 0.1 x 0.1 m (thickness 0.1 m) resting on a horizontal rigid line,
+/// gravity tilted by `theta` (the incline turned level), friction `mu`.
+fn incline(theta: f64, mu: f64, h: f64, t_end: f64) -> String {
+    let (gx, gy) = (G * theta.sin(), -G * theta.cos());
+    format!(
+        r#"
+[analysis]
+t_end = {t_end:e}
+dt = {h:e}
+gravity = [{gx:e}, {gy:e}]
+vtk_every = 0
+
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+
+[[bodies]]
+name = "block"
+material = "steel"
+thickness = 0.1
+mesh = {{ kind = "rectangle", size = [0.1, 0.1], divisions = [4, 4] }}
+
+[[contact]]
+name = "incline"
+slave = "block.bottom"
+rigid_line = [[-10.0, 0.0], [10.0, 0.0]]
+mu = {mu:e}
+"#
+    )
+}
+
+/// Mean velocity and displacement of the block along the incline (x).
+fn mean_x(m: &Model, s: &State) -> (f64, f64) {
+    let n = m.mesh.n_nodes() as f64;
+    let v = (0..m.mesh.n_nodes()).map(|i| s.v[2 * i]).sum::<f64>() / n;
+    let u = (0..m.mesh.n_nodes()).map(|i| s.u[2 * i]).sum::<f64>() / n;
+    (v, u)
+}
+
+/// Runs the incline; returns the final state and `Σ |F_T| Δx` over the steps (the
+/// pair's tangential force times the block's slip increment).
+fn run_incline(theta: f64, mu: f64) -> (Model, State, f64) {
+    let m = model(&incline(theta, mu, 1.0e-3, 0.1));
+    let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+    let mut s = be.initial_state();
+    let mut work = 0.0;
+    for _ in 0..m.analysis.n_steps() {
+        let before = mean_x(&m, &s).1;
+        be.step_accepted(&mut s).unwrap();
+        let after = mean_x(&m, &s).1;
+        let rec = s.contact.pairs[0];
+        work += rec.tangential_force.abs() * (after - before).abs();
+        // Every step: the friction force within the cone, its line nonnegative.
+        assert!(
+            rec.tangential_force.abs() <= mu * rec.force * (1.0 + 1e-6),
+            "{rec:?}"
+        );
+        let l = &s.ledger;
+        assert!(l.dissipated().friction >= -1e-12 * l.scale());
+        assert!(
+            l.residual().abs() <= 1e-8 * l.scale(),
+            "ledger residual {} of {}",
+            l.residual(),
+            l.scale()
+        );
+    }
+    (m, s, work)
+}
+
+#[test]
+fn a_block_on_an_incline_slides_with_the_closed_form_acceleration() {
+    let theta = 30f64.to_radians();
+    let mu = 0.3;
+    let (m, s, work) = run_incline(theta, mu);
+    let (v, u) = mean_x(&m, &s);
+    let a = v / s.t;
+    let expect = G * (theta.sin() - mu * theta.cos());
+    eprintln!("slide: a = {a:.6} m/s² against {expect:.6}; u = {u:.6e} m");
+    assert!(
+        (a - expect).abs() < 0.01 * expect,
+        "a = {a}, expected {expect}"
+    );
+    let rec = s.contact.pairs[0];
+    assert!(rec.slip > 0 && rec.stick == 0, "{rec:?}");
+    // The friction line: the friction force times the slip, step by step (to the
+    // block's elastic shear, round-off against the slip), and in closed form
+    // μ m g cos θ u (the weight's normal part carried at every step).
+    let d = s.ledger.dissipated().friction;
+    assert!(
+        (d - work).abs() <= 1e-6 * d,
+        "D_friction {d:e} against Σ F Δx {work:e}"
+    );
+    let mass = 7850.0 * 0.1 * 0.1 * 0.1;
+    let closed = mu * mass * G * theta.cos() * u;
+    eprintln!("D_friction {d:.6e} J, closed form {closed:.6e} J");
+    assert!(
+        (d - closed).abs() < 0.01 * closed,
+        "{d:e} against {closed:e}"
+    );
+    // Sliding keeps every node on the line.
+    assert!(s.contact.pairs[0].penetration <= m.analysis.contact_tolerance);
+    assert!(s.contact.slip.iter().any(|&x| x > 0.5 * u));
+}
+
+#[test]
+fn a_block_on_an_incline_sticks_below_the_friction_angle() {
+    let theta = 30f64.to_radians();
+    let mu = 0.7;
+    assert!(theta.tan() < mu);
+    let (m, s, _) = run_incline(theta, mu);
+    let (v, u) = mean_x(&m, &s);
+    eprintln!("stick: v = {v:.3e} m/s, u = {u:.3e} m");
+    // The block stays (its elastic shear over the contact only: micrometres at most,
+    // against the 12 mm it would slide frictionless in the same time).
+    let free_slide = 0.5 * G * theta.sin() * s.t * s.t;
+    assert!(u.abs() < 1e-4 * free_slide, "u = {u:e}");
+    assert!(v.abs() < 1e-3 * G * theta.sin() * s.t, "v = {v:e}");
+    let rec = s.contact.pairs[0];
+    assert!(rec.stick > 0 && rec.slip == 0, "{rec:?}");
+    // Holding it takes the weight's tangential part.
+    let mass = 7850.0 * 0.1 * 0.1 * 0.1;
+    let hold = mass * G * theta.sin();
+    assert!(
+        (rec.tangential_force.abs() - hold).abs() < 1e-3 * hold,
+        "{} against {hold}",
+        rec.tangential_force
+    );
+    // Only the micro-slip at the contact's edges dissipates (the bottom spreads
+    // sideways under the weight where the pressure is lowest): a millionth of what
+    // sliding the free distance against the same friction would.
+    let l = &s.ledger;
+    let sliding = mu * mass * G * theta.cos() * free_slide;
+    eprintln!(
+        "stick: D_friction {:.3e} J against {sliding:.3e} J sliding",
+        l.dissipated().friction
+    );
+    assert!(l.dissipated().friction < 1e-6 * sliding);
+}
+
+/// Two free steel blocks (no supports, no gravity): the upper, 0.2 x 0.1 m, moves
+/// at `(vx, −vy)` onto the lower, 0.4 x 0.1 m, at rest, `gap` apart, friction `mu`.
+fn oblique(mu: f64, formulation: &str) -> String {
+    format!(
+        r#"
+[analysis]
+t_end = 1.5e-4
+dt = 1.0e-6
+vtk_every = 0
+
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+
+[[bodies]]
+name = "lower"
+material = "steel"
+thickness = 0.1
+mesh = {{ kind = "rectangle", size = [0.4, 0.1], divisions = [8, 2] }}
+
+[[bodies]]
+name = "upper"
+material = "steel"
+thickness = 0.1
+velocity = [3.0, -2.0]
+mesh = {{ kind = "rectangle", origin = [0.1, 0.1001], size = [0.2, 0.1], divisions = [5, 3] }}
+
+[[contact]]
+name = "impact"
+slave = "upper.bottom"
+master = "lower.top"
+mu = {mu:e}
+formulation = "{formulation}"
+"#
+    )
+}
+
+#[test]
+fn an_oblique_impact_keeps_friction_in_the_cone_and_conserves_momentum() {
+    for formulation in ["mortar", "node_to_segment"] {
+        let mu = 0.3;
+        let m = model(&oblique(mu, formulation));
+        let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let p = |s: &State, dir: usize| {
+            (0..m.mesh.n_nodes())
+                .map(|i| s.mv[2 * i + dir])
+                .sum::<f64>()
+        };
+        let (px0, py0) = (p(&s, 0), p(&s, 1));
+        let scale = px0.abs().max(py0.abs());
+        let (mut normal, mut tangential) = (0.0, 0.0);
+        let mut worst: f64 = 0.0;
+        let mut slipped = 0;
+        for _ in 0..m.analysis.n_steps() {
+            let d0 = s.ledger.dissipated().friction;
+            be.step_accepted(&mut s).unwrap();
+            let rec = s.contact.pairs[0];
+            normal += rec.force;
+            tangential += rec.tangential_force;
+            slipped += rec.slip;
+            assert!(
+                rec.tangential_force.abs() <= mu * rec.force * (1.0 + 1e-6) + 1e-9,
+                "{formulation}: {rec:?}"
+            );
+            assert!(
+                s.ledger.dissipated().friction >= d0 - 1e-12 * s.ledger.scale(),
+                "{formulation}: D_friction fell"
+            );
+            worst = worst
+                .max((p(&s, 0) - px0).abs() / scale)
+                .max((p(&s, 1) - py0).abs() / scale);
+        }
+        let l = &s.ledger;
+        eprintln!(
+            "{formulation}: impulses normal {:.4e} tangential {:.4e} N s, momentum drift {worst:.2e}, \
+             D_friction {:.4e} J, D_contact {:.4e} J of E_kin0 {:.4e} J, residual {:.2e}",
+            normal * 1e-6,
+            tangential * 1e-6,
+            l.dissipated().friction,
+            l.dissipated().contact,
+            l.kinetic_0(),
+            l.residual()
+        );
+        assert!(normal > 0.0, "{formulation}: no impact");
+        assert!(slipped > 0, "{formulation}: nothing slid");
+        assert!(tangential.abs() <= mu * normal * (1.0 + 1e-6));
+        // The upper block slides right: friction on it points left.
+        assert!(tangential < 0.0, "{formulation}: {tangential}");
+        assert!(l.dissipated().friction > 0.0);
+        assert!(worst < 1e-9, "{formulation}: momentum drift {worst:e}");
+        assert!(
+            l.residual().abs() < 1e-8 * l.scale(),
+            "{formulation}: {}",
+            l.residual()
+        );
+    }
+}
