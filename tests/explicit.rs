@@ -333,7 +333,12 @@ fn two_bars_collide_as_1d_wave_theory_says_and_conserve_momentum() {
 /// A steel block 0.2 x 0.1 m thrown at (1, −1) m/s onto a rigid floor, with the
 /// friction `beta` and position weight `w` of the pair.
 fn thrown(beta: f64, w: f64, dt: f64, t_end: f64, gap: f64) -> Model {
-    let text = format!(
+    load(&thrown_text(beta, w, dt, t_end, gap), false).unwrap()
+}
+
+/// The text of [`thrown`].
+fn thrown_text(beta: f64, w: f64, dt: f64, t_end: f64, gap: f64) -> String {
+    format!(
         r#"
 [analysis]
 scheme = "central_difference"
@@ -358,8 +363,45 @@ rigid_line = [[-1.0, 0.0], [2.0, 0.0]]
 friction = {beta}
 position_weight = {w}
 "#
-    );
-    load(&text, false).unwrap()
+    )
+}
+
+#[test]
+fn coulomb_friction_bounds_the_impact_impulse_by_mu_times_the_normal_one() {
+    // The thrown block of the next test with Coulomb's μ instead of β: the impact
+    // stops the bottom nodes (lumped mass m_b) vertically, a normal impulse m_b v_y =
+    // m_b; stopping them sideways too would take m_b v_x = m_b, which the cone allows
+    // for μ ≥ 1 (they stick) and caps at μ m_b below (they slide on). The floor is
+    // external: the block's horizontal momentum drops by min(μ, 1) m_b.
+    let m_b = 0.2 * 0.1 * 0.1 * 7850.0 / 4.0;
+    for mu in [0.0f64, 0.3, 0.7, 2.0] {
+        let text = thrown_text(0.0, 0.5, 1e-6, 3e-4, 0.5e-6)
+            .replace("friction = 0", &format!("mu = {mu:e}"));
+        let m = load(&text, false).unwrap();
+        let mut cd = CentralDifference::new(&m).unwrap();
+        let mass = cd.lumped_mass().to_vec();
+        let mut s = cd.initial_state().unwrap();
+        let px0 = momentum(&m, &s, &mass, 0).0;
+        cd.step_accepted(&mut s).unwrap();
+        let px1 = momentum(&m, &s, &mass, 0).0;
+        let rec = s.contact.pairs[0];
+        eprintln!(
+            "μ = {mu}: momentum {px0:.6} → {px1:.6}; forces normal {:.6e} tangential {:.6e} N",
+            rec.force, rec.tangential_force
+        );
+        let expect = px0 - mu.min(1.0) * m_b;
+        assert!(
+            (px1 - expect).abs() <= 1e-8 * px0,
+            "μ = {mu}: {px1} against {expect}"
+        );
+        assert!(rec.tangential_force.abs() <= mu * rec.force * (1.0 + 1e-8));
+        for _ in 1..m.analysis.n_steps() {
+            cd.step_accepted(&mut s).unwrap();
+            let rec = s.contact.pairs[0];
+            assert!(rec.tangential_force.abs() <= mu * rec.force * (1.0 + 1e-8) + 1e-9);
+            assert!(s.ledger.residual().abs() <= 1e-11 * s.ledger.scale());
+        }
+    }
 }
 
 #[test]

@@ -102,7 +102,7 @@ fn a_block_on_an_incline_slides_with_the_closed_form_acceleration() {
         "a = {a}, expected {expect}"
     );
     let rec = s.contact.pairs[0];
-    assert!(rec.slip > 0 && rec.stick == 0, "{rec:?}");
+    assert!(rec.slipping > 0 && rec.sticking == 0, "{rec:?}");
     // The friction line: the friction force times the slip, step by step (to the
     // block's elastic shear, round-off against the slip), and in closed form
     // μ m g cos θ u (the weight's normal part carried at every step).
@@ -137,7 +137,7 @@ fn a_block_on_an_incline_sticks_below_the_friction_angle() {
     assert!(u.abs() < 1e-4 * free_slide, "u = {u:e}");
     assert!(v.abs() < 1e-3 * G * theta.sin() * s.t, "v = {v:e}");
     let rec = s.contact.pairs[0];
-    assert!(rec.stick > 0 && rec.slip == 0, "{rec:?}");
+    assert!(rec.sticking > 0 && rec.slipping == 0, "{rec:?}");
     // Holding it takes the weight's tangential part.
     let mass = 7850.0 * 0.1 * 0.1 * 0.1;
     let hold = mass * G * theta.sin();
@@ -220,7 +220,7 @@ fn an_oblique_impact_keeps_friction_in_the_cone_and_conserves_momentum() {
             let rec = s.contact.pairs[0];
             normal += rec.force;
             tangential += rec.tangential_force;
-            slipped += rec.slip;
+            slipped += rec.slipping;
             assert!(
                 rec.tangential_force.abs() <= mu * rec.force * (1.0 + 1e-6) + 1e-9,
                 "{formulation}: {rec:?}"

@@ -68,9 +68,11 @@ pub struct PairRecord {
     /// tangent (N).
     pub tangential_force: f64,
     /// Pressed nodes of a frictional pair that stick (`|λ_T| < μ λ_N`).
-    pub stick: usize,
+    pub sticking: usize,
     /// Pressed nodes of a frictional pair that slip (on the cone).
-    pub slip: usize,
+    pub slipping: usize,
+    /// The longest slip path of a pressed node of the pair so far (m).
+    pub max_slip: f64,
 }
 
 /// The contact state a step leaves: kept in `time::State`, so a cut-back restores
@@ -328,13 +330,14 @@ impl<'m> ContactCorrection<'m> {
                         out.traction[c.slave] += lt / area;
                     }
                     if lt.abs() < (1.0 - STICK_MARGIN) * mu * l {
-                        rec.stick += 1;
+                        rec.sticking += 1;
                     } else {
-                        rec.slip += 1;
+                        rec.slipping += 1;
                     }
                     let t = c.tangent();
                     let d = c.combine(|n| [du[2 * n], du[2 * n + 1]]);
                     out.slip[c.slave] += (d[0] * t[0] + d[1] * t[1]).abs();
+                    rec.max_slip = rec.max_slip.max(out.slip[c.slave]);
                 }
             }
         }

@@ -43,10 +43,11 @@ struct Row {
     t_c: f64,
     /// Dofs and coefficients of the normal row (slave `+n`, segment `−(1−ξ)n, −ξn`).
     normal: ([(usize, f64); 6], usize),
-    /// The same with the tangent `(−n_y, n_x)`.
+    /// The same with the tangent `(n_y, −n_x)` (the implicit path's, [`Candidate::tangent`]).
     tangent: ([(usize, f64); 6], usize),
-    /// Friction interpolation and position weight of the pair.
+    /// Friction interpolation, Coulomb coefficient and position weight of the pair.
     beta: f64,
+    mu: f64,
     weight: f64,
 }
 
@@ -124,6 +125,8 @@ pub struct KinematicContact<'m> {
     v_pre: Vec<f64>,
     cands: Vec<Candidate>,
     impulses: Vec<(Key, f64)>,
+    /// The step's tangential impulses summed per pair (N s).
+    tangential: Vec<f64>,
     dual: DualQp,
     step: KinematicStats,
     total: KinematicStats,
@@ -147,6 +150,7 @@ impl<'m> KinematicContact<'m> {
             v_pre: Vec::new(),
             cands: Vec::new(),
             impulses: Vec::new(),
+            tangential: vec![0.0; model.contacts.len()],
             dual: DualQp::default(),
             step: KinematicStats::default(),
             total: KinematicStats::default(),
@@ -173,6 +177,7 @@ impl<'m> KinematicContact<'m> {
     ) -> Result<()> {
         self.step = KinematicStats::default();
         self.impulses.clear();
+        self.tangential.fill(0.0);
         // Slaves that came around the end of a rigid line pass beside it.
         let coords = &self.model.mesh.coords;
         self.rigid.beneath = super::detect::beneath_rigid(
@@ -252,8 +257,9 @@ impl<'m> KinematicContact<'m> {
                                     key: (pi, si, s, k),
                                     t_c,
                                     normal: row_of(s, Some(([a, b], xi)), n),
-                                    tangent: row_of(s, Some(([a, b], xi)), [-n[1], n[0]]),
+                                    tangent: row_of(s, Some(([a, b], xi)), [n[1], -n[0]]),
                                     beta: pair.friction,
+                                    mu: pair.mu,
                                     weight: pair.position_weight,
                                 });
                             }
@@ -289,8 +295,9 @@ impl<'m> KinematicContact<'m> {
                                     key: (pi, si, s, usize::MAX),
                                     t_c: c.t,
                                     normal: row_of(s, None, *n),
-                                    tangent: row_of(s, None, [-n[1], n[0]]),
+                                    tangent: row_of(s, None, [n[1], -n[0]]),
                                     beta: pair.friction,
+                                    mu: pair.mu,
                                     weight: pair.position_weight,
                                 });
                             }
@@ -323,6 +330,9 @@ impl<'m> KinematicContact<'m> {
                     self.w[j + i * m] = if i == j { 1.0 } else { 0.0 };
                 }
             }
+        }
+        if self.rows.iter().any(|r| r.mu > 0.0) {
+            return self.coulomb_impacts(v, m_inv, &movable);
         }
         // The frictionless impact: min ½pᵀWp + pᵀc, p ≥ 0.
         self.active.clear();
@@ -391,6 +401,71 @@ impl<'m> KinematicContact<'m> {
                 }
             }
         }
+        self.apply(v, m_inv, &movable, normal, &tangential);
+        Ok(())
+    }
+
+    /// The perfectly inelastic impact with Coulomb friction: the normal relative
+    /// velocities nonnegative after it (zero where pressed), the tangential ones zero
+    /// where the impulse stays inside the cone `|p_T| ≤ μ p_N` and opposite to it on
+    /// the cone: the velocity form of the implicit path's cone programs
+    /// ([`super::coulomb`]), on `W = G M⁻¹ Gᵀ` with the tangential rows of the pairs
+    /// that have friction.
+    fn coulomb_impacts(&mut self, v: &mut [f64], m_inv: &[f64], movable: &[bool]) -> Result<()> {
+        let m = self.rows.len();
+        let frictional: Vec<usize> = (0..m)
+            .filter(|&i| movable[i] && self.rows[i].mu > 0.0)
+            .collect();
+        let rows: Vec<&([(usize, f64); 6], usize)> = self
+            .rows
+            .iter()
+            .map(|r| &r.normal)
+            .chain(frictional.iter().map(|&i| &self.rows[i].tangent))
+            .collect();
+        let k = rows.len();
+        let mut w = vec![0.0; k * k];
+        let mut c = vec![0.0; k];
+        for (a, ra) in rows.iter().enumerate() {
+            c[a] = dot_row(ra, v);
+            for (b, rb) in rows.iter().enumerate() {
+                w[a + b * k] = coupling(ra, rb, m_inv);
+            }
+        }
+        // Rows whose nodes are all constrained: no impulse (as the frictionless one).
+        for i in (0..m).filter(|&i| !movable[i]) {
+            c[i] = c[i].max(0.0);
+            for j in 0..k {
+                w[i + j * k] = if i == j { 1.0 } else { 0.0 };
+                w[j + i * k] = if i == j { 1.0 } else { 0.0 };
+            }
+        }
+        let cones: Vec<(usize, f64)> = frictional.iter().map(|&i| (i, self.rows[i].mu)).collect();
+        let mut q = Vec::new();
+        self.step.clarabel += 1;
+        super::coulomb::solve(&w, &c, m, &cones, &mut q).map_err(|e| {
+            Error::Stepping(format!(
+                "the impact impulses of the kinematic contact with friction: {e}"
+            ))
+        })?;
+        let normal = q[..m].to_vec();
+        let mut tangential = vec![0.0; m];
+        for (a, &i) in frictional.iter().enumerate() {
+            tangential[i] = q[m + a];
+        }
+        self.apply(v, m_inv, movable, normal, &tangential);
+        Ok(())
+    }
+
+    /// Applies the normal and tangential impulses of the rows to `v` and keeps the
+    /// normal ones (for the positions and the record).
+    fn apply(
+        &mut self,
+        v: &mut [f64],
+        m_inv: &[f64],
+        movable: &[bool],
+        normal: Vec<f64>,
+        tangential: &[f64],
+    ) {
         for (i, r) in self.rows.iter().enumerate() {
             if !movable[i] {
                 continue;
@@ -406,9 +481,9 @@ impl<'m> KinematicContact<'m> {
                 self.step.impacts += 1;
                 self.impulses.push((r.key, normal[i]));
             }
+            self.tangential[r.key.0] += tangential[i];
         }
         self.p = normal;
-        Ok(())
     }
 
     /// The paper's position update over the step for the nodes of the impacts.
@@ -515,6 +590,9 @@ impl<'m> KinematicContact<'m> {
             rec.penetration = rec.penetration.max(-c.gap);
             let g = &mut out.gap[c.slave];
             *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
+        }
+        for (rec, t) in out.pairs.iter_mut().zip(&self.tangential) {
+            rec.tangential_force = t / h;
         }
         out.active.clear();
         self.impulses.sort_unstable_by_key(|(k, _)| *k);

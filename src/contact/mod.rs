@@ -16,7 +16,7 @@
 
 pub mod collision;
 mod compliance;
-mod coulomb;
+pub(crate) mod coulomb;
 pub mod detect;
 pub mod implicit;
 pub mod kinematic;

@@ -83,7 +83,7 @@ impl History {
         for p in pairs {
             line.push_str(&format!(
                 ",{:.12e},{},{:.12e},{},{}",
-                p.force, p.active, p.tangential_force, p.stick, p.slip
+                p.force, p.active, p.tangential_force, p.sticking, p.slipping
             ));
         }
         writeln!(self.out, "{line}").map_err(|e| Error::io(&self.path, e))?;

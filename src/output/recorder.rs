@@ -140,10 +140,17 @@ impl Recorder {
                     if model.contacts.is_empty() || s.contact.gap.len() != model.mesh.n_nodes() {
                         Vec::new()
                     } else {
-                        vec![
+                        let mut f = vec![
                             ("contact_gap", &s.contact.gap[..]),
                             ("contact_pressure", &s.contact.pressure[..]),
-                        ]
+                        ];
+                        if model.contacts.iter().any(|p| p.mu > 0.0)
+                            && s.contact.traction.len() == model.mesh.n_nodes()
+                        {
+                            f.push(("contact_traction", &s.contact.traction[..]));
+                            f.push(("contact_slip", &s.contact.slip[..]));
+                        }
+                        f
                     };
                 vtk.write(
                     s.step,

@@ -138,11 +138,11 @@ pub(super) fn contacts(
             ));
         }
         let explicit = scheme == crate::model::TimeScheme::CentralDifference;
-        if explicit && mu > 0.0 {
+        if mu > 0.0 && friction.is_some_and(|b| b != 0.0) {
             return Err(Error::config(
                 format!("{field}.mu"),
-                "Coulomb friction is enforced by the implicit schemes; the explicit kinematic \
-                 contact takes the paper's friction interpolation `friction` (beta)",
+                "give Coulomb's `mu` or the paper's friction interpolation `friction` (beta), \
+                 not both",
             ));
         }
         let friction = friction.unwrap_or(0.0);
