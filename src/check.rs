@@ -62,6 +62,8 @@ pub struct Report {
     /// The nonlocal table, when a material is nonlocal: points, neighbour counts
     /// (fewest, most, mean) and bytes.
     pub nonlocal: Option<(usize, usize, usize, f64, u64)>,
+    /// One line per contact pair: name, master, formulation, friction.
+    pub contacts: Vec<String>,
 }
 
 /// The lines `check` and `material` print for a material: model, elastic constants,
@@ -199,6 +201,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         available: memory_limit.or_else(crate::memory::available),
         warnings,
         materials: model.materials.iter().map(material_lines).collect(),
+        contacts: model.contacts.iter().map(contact_line).collect(),
         nonlocal: crate::assembly::nonlocal::NonlocalTable::build(mesh, &model.materials).map(
             |t| {
                 let (lo, hi) = t.neighbour_range();
@@ -207,6 +210,35 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
             },
         ),
     })
+}
+
+/// How a contact pair is enforced, for `check`: its master, the formulation of its
+/// gaps and its friction.
+fn contact_line(p: &crate::model::ContactPair) -> String {
+    use crate::model::{Formulation, Master};
+    let rigid = p
+        .sides
+        .iter()
+        .any(|s| matches!(s.master, Master::Rigid { .. }));
+    let master = if rigid {
+        "a rigid line"
+    } else if p.sides.len() == 2 {
+        "segments, both ways"
+    } else {
+        "segments"
+    };
+    let formulation = match p.formulation {
+        Formulation::Mortar => "mortar (one weighted gap per slave node)",
+        Formulation::NodeToSegment => "node to segment",
+    };
+    let friction = if p.mu > 0.0 {
+        format!("Coulomb mu = {}", p.mu)
+    } else if p.friction > 0.0 {
+        format!("interpolated beta = {} (explicit)", p.friction)
+    } else {
+        "frictionless".to_string()
+    };
+    format!("{}: against {master}, {formulation}, {friction}", p.name)
 }
 
 impl fmt::Display for Report {
@@ -230,6 +262,12 @@ impl fmt::Display for Report {
                 "nonlocal    {points} points, {lo} to {hi} neighbours each (mean {mean:.1}), table {}",
                 human(bytes)
             )?;
+        }
+        if !self.contacts.is_empty() {
+            writeln!(f, "contact     {}", self.contacts.len())?;
+            for l in &self.contacts {
+                writeln!(f, "  {l}")?;
+            }
         }
         writeln!(f, "nodes       {}", self.nodes)?;
         writeln!(f, "elements    {}", self.elements)?;

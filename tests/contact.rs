@@ -425,6 +425,84 @@ fn contact_pairs_are_validated() {
 }
 
 #[test]
+fn friction_and_formulation_keys_are_validated() {
+    let base = drop_on("model = \"elastic\"");
+    let pair = "master = \"base.top\"";
+    let explicit = |t: &str| {
+        t.replace(
+            "vtk_every = 0",
+            "vtk_every = 0\nscheme = \"central_difference\"",
+        )
+    };
+    let cases: Vec<(String, &str, &str)> = vec![
+        (
+            base.replace(pair, &format!("{pair}\nmu = -0.1")),
+            "contact[0].mu",
+            "friction coefficient",
+        ),
+        (
+            base.replace(pair, &format!("{pair}\nformulation = \"mortar\""))
+                .replace("slave = \"block.bottom\"", "slave = \"block.bottom_left\""),
+            "contact[0].formulation",
+            "mortar needs the slave",
+        ),
+        (
+            base.replace(pair, &format!("{pair}\nboth_ways = true")),
+            "contact[0].both_ways",
+            "one pass",
+        ),
+        (
+            base.replace(
+                pair,
+                "rigid_line = [[0.0, 0.0], [1.2, 0.0]]\nformulation = \"mortar\"",
+            ),
+            "contact[0].formulation",
+            "a rigid line is straight",
+        ),
+        (
+            explicit(&base.replace(pair, &format!("{pair}\nmu = 0.3\nfriction = 0.5"))),
+            "contact[0].mu",
+            "not both",
+        ),
+        (
+            explicit(&base.replace(pair, &format!("{pair}\nformulation = \"mortar\""))),
+            "contact[0].formulation",
+            "node to segment",
+        ),
+        (
+            base.replace(pair, &format!("{pair}\nmu = 0.3"))
+                .replace("vtk_every = 0", "vtk_every = 0\ncontact_qp = \"full\""),
+            "analysis.contact_qp",
+            "frictionless reference",
+        ),
+        (
+            base.replace("divisions = [12, 6]", "divisions = [80, 6]"),
+            "contact[0].formulation",
+            "too fine for mortar",
+        ),
+    ];
+    for (text, field, words) in cases {
+        let e = rothe::config::from_str(&text, Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field) && e.contains(words), "{e}");
+    }
+    // Node to segment takes any mesh ratio; rigid lines and the explicit path take μ.
+    for text in [
+        base.replace("divisions = [12, 6]", "divisions = [80, 6]")
+            .replace(pair, &format!("{pair}\nformulation = \"node_to_segment\"")),
+        base.replace(pair, "rigid_line = [[0.0, 0.0], [1.2, 0.0]]\nmu = 0.5"),
+        explicit(&base.replace(pair, &format!("{pair}\nmu = 0.3"))),
+    ] {
+        let m = model(&text);
+        assert_eq!(m.contacts.len(), 1);
+    }
+    let m = model(&base);
+    assert_eq!(m.contacts[0].formulation, rothe::model::Formulation::Mortar);
+    assert_eq!(m.contacts[0].mu, 0.0);
+}
+
+#[test]
 fn an_infeasible_contact_qp_cuts_the_step_then_stops_naming_the_pair_and_status() {
     // A block whose bottom nodes are driven down (prescribed y) into a V of two rigid
     // lines: once the bottom passes below the apex (step 7, t = 6e-5 s), no sideways

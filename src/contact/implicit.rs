@@ -67,6 +67,9 @@ pub struct PairRecord {
     /// Total tangential (friction) force `Σ λ_T` on the slaves, along each row's
     /// tangent (N).
     pub tangential_force: f64,
+    /// Total magnitude of the tangential forces `Σ |λ_T|` (N): the net force above
+    /// cancels where a symmetric body slides outwards on both sides.
+    pub tangential_magnitude: f64,
     /// Pressed nodes of a frictional pair that stick (`|λ_T| < μ λ_N`).
     pub sticking: usize,
     /// Pressed nodes of a frictional pair that slip (on the cone).
@@ -326,6 +329,7 @@ impl<'m> ContactCorrection<'m> {
                 if mu > 0.0 && l > threshold {
                     let lt = self.lambda_t.get(&c.key()).copied().unwrap_or(0.0);
                     rec.tangential_force += lt;
+                    rec.tangential_magnitude += lt.abs();
                     if area > 0.0 {
                         out.traction[c.slave] += lt / area;
                     }

@@ -127,6 +127,7 @@ pub struct KinematicContact<'m> {
     impulses: Vec<(Key, f64)>,
     /// The step's tangential impulses summed per pair (N s).
     tangential: Vec<f64>,
+    magnitude: Vec<f64>,
     dual: DualQp,
     step: KinematicStats,
     total: KinematicStats,
@@ -151,6 +152,7 @@ impl<'m> KinematicContact<'m> {
             cands: Vec::new(),
             impulses: Vec::new(),
             tangential: vec![0.0; model.contacts.len()],
+            magnitude: vec![0.0; model.contacts.len()],
             dual: DualQp::default(),
             step: KinematicStats::default(),
             total: KinematicStats::default(),
@@ -178,6 +180,7 @@ impl<'m> KinematicContact<'m> {
         self.step = KinematicStats::default();
         self.impulses.clear();
         self.tangential.fill(0.0);
+        self.magnitude.fill(0.0);
         // Slaves that came around the end of a rigid line pass beside it.
         let coords = &self.model.mesh.coords;
         self.rigid.beneath = super::detect::beneath_rigid(
@@ -482,6 +485,7 @@ impl<'m> KinematicContact<'m> {
                 self.impulses.push((r.key, normal[i]));
             }
             self.tangential[r.key.0] += tangential[i];
+            self.magnitude[r.key.0] += tangential[i].abs();
         }
         self.p = normal;
     }
@@ -591,8 +595,9 @@ impl<'m> KinematicContact<'m> {
             let g = &mut out.gap[c.slave];
             *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
         }
-        for (rec, t) in out.pairs.iter_mut().zip(&self.tangential) {
+        for ((rec, t), a) in out.pairs.iter_mut().zip(&self.tangential).zip(&self.magnitude) {
             rec.tangential_force = t / h;
+            rec.tangential_magnitude = a / h;
         }
         out.active.clear();
         self.impulses.sort_unstable_by_key(|(k, _)| *k);

@@ -58,7 +58,7 @@ pub struct ContactSummary {
     pub max_active: usize,
     /// Impulse `∫ F dt` (N s), the force of each step times its length.
     pub impulse: f64,
-    /// Largest total friction force `|Σ λ_T|` (N).
+    /// Largest total magnitude of the friction forces `Σ |λ_T|` (N).
     pub max_tangential_force: f64,
     /// Tangential impulse `∫ Σ λ_T dt` (N s), along the rows' tangents.
     pub tangential_impulse: f64,
@@ -82,7 +82,7 @@ impl ContactSummary {
         };
         self.max_active = self.max_active.max(p.active);
         self.impulse += p.force * dt;
-        self.max_tangential_force = self.max_tangential_force.max(p.tangential_force.abs());
+        self.max_tangential_force = self.max_tangential_force.max(p.tangential_magnitude);
         self.tangential_impulse += p.tangential_force * dt;
         self.slip = self.slip.max(p.max_slip);
     }
