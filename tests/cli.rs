@@ -223,6 +223,17 @@ fn gmsh_physical_groups_become_sets() {
     let x = |n: usize| part.coords[part.blocks[0].conn[n]];
     let (a, b, c) = (x(3), x(4), x(5));
     assert!((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]) > 0.0);
+    // A curve listed against its body's sense is turned: every edge has its element
+    // on the left (contact takes the outward normal from the direction).
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/square.msh"),
+    )
+    .unwrap()
+    .replace("2 3 4\n", "2 4 3\n")
+    .replace("1 1 2\n", "1 2 1\n");
+    let turned = rothe::mesh::gmsh::parse(text.as_bytes()).unwrap();
+    assert_eq!(turned.edge_sets["top"], vec![[2, 3]]);
+    assert_eq!(turned.edge_sets["bottom"], vec![[0, 1]]);
 }
 
 #[test]

@@ -153,6 +153,7 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
             "the file has no 2D elements (3-node triangles or 4-node quadrilaterals)".into(),
         );
     }
+    orient_edges(&blocks, &mut edge_sets);
     Ok(Part {
         coords,
         blocks,
@@ -160,6 +161,30 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
         edge_sets,
         node_tags: Some(node_tags),
     })
+}
+
+/// Orients every edge of the edge sets with its element on the left (the element's
+/// counter-clockwise order), as the rectangle meshes give them: contact takes a
+/// segment's outward normal from its direction. Gmsh lists a curve's lines in the
+/// curve's own direction, which is the other one for half of a body's boundary. An
+/// edge of no element (an interior line of the file) keeps the file's direction.
+fn orient_edges(blocks: &[Elements], edge_sets: &mut BTreeMap<String, Vec<[usize; 2]>>) {
+    let mut directed = std::collections::HashSet::new();
+    for b in blocks {
+        let n = b.kind.nodes();
+        for e in b.conn.chunks(n) {
+            for k in 0..n {
+                directed.insert((e[k], e[(k + 1) % n]));
+            }
+        }
+    }
+    for edges in edge_sets.values_mut() {
+        for e in edges.iter_mut() {
+            if !directed.contains(&(e[0], e[1])) && directed.contains(&(e[1], e[0])) {
+                e.swap(0, 1);
+            }
+        }
+    }
 }
 
 /// The nodes in the order the file lists them: coordinates, tags and the map from a
