@@ -476,7 +476,7 @@ fn friction_and_formulation_keys_are_validated() {
             "frictionless reference",
         ),
         (
-            base.replace("divisions = [12, 6]", "divisions = [80, 6]"),
+            base.replace("divisions = [12, 6]", "divisions = [240, 6]"),
             "contact[0].formulation",
             "too fine for mortar",
         ),
@@ -489,7 +489,7 @@ fn friction_and_formulation_keys_are_validated() {
     }
     // Node to segment takes any mesh ratio; rigid lines and the explicit path take μ.
     for text in [
-        base.replace("divisions = [12, 6]", "divisions = [80, 6]")
+        base.replace("divisions = [12, 6]", "divisions = [240, 6]")
             .replace(pair, &format!("{pair}\nformulation = \"node_to_segment\"")),
         base.replace(pair, "rigid_line = [[0.0, 0.0], [1.2, 0.0]]\nmu = 0.5"),
         explicit(&base.replace(pair, &format!("{pair}\nmu = 0.3"))),

@@ -44,9 +44,10 @@ pub enum Contactee {
 }
 
 /// The most nodes one gap row spans: a mortar row holds the slave node, its two
-/// neighbours and the master nodes facing its two segments (validation keeps the
-/// mesh ratio of a mortar pair within this).
-pub const ROW_NODES: usize = 16;
+/// neighbours and the master nodes facing its two segments (validation refuses a
+/// mortar pair whose rows need more at the initial geometry: a master locally more
+/// than about 14 times finer than the slave).
+pub const ROW_NODES: usize = 32;
 
 /// The nodes of a gap row and their weights: the gap is
 /// `n · Σ w_k x_k` (slave weights summing to 1, master weights to −1).
@@ -568,6 +569,9 @@ where
         for (si, side) in pair.sides.iter().enumerate() {
             match &side.master {
                 Master::Segments(segments) if !side.mortar.is_empty() => {
+                    // Rows are sized for the initial geometry (validation); a mesh
+                    // sliding far enough to bring more master nodes under one slave
+                    // node keeps the first `ROW_NODES`.
                     super::mortar::rows(
                         (pi, si),
                         &side.slaves,

@@ -595,7 +595,12 @@ impl<'m> KinematicContact<'m> {
             let g = &mut out.gap[c.slave];
             *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
         }
-        for ((rec, t), a) in out.pairs.iter_mut().zip(&self.tangential).zip(&self.magnitude) {
+        for ((rec, t), a) in out
+            .pairs
+            .iter_mut()
+            .zip(&self.tangential)
+            .zip(&self.magnitude)
+        {
             rec.tangential_force = t / h;
             rec.tangential_magnitude = a / h;
         }

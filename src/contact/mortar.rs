@@ -56,16 +56,18 @@ struct Gathered {
     total: f64,
     /// Sum of the outward normals of the node's segments.
     normal: [f64; 2],
-    /// A row overflowed [`super::detect::ROW_NODES`].
-    overflow: bool,
+    /// Entries that did not fit the row ([`super::detect::ROW_NODES`]).
+    overflow: usize,
 }
 
 /// The mortar rows of one side (`key`: pair and side) against the master
 /// `segments` at the geometry `x`, appended to `out` in slave order. `slaves` are the
 /// side's slave nodes (sorted), `slave_segments` its slave surface; master segments
-/// farther than `radius` from a slave segment are not looked at.
+/// farther than `radius` from a slave segment are not looked at. Returns the most
+/// nodes a row needed (more than [`super::detect::ROW_NODES`] means rows were cut:
+/// validation refuses such a pair at the initial geometry).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn rows<X: Fn(usize) -> [f64; 2]>(
+pub fn rows<X: Fn(usize) -> [f64; 2]>(
     key: (usize, usize),
     slaves: &[usize],
     slave_segments: &[[usize; 2]],
@@ -73,14 +75,14 @@ pub(super) fn rows<X: Fn(usize) -> [f64; 2]>(
     radius: f64,
     x: &X,
     out: &mut Vec<Candidate>,
-) {
+) -> usize {
     let mut gathered = vec![
         Gathered {
             weights: Weights::EMPTY,
             covered: 0.0,
             total: 0.0,
             normal: [0.0, 0.0],
-            overflow: false,
+            overflow: 0,
         };
         slaves.len()
     ];
@@ -155,24 +157,26 @@ pub(super) fn rows<X: Fn(usize) -> [f64; 2]>(
                     let gj = &mut gathered[j];
                     let wj = w * ns[jj];
                     gj.covered += wj;
-                    let mut ok = true;
                     for (k, &node) in [s1, s2].iter().enumerate() {
-                        ok &= gj.weights.add(node, wj * ns[k]);
+                        gj.overflow += usize::from(!gj.weights.add(node, wj * ns[k]));
                     }
                     for (l, &node) in [m1, m2].iter().enumerate() {
-                        ok &= gj.weights.add(node, -wj * nm[l]);
+                        gj.overflow += usize::from(!gj.weights.add(node, -wj * nm[l]));
                     }
-                    gj.overflow |= !ok;
                 }
             }
         }
     }
     let (pair, side) = key;
+    let needed = gathered
+        .iter()
+        .map(|g| g.weights.len() + g.overflow)
+        .max()
+        .unwrap_or(0);
     for (j, gj) in gathered.iter_mut().enumerate() {
         if gj.covered <= COVERED_FRACTION * gj.total || gj.total == 0.0 {
             continue;
         }
-        debug_assert!(!gj.overflow, "a mortar row spans more than ROW_NODES nodes");
         let l = gj.normal[0].hypot(gj.normal[1]);
         if l == 0.0 {
             continue;
@@ -186,6 +190,7 @@ pub(super) fn rows<X: Fn(usize) -> [f64; 2]>(
         c.gap = p[0] * n[0] + p[1] * n[1];
         out.push(c);
     }
+    needed
 }
 
 #[cfg(test)]

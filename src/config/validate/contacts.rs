@@ -72,28 +72,35 @@ fn master_edges(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<[usize; 2]>>
     }
 }
 
-/// Refuses a mortar pair whose rows could span more than
-/// [`crate::contact::detect::ROW_NODES`] nodes: a slave node's two segments facing
-/// more master segments than a row holds (the master much finer than the slave).
+/// Refuses a mortar pair whose rows need more than
+/// [`crate::contact::detect::ROW_NODES`] nodes at the initial geometry: a slave node's
+/// two segments facing more master segments than a row holds (the master locally
+/// much finer than the slave).
 fn mortar_reach(
     mesh: &Mesh,
     field: &str,
+    slaves: &[usize],
     slave_segments: &[[usize; 2]],
     master: &[[usize; 2]],
+    radius: f64,
 ) -> Result<()> {
-    let len = |e: &[usize; 2]| dist(mesh.coords[e[0]], mesh.coords[e[1]]);
-    let longest_slave = slave_segments.iter().map(len).fold(0.0, f64::max);
-    let shortest_master = master.iter().map(len).fold(f64::INFINITY, f64::min);
-    // Three slave nodes, and the master nodes under two slave segments (one more
-    // than the segments they hold, one more for a segment only partly under).
-    let needed = 3.0 + (2.0 * longest_slave / shortest_master).ceil() + 2.0;
-    if needed > crate::contact::detect::ROW_NODES as f64 {
+    let mut rows = Vec::new();
+    let needed = crate::contact::mortar::rows(
+        (0, 0),
+        slaves,
+        slave_segments,
+        master,
+        radius,
+        &|n| mesh.coords[n],
+        &mut rows,
+    );
+    if needed > crate::contact::detect::ROW_NODES {
         return Err(Error::config(
             field,
             format!(
-                "the master is too fine for mortar against this slave (slave segments up to \
-                 {longest_slave:.3e} m, master segments down to {shortest_master:.3e} m: a row \
-                 would hold {needed} nodes, at most {} fit); refine the slave side or give \
+                "the master is too fine for mortar against this slave: a slave node's \
+                 weighted gap would hold {needed} nodes, at most {} fit; refine the slave \
+                 side where it faces the finer master, or give \
                  `formulation = \"node_to_segment\"`",
                 crate::contact::detect::ROW_NODES
             ),
@@ -250,12 +257,8 @@ pub(super) fn contacts(
                              give `formulation = \"node_to_segment\"` for two passes",
                         ));
                     }
-                    mortar_reach(
-                        mesh,
-                        &format!("{field}.formulation"),
-                        slave_segments,
-                        &edges,
-                    )?;
+                    let field = format!("{field}.formulation");
+                    mortar_reach(mesh, &field, &slaves, slave_segments, &edges, radius)?;
                 }
                 sides.push(ContactSide {
                     slaves: slaves.clone(),
