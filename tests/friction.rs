@@ -258,3 +258,68 @@ fn an_oblique_impact_keeps_friction_in_the_cone_and_conserves_momentum() {
         );
     }
 }
+
+/// A block pressed onto a rigid floor by a pressure on its top and pushed sideways
+/// by a shear traction on its left side, in statics, with no support at all: the
+/// contact alone holds it (the static matrix is seated, theory/contact.md).
+fn pressed(mu: f64, shear: f64) -> String {
+    format!(
+        r#"
+[analysis]
+kind = "static"
+t_end = 1.0
+dt = 1.0
+vtk_every = 0
+
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+
+[[bodies]]
+name = "block"
+material = "steel"
+thickness = 0.1
+mesh = {{ kind = "rectangle", size = [0.1, 0.1], divisions = [4, 4] }}
+
+[[loads]]
+kind = "traction"
+set = "block.top"
+value = [0.0, -1.0e6]
+
+[[loads]]
+kind = "traction"
+set = "block.left"
+value = [{shear:e}, 0.0]
+
+[[contact]]
+name = "floor"
+slave = "block.bottom"
+rigid_line = [[-1.0, 0.0], [1.0, 0.0]]
+mu = {mu:e}
+"#
+    )
+}
+
+#[test]
+fn a_block_pressed_onto_a_floor_in_statics_is_held_by_contact_and_friction() {
+    // Normal force 1e6 Pa x 0.1 m x 0.1 m = 1e4 N; the shear 2e5 Pa on the left
+    // side pushes 2e3 N sideways, within μ N = 5e3 N: the block sticks.
+    let m = model(&pressed(0.5, 2.0e5));
+    let mut st = rothe::time::statics::Statics::new(&m, Backend::Faer).unwrap();
+    let mut s = st.initial_state();
+    st.step_accepted(&mut s).unwrap();
+    let rec = s.contact.pairs[0];
+    eprintln!("pressed: {rec:?}");
+    assert!((rec.force - 1.0e4).abs() < 1e-6 * 1.0e4, "{rec:?}");
+    assert!(
+        (rec.tangential_force + 2.0e3).abs() < 1e-6 * 2.0e3,
+        "{rec:?}"
+    );
+    assert!(rec.sticking > 0 && rec.slipping == 0, "{rec:?}");
+    assert!(rec.penetration <= m.analysis.contact_tolerance);
+    // The block rests: its mean sideways displacement is elastic (micrometres).
+    let (_, u) = mean_x(&m, &s);
+    assert!(u.abs() < 1e-6, "u = {u:e}");
+}
