@@ -1,9 +1,11 @@
 //! Criterion bench of implicit contact on benchmark 1's two blocks (NOTES.md; both
 //! elastic, `h = 1e-7` s, the paper's step) at the mesh sizes 0.05 m and 0.0125 m:
-//! one backward-Euler step in persistent contact with the condensed QP, with the
-//! full QP, and the same step of the same state without contact. The steel block
-//! starts a micrometre above the concrete and is marched into contact (1000 steps)
-//! before the timed steps, each of which starts from that state.
+//! one backward-Euler step in persistent contact, node to segment and mortar with
+//! the condensed QP, mortar with Coulomb friction (μ = 0.4, the steel's corners
+//! free as in the benchmark's friction variant), mortar with the full QP, and the
+//! same step of the same state without contact. The steel block starts a micrometre
+//! above the concrete and is marched into contact (1000 steps) before the timed
+//! steps, each of which starts from that state (each formulation from its own).
 //!
 //! After the benches it prints, per mesh, the split of a condensed step: the time to
 //! form `W`, the QP, detection, and the solves.
@@ -17,18 +19,29 @@ use rothe::time::{Integrator, State};
 /// Steps marched before the timed ones: 0.1 ms, well into the contact.
 const WARM_UP: usize = 1000;
 
-fn scenario(size: f64, contact: Option<&str>) -> Model {
+/// How the pair is enforced: QP, formulation and `μ` (`None`: no contact).
+type Enforced<'a> = Option<(&'a str, &'a str, f64)>;
+
+fn scenario(size: f64, contact: Enforced) -> Model {
     let (nx, ny, ns) = (
         (1.2 / size) as usize,
         (0.6 / size) as usize,
         (0.6 / size) as usize,
     );
-    let pair = if contact.is_some() {
-        "[[contact]]\nname = \"impact\"\nslave = \"steel.bottom\"\nmaster = \"concrete.top\"\n"
-    } else {
-        ""
+    let pair = match contact {
+        Some((_, formulation, mu)) => format!(
+            "[[contact]]\nname = \"impact\"\nslave = \"steel.bottom\"\nmaster = \"concrete.top\"\n\
+             formulation = \"{formulation}\"\nmu = {mu:e}\n"
+        ),
+        None => String::new(),
     };
-    let qp = contact.unwrap_or("condensed");
+    let qp = contact.map_or("condensed", |c| c.0);
+    // Friction holds the steel sideways: its corners are free then.
+    let corners = if contact.is_some_and(|c| c.2 > 0.0) {
+        ""
+    } else {
+        CORNERS
+    };
     let text = format!(
         r#"
 [analysis]
@@ -61,6 +74,15 @@ mesh = {{ kind = "rectangle", origin = [0.3, 0.600001], size = [0.6, 0.6], divis
 [[supports]]
 set = "concrete.bottom"
 fix = ["x", "y"]
+{corners}
+{pair}
+"#
+    );
+    rothe::config::from_str(&text, std::path::Path::new(".")).expect("valid scenario")
+}
+
+/// The supports holding the steel's corners horizontally.
+const CORNERS: &str = r#"
 [[supports]]
 set = "steel.bottom_left"
 fix = ["x"]
@@ -73,11 +95,7 @@ fix = ["x"]
 [[supports]]
 set = "steel.top_right"
 fix = ["x"]
-{pair}
-"#
-    );
-    rothe::config::from_str(&text, std::path::Path::new(".")).expect("valid scenario")
-}
+"#;
 
 /// The state after the warm-up, in persistent contact.
 fn in_contact(model: &Model) -> State {
@@ -99,16 +117,27 @@ fn steps(c: &mut Criterion) {
     let mut g = c.benchmark_group("contact_step");
     g.sample_size(10);
     for (size, label) in SIZES {
-        let condensed = scenario(size, Some("condensed"));
-        let state = in_contact(&condensed);
         let cases = [
-            ("without_contact", scenario(size, None)),
-            ("condensed", condensed),
-            ("full", scenario(size, Some("full"))),
+            (
+                "node_to_segment",
+                Some(("condensed", "node_to_segment", 0.0)),
+            ),
+            ("without_contact", None),
+            ("mortar_friction", Some(("condensed", "mortar", 0.4))),
+            ("mortar", Some(("condensed", "mortar", 0.0))),
+            ("mortar_full_qp", Some(("full", "mortar", 0.0))),
         ];
-        for (name, model) in &cases {
-            let mut be = BackwardEuler::new(model, Backend::Faer).unwrap();
-            g.bench_with_input(BenchmarkId::new(*name, label), &size, |b, _| {
+        let mut state = None;
+        for (name, enforced) in cases {
+            let model = scenario(size, enforced);
+            // The state without contact is node to segment's (its contact part
+            // unread), the full QP's is mortar's (its rows the same).
+            if enforced.is_some_and(|e| e.0 == "condensed") {
+                state = Some(in_contact(&model));
+            }
+            let state = state.clone().expect("node to segment first");
+            let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
+            g.bench_with_input(BenchmarkId::new(name, label), &size, |b, _| {
                 b.iter_batched(
                     || state.clone(),
                     |mut s| {
@@ -127,8 +156,15 @@ fn steps(c: &mut Criterion) {
 /// Where a condensed step's time goes, from the integrator's own counters.
 fn split() {
     eprintln!("\ncondensed step, per step (ms): W | QP | detection | solves | solves/step | QPs/step | rows/QP");
-    for (size, label) in SIZES {
-        let model = scenario(size, Some("condensed"));
+    for ((size, label), (formulation, mu)) in SIZES.iter().flat_map(|s| {
+        [
+            (*s, ("node_to_segment", 0.0)),
+            (*s, ("mortar", 0.0)),
+            (*s, ("mortar", 0.4)),
+        ]
+    }) {
+        let label = format!("{label} {formulation} mu = {mu}");
+        let model = scenario(size, Some(("condensed", formulation, mu)));
         let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
         let mut s = in_contact(&model);
         // The state's contact state is the warm-up's: march a few steps so the

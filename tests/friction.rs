@@ -50,6 +50,18 @@ mu = {mu:e}
     )
 }
 
+/// How the frictional QPs of a run were solved: by the last statuses, or by how
+/// many cone programs each.
+fn print_cone_programs(what: &str, be: &BackwardEuler) {
+    let cs = be.contact_stats().unwrap();
+    eprintln!(
+        "{what}: {} frictional QPs, {} by the last statuses, {:.2} cone programs for each other",
+        cs.frictional,
+        cs.friction_guessed,
+        cs.cone_programs as f64 / (cs.frictional - cs.friction_guessed).max(1) as f64
+    );
+}
+
 /// Mean velocity and displacement of the block along the incline (x).
 fn mean_x(m: &Model, s: &State) -> (f64, f64) {
     let n = m.mesh.n_nodes() as f64;
@@ -85,6 +97,7 @@ fn run_incline(theta: f64, mu: f64) -> (Model, State, f64) {
             l.scale()
         );
     }
+    print_cone_programs(&format!("incline μ = {mu}"), &be);
     (m, s, work)
 }
 
@@ -234,6 +247,7 @@ fn an_oblique_impact_keeps_friction_in_the_cone_and_conserves_momentum() {
                 .max((p(&s, 1) - py0).abs() / scale);
         }
         let l = &s.ledger;
+        print_cone_programs(formulation, &be);
         eprintln!(
             "{formulation}: impulses normal {:.4e} tangential {:.4e} N s, momentum drift {worst:.2e}, \
              D_friction {:.4e} J, D_contact {:.4e} J of E_kin0 {:.4e} J, residual {:.2e}",

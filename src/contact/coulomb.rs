@@ -96,6 +96,7 @@ pub(crate) fn solve(
         solver.solve();
         accept(solver.solution.status)?;
         stats.iterations += solver.solution.iterations;
+        stats.programs += 1;
         stats.solve_s += solver.solution.solve_time;
         for (l, x) in lambda.iter_mut().zip(&solver.solution.x) {
             *l = f * x;
@@ -183,4 +184,211 @@ mod tests {
         let (n, t, _) = one(0.5, 1.0e-3, 3.0e-4);
         assert_eq!((n, t), (0.0, 0.0));
     }
+
+    #[test]
+    fn a_right_guess_gives_the_cone_programs_answer_and_a_wrong_one_is_refused() {
+        // Two coupled frictional nodes: the cone programs' answer, then the same
+        // from the statuses it ended in, and a wrong guess refused.
+        let w = [
+            2.0e-9, 0.5e-9, 0.1e-9, 0.0, //
+            0.5e-9, 2.5e-9, 0.0, 0.2e-9, //
+            0.1e-9, 0.0, 3.0e-9, 0.4e-9, //
+            0.0, 0.2e-9, 0.4e-9, 2.0e-9,
+        ];
+        let c = [-2.0e-3, -1.0e-3, 3.0e-4, -1.0e-5];
+        let cones = [(0, 0.1), (1, 0.5)];
+        let mut reference = Vec::new();
+        solve(&w, &c, 2, &cones, &mut reference).unwrap();
+        let status = |k: usize| {
+            let (ln, lt, mu) = (reference[cones[k].0], reference[2 + k], cones[k].1);
+            if lt.abs() < (1.0 - 1e-6) * mu * ln {
+                Guess::Stick
+            } else {
+                Guess::Slip(lt.signum())
+            }
+        };
+        let guess = [status(0), status(1)];
+        assert!(
+            matches!(guess[0], Guess::Slip(_)) && guess[1] == Guess::Stick,
+            "{guess:?}"
+        );
+        let mut l = Vec::new();
+        assert!(solve_by_guess(
+            &w,
+            &c,
+            2,
+            &cones,
+            &[true, true],
+            &guess,
+            1e-12,
+            &mut l
+        ));
+        for (a, b) in l.iter().zip(&reference) {
+            assert!(
+                (a - b).abs() < 1e-6 * reference[0],
+                "{l:?} against {reference:?}"
+            );
+        }
+        // Guessing the slipping node sticks puts its force outside the cone.
+        assert!(!solve_by_guess(
+            &w,
+            &c,
+            2,
+            &cones,
+            &[true, true],
+            &[Guess::Stick; 2],
+            1e-12,
+            &mut l
+        ));
+    }
+}
+
+/// How a frictional node is guessed to end: inside the cone, or on it with the sign
+/// of its tangential force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Guess {
+    /// `|λ_T| < μ λ_N`, no slip.
+    Stick,
+    /// `λ_T = sign μ λ_N`, the slip opposite to it.
+    Slip(f64),
+}
+
+/// Solves Coulomb's law for the rows of [`solve`] on a guess of how it ends: the
+/// normal rows `pressed` (the others open) and each frictional node's [`Guess`]. On
+/// the guess the law is linear: pressed gaps and sticking slips vanish, a slipping
+/// node's tangential force is `sign μ λ_N`; the unknowns solve that by dense
+/// elimination. True, with the forces in `lambda`, when the result satisfies the
+/// whole law (pressed forces non-negative, open gaps non-negative to `tol`, sticking
+/// forces inside the cone, slips opposite to their forces to `tol`): then it is the
+/// law's solution and no cone program is needed. In persistent contact the last
+/// iterate's statuses hold, and a step costs one small elimination.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_by_guess(
+    w: &[f64],
+    c: &[f64],
+    n: usize,
+    cones: &[(usize, f64)],
+    pressed: &[bool],
+    guess: &[Guess],
+    tol: f64,
+    lambda: &mut Vec<f64>,
+) -> bool {
+    let m = c.len();
+    // Unknowns: λ_N of the pressed rows, then λ_T of their sticking nodes.
+    let mut var = vec![usize::MAX; m];
+    let mut rows = Vec::new();
+    for j in (0..n).filter(|&j| pressed[j]) {
+        var[j] = rows.len();
+        rows.push(j);
+    }
+    for (k, &(j, _)) in cones.iter().enumerate() {
+        if pressed[j] && guess[k] == Guess::Stick {
+            var[n + k] = rows.len();
+            rows.push(n + k);
+        }
+    }
+    let q = rows.len();
+    if q == 0 {
+        return false;
+    }
+    // dΛ/dx: a pressed row's λ_N also drives its slipping node's λ_T.
+    let mut slip_of = vec![None; n];
+    for (k, &(j, mu)) in cones.iter().enumerate() {
+        if let Guess::Slip(sign) = guess[k] {
+            slip_of[j] = Some((n + k, sign * mu));
+        }
+    }
+    let mut b = vec![0.0; q * q];
+    let mut rhs = vec![0.0; q];
+    for (e, &r) in rows.iter().enumerate() {
+        rhs[e] = -c[r];
+        for (v, &i) in rows.iter().enumerate() {
+            let mut x = w[r + i * m];
+            if let Some(Some((t, f))) = slip_of.get(i) {
+                x += f * w[r + t * m];
+            }
+            b[e + v * q] = x;
+        }
+    }
+    if !eliminate(&mut b, &mut rhs, q) {
+        return false;
+    }
+    lambda.clear();
+    lambda.resize(m, 0.0);
+    for (v, &i) in rows.iter().enumerate() {
+        lambda[i] = rhs[v];
+        if let Some(Some((t, f))) = slip_of.get(i) {
+            lambda[*t] = f * rhs[v];
+        }
+    }
+    // The whole law.
+    let scale = lambda.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let y = |r: usize, lambda: &[f64]| c[r] + (0..m).map(|i| w[r + i * m] * lambda[i]).sum::<f64>();
+    for j in 0..n {
+        if pressed[j] {
+            if lambda[j] < -1e-12 * scale {
+                return false;
+            }
+        } else if y(j, lambda) < -tol {
+            return false;
+        }
+    }
+    for (k, &(j, mu)) in cones.iter().enumerate() {
+        let (ln, lt) = (lambda[j], lambda[n + k]);
+        match guess[k] {
+            Guess::Stick if pressed[j] => {
+                if lt.abs() > mu * ln * (1.0 + 1e-12) + 1e-12 * scale {
+                    return false;
+                }
+            }
+            Guess::Slip(sign) if pressed[j] => {
+                if sign * y(n + k, lambda) > tol {
+                    return false;
+                }
+            }
+            _ => {}
+        }
+    }
+    for l in &mut lambda[..n] {
+        *l = l.max(0.0);
+    }
+    true
+}
+
+/// Solves the dense `q x q` system `b x = rhs` (column-major) by Gaussian elimination
+/// with partial pivoting, into `rhs`. False when a pivot vanishes.
+fn eliminate(b: &mut [f64], rhs: &mut [f64], q: usize) -> bool {
+    let norm = b.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    for col in 0..q {
+        let p = (col..q)
+            .max_by(|&x, &y| b[x + col * q].abs().total_cmp(&b[y + col * q].abs()))
+            .expect("a row");
+        let pivot = b[p + col * q];
+        if !(pivot.abs() > 1e-13 * norm) {
+            return false;
+        }
+        if p != col {
+            for k in 0..q {
+                b.swap(p + k * q, col + k * q);
+            }
+            rhs.swap(p, col);
+        }
+        for r in col + 1..q {
+            let f = b[r + col * q] / pivot;
+            if f != 0.0 {
+                for k in col..q {
+                    b[r + k * q] -= f * b[col + k * q];
+                }
+                rhs[r] -= f * rhs[col];
+            }
+        }
+    }
+    for col in (0..q).rev() {
+        let mut v = rhs[col];
+        for k in col + 1..q {
+            v -= b[col + k * q] * rhs[k];
+        }
+        rhs[col] = v / b[col + col * q];
+    }
+    true
 }

@@ -117,6 +117,13 @@ pub struct ContactStats {
     pub compliant: usize,
     /// QPs solved by the previous active set (its KKT conditions held).
     pub guessed: usize,
+    /// QPs with friction, those solved by the guess of the last statuses, and the
+    /// cone programs the others took (De Saxcé's fixed point).
+    pub frictional: usize,
+    /// Frictional QPs solved by the guess.
+    pub friction_guessed: usize,
+    /// Cone programs solved.
+    pub cone_programs: usize,
 }
 
 /// The constrained correction for the contact pairs of a model.
@@ -145,6 +152,10 @@ pub struct ContactCorrection<'m> {
     /// tangential row's normal row and `μ`.
     normal_rows: usize,
     cones: Vec<(usize, f64)>,
+    /// The guess of a frictional QP: the normal rows pressed at the last QP and how
+    /// each frictional node ended there.
+    pressed: Vec<bool>,
+    guess_t: Vec<super::coulomb::Guess>,
     /// Active constraints (multipliers above the threshold) of the previous QP (or of
     /// the last step) and of the last one, sorted. The active set has settled when
     /// the same slaves are held (a slave in a notch may share its force between
@@ -206,6 +217,8 @@ impl<'m> ContactCorrection<'m> {
             u0: Vec::new(),
             normal_rows: 0,
             cones: Vec::new(),
+            pressed: Vec::new(),
+            guess_t: Vec::new(),
             previous: Vec::new(),
             current: Vec::new(),
             f_c: vec![0.0; n],
@@ -313,7 +326,8 @@ impl<'m> ContactCorrection<'m> {
         out.traction.clear();
         out.traction.resize(n_nodes, 0.0);
         out.slip.resize(n_nodes, 0.0);
-        let threshold = self.active_threshold(&self.lambda.values().copied().collect::<Vec<_>>());
+        let largest = self.lambda.values().fold(0.0f64, |a, x| a.max(*x));
+        let threshold = self.active_threshold(&[largest]);
         for c in &self.cands {
             let rec = &mut out.pairs[c.pair];
             rec.penetration = rec.penetration.max(-c.gap);
@@ -578,7 +592,13 @@ impl Correction for ContactCorrection<'_> {
         // The tangential rows of the frictional pairs' rows, after the normal ones:
         // the slip since the start of the step, predicted.
         self.normal_rows = self.rows.len();
+        self.pressed.clear();
+        self.guess_t.clear();
         if self.frictional {
+            for &i in &self.rows {
+                let key = self.cands[i].key();
+                self.pressed.push(self.current.binary_search(&key).is_ok());
+            }
             for j in 0..self.normal_rows {
                 let i = self.rows[j];
                 let c = &self.cands[i];
@@ -595,6 +615,15 @@ impl Correction for ContactCorrection<'_> {
                     self.rows.push(n_cands + i);
                     self.c.push(slip);
                     self.cones.push((j, mu));
+                    let key = c.key();
+                    let ln = self.lambda.get(&key).copied().unwrap_or(0.0);
+                    let lt = self.lambda_t.get(&key).copied().unwrap_or(0.0);
+                    self.guess_t
+                        .push(if lt.abs() < (1.0 - STICK_MARGIN) * mu * ln {
+                            super::coulomb::Guess::Stick
+                        } else {
+                            super::coulomb::Guess::Slip(lt.signum())
+                        });
                 }
             }
         }
@@ -676,14 +705,36 @@ impl Correction for ContactCorrection<'_> {
                 }
                 let gap_tol =
                     GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-                let r = if !self.cones.is_empty() {
-                    super::coulomb::solve(
+                let slip_tol =
+                    GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                let r = if !self.cones.is_empty()
+                    && super::coulomb::solve_by_guess(
+                        &self.w,
+                        &self.c,
+                        self.normal_rows,
+                        &self.cones,
+                        &self.pressed,
+                        &self.guess_t,
+                        slip_tol,
+                        &mut self.lambda_rows,
+                    ) {
+                    self.stats.guessed += 1;
+                    self.stats.frictional += 1;
+                    self.stats.friction_guessed += 1;
+                    Ok(QpStats::default())
+                } else if !self.cones.is_empty() {
+                    let r = super::coulomb::solve(
                         &self.w,
                         &self.c,
                         self.normal_rows,
                         &self.cones,
                         &mut self.lambda_rows,
-                    )
+                    );
+                    if let Ok(q) = &r {
+                        self.stats.frictional += 1;
+                        self.stats.cone_programs += q.programs as usize;
+                    }
+                    r
                 } else if !self.guess.is_empty()
                     && solve_by_active_set(
                         &self.w,

@@ -65,6 +65,8 @@ pub(crate) struct QpStats {
     pub iterations: u32,
     /// Clarabel's own solve time (s).
     pub solve_s: f64,
+    /// Cone programs solved (the friction shift's fixed point; 1 otherwise).
+    pub programs: u32,
 }
 
 /// Rounds of changes to the active set [`solve_by_active_set`] tries before it gives
@@ -254,6 +256,7 @@ impl DualQp {
         Ok(QpStats {
             iterations: s.solution.iterations,
             solve_s: s.solution.solve_time,
+            programs: 1,
         })
     }
 }
@@ -346,6 +349,7 @@ pub(crate) fn primal_qp(
     Ok(QpStats {
         iterations: s.solution.iterations,
         solve_s: s.solution.solve_time,
+        programs: 1,
     })
 }
 
