@@ -40,7 +40,8 @@ fn scaled(h: &History, name: &str, factor: f64) -> Option<Vec<f64>> {
 ///   zero and the total dissipation, in J against t in ms;
 /// - `dissipation`: those dissipation lines and the total over the initial kinetic
 ///   energy (skipped when that is zero or unknown);
-/// - `contact_<pair>`: the pair's total normal force in kN against t in ms.
+/// - `contact_<pair>`: the pair's total normal force in kN against t in ms, with its
+///   net tangential (friction) force where it has one.
 ///
 /// Returns the paths of all files written. A history without a `t` column, or a
 /// `summary.json` that is not JSON, is an error.
@@ -124,9 +125,20 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>> {
     let pair_files = chart_names("contact", &h.pairs());
     for (p, file) in h.pairs().iter().zip(&pair_files) {
         let f = scaled(&h, &format!("{p}_force"), 1e-3).unwrap_or_default();
-        let fig = Figure::new(format!("Contact {p}"), "t [ms]", "normal force [kN]").with(
+        let mut fig = Figure::new(format!("Contact {p}"), "t [ms]", "force [kN]").with(
             Series::from_xy(format!("{p}: total normal force"), &t, &f, Style::Line),
         );
+        // With friction: the net tangential force beside it.
+        if let Some(ft) = scaled(&h, &format!("{p}_tangential_force"), 1e-3) {
+            if ft.iter().any(|&x| x != 0.0) {
+                fig = fig.with(Series::from_xy(
+                    format!("{p}: net tangential (friction) force"),
+                    &t,
+                    &ft,
+                    Style::Line,
+                ));
+            }
+        }
         emit(fig, file)?;
     }
     Ok(written)
