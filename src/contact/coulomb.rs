@@ -335,18 +335,13 @@ pub(crate) fn solve_by_guess(
     }
     for (k, &(j, mu)) in cones.iter().enumerate() {
         let (ln, lt) = (lambda[j], lambda[n + k]);
-        match guess[k] {
-            Guess::Stick if pressed[j] => {
-                if lt.abs() > mu * ln * (1.0 + 1e-12) + 1e-12 * scale {
-                    return false;
-                }
-            }
-            Guess::Slip(sign) if pressed[j] => {
-                if sign * y(n + k, lambda) > tol {
-                    return false;
-                }
-            }
-            _ => {}
+        let broken = match guess[k] {
+            _ if !pressed[j] => false,
+            Guess::Stick => lt.abs() > mu * ln * (1.0 + 1e-12) + 1e-12 * scale,
+            Guess::Slip(sign) => sign * y(n + k, lambda) > tol,
+        };
+        if broken {
+            return false;
         }
     }
     for l in &mut lambda[..n] {
@@ -364,7 +359,8 @@ fn eliminate(b: &mut [f64], rhs: &mut [f64], q: usize) -> bool {
             .max_by(|&x, &y| b[x + col * q].abs().total_cmp(&b[y + col * q].abs()))
             .expect("a row");
         let pivot = b[p + col * q];
-        if !(pivot.abs() > 1e-13 * norm) {
+        // A NaN pivot fails too.
+        if pivot.abs().partial_cmp(&(1e-13 * norm)) != Some(std::cmp::Ordering::Greater) {
             return false;
         }
         if p != col {

@@ -197,15 +197,14 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
 mod tests {
     use super::*;
 
+    /// Nodes, slave nodes, slave segments, master segments.
+    type Strips = (Vec<[f64; 2]>, Vec<usize>, Vec<[usize; 2]>, Vec<[usize; 2]>);
+
     /// A slave strip of `ns` segments on top of a master strip of `nm`, both on
     /// [0, 1], the slave `gap` above: nodes, slave segments (body above, on the left
     /// of segments running left to right), master segments (body below: right to
     /// left).
-    fn strips(
-        ns: usize,
-        nm: usize,
-        gap: f64,
-    ) -> (Vec<[f64; 2]>, Vec<usize>, Vec<[usize; 2]>, Vec<[usize; 2]>) {
+    fn strips(ns: usize, nm: usize, gap: f64) -> Strips {
         let mut x = Vec::new();
         for i in 0..=ns {
             x.push([i as f64 / ns as f64, gap]);
