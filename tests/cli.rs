@@ -334,3 +334,56 @@ fn check_and_material_print_the_identified_concrete() {
     assert_eq!(v["materials"]["concrete"]["regularisation"], "nonlocal");
     assert_eq!(v["materials"]["concrete"]["radius"], 0.1);
 }
+
+#[test]
+fn a_frictional_run_reports_friction_in_every_output() {
+    // examples/contact/incline.toml: the block slides 11.9 mm in 0.1 s against
+    // μ m g cos 30° = 20.0 N of friction.
+    let dir = tempfile::tempdir().unwrap();
+    let sc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/contact/incline.toml");
+    let out = dir.path().join("out");
+    let (ok, _, err) = rothe(&[
+        "run",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+            .unwrap();
+    let floor = &summary["contact"]["floor"];
+    let friction = 0.3 * 7.85 * 9.81 * 30f64.to_radians().cos();
+    let f = floor["max_tangential_force"].as_f64().unwrap();
+    assert!((f - friction).abs() < 1e-3 * friction, "{floor}");
+    let slip = floor["slip"].as_f64().unwrap();
+    assert!((slip - 0.0119).abs() < 1e-4, "{floor}");
+    let d = summary["energy"]["dissipated"]["friction"].as_f64().unwrap();
+    assert!((d - friction * slip).abs() < 0.01 * d, "D_friction {d} against {}", friction * slip);
+    // history.csv: the friction line and the pair's stick and slip counts.
+    let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
+    let header: Vec<&str> = history.lines().next().unwrap().split(',').collect();
+    let last: Vec<&str> = history.lines().last().unwrap().split(',').collect();
+    let col = |name: &str| {
+        let i = header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}"));
+        last[i].parse::<f64>().unwrap()
+    };
+    assert!((col("D_friction") - d).abs() < 1e-9 * d);
+    assert_eq!((col("floor_stick"), col("floor_slip")), (0.0, 5.0));
+    assert!((col("floor_tangential_force") + friction).abs() < 1e-3 * friction);
+    // VTK point data: the tangential traction and the slip path.
+    let vtu: Vec<_> = std::fs::read_dir(out.join("vtk"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    let last_vtu = vtu.iter().max().unwrap();
+    let text = std::fs::read_to_string(last_vtu).unwrap();
+    assert!(text.contains("contact_traction") && text.contains("contact_slip"));
+    // check names the pair's formulation and friction.
+    let (ok, report, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        report.contains("floor: against a rigid line, node to segment, Coulomb mu = 0.3"),
+        "{report}"
+    );
+}
