@@ -342,30 +342,33 @@ fn a_frictional_run_reports_friction_in_every_output() {
     let dir = tempfile::tempdir().unwrap();
     let sc = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/contact/incline.toml");
     let out = dir.path().join("out");
-    let (ok, _, err) = rothe(&[
-        "run",
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, _, err) = rothe(&["run", sc.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(ok, "{err}");
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     let floor = &summary["contact"]["floor"];
     let friction = 0.3 * 7.85 * 9.81 * 30f64.to_radians().cos();
     let f = floor["max_tangential_force"].as_f64().unwrap();
     assert!((f - friction).abs() < 1e-3 * friction, "{floor}");
     let slip = floor["slip"].as_f64().unwrap();
     assert!((slip - 0.0119).abs() < 1e-4, "{floor}");
-    let d = summary["energy"]["dissipated"]["friction"].as_f64().unwrap();
-    assert!((d - friction * slip).abs() < 0.01 * d, "D_friction {d} against {}", friction * slip);
+    let d = summary["energy"]["dissipated"]["friction"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (d - friction * slip).abs() < 0.01 * d,
+        "D_friction {d} against {}",
+        friction * slip
+    );
     // history.csv: the friction line and the pair's stick and slip counts.
     let history = std::fs::read_to_string(out.join("history.csv")).unwrap();
     let header: Vec<&str> = history.lines().next().unwrap().split(',').collect();
     let last: Vec<&str> = history.lines().last().unwrap().split(',').collect();
     let col = |name: &str| {
-        let i = header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}"));
+        let i = header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("{name}"));
         last[i].parse::<f64>().unwrap()
     };
     assert!((col("D_friction") - d).abs() < 1e-9 * d);

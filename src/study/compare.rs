@@ -62,7 +62,7 @@ pub fn pair(
 }
 
 /// What explains the difference of each ledger line between the two paths.
-const WHY: [(&str, &str); 6] = [
+const WHY: [(&str, &str); 7] = [
     (
         "numerical",
         "backward Euler loses ½|Δv|²_M per step (and the material's algorithmic share): \
@@ -75,6 +75,12 @@ const WHY: [(&str, &str); 6] = [
         "implicit: the work of the QP's contact forces on the gaps they close; the velocity \
          jump of an impact is split between this line and the scheme's loss. Explicit: the \
          kinetic energy the perfectly inelastic impulses remove",
+    ),
+    (
+        "friction",
+        "implicit: the work of the Coulomb forces on the slip, step by step. Explicit: \
+         none of its own, the impacts' friction loss is inside D_contact (an impulse's \
+         loss does not split by direction)",
     ),
     (
         "viscous",
