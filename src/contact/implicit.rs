@@ -24,8 +24,9 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use super::compliance::Compliance;
-use super::detect::{detect, Candidate};
+use super::detect::detect;
 use super::qp::{primal_qp, solve_by_active_set, DualQp, QpStats};
+use super::rows::Candidate;
 use crate::error::Result;
 use crate::model::{ContactPair, ContactQp, Model};
 use crate::nonlinear::{ConstraintStatus, Corrected, Correction};
@@ -556,9 +557,9 @@ impl Correction for ContactCorrection<'_> {
         // enforce them).
         let n_cands = self.cands.len();
         let g = if self.frictional {
-            super::detect::gap_and_tangent_matrix(&self.cands, eq, free.len())
+            super::rows::gap_and_tangent_matrix(&self.cands, eq, free.len())
         } else {
-            super::detect::gap_matrix(&self.cands, eq, free.len())
+            super::rows::gap_matrix(&self.cands, eq, free.len())
         };
         self.rows.clear();
         self.cones.clear();

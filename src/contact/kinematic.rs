@@ -22,9 +22,9 @@ use rstar::primitives::{GeomWithData, Line};
 use rstar::RTree;
 
 use super::collision::node_segment;
-use super::detect::Candidate;
 use super::implicit::{ContactState, PairRecord};
 use super::qp::{on_active_set, solve_by_active_set, DualQp};
+use super::rows::Candidate;
 use crate::error::{Error, Result};
 use crate::model::{Master, Model};
 

@@ -2,7 +2,7 @@
 //!
 //! - [`detect`] finds, for the current geometry, the candidate constraints of every
 //!   contact pair: slave node, closest master segment (or rigid line), `ξ`, gap and
-//!   normal, as plain data ([`detect::Candidate`]), with an R-tree (`rstar`) over the
+//!   normal, as plain data ([`rows::Candidate`]), with an R-tree (`rstar`) over the
 //!   master segments as the broad phase.
 //! - [`implicit`] enforces impenetrability in the implicit schemes: per step a convex
 //!   QP (solved with Clarabel) inside the equilibrium loop, as a
@@ -22,10 +22,11 @@ pub mod implicit;
 pub mod kinematic;
 pub mod mortar;
 mod qp;
+pub mod rows;
 pub mod sweep;
 
-pub use detect::{gap_matrix, Candidate, Contactee};
 pub use implicit::{ContactCorrection, ContactState, PairRecord};
+pub use rows::{gap_matrix, Candidate, Contactee};
 
 /// The tributary area (length × thickness) of every node as a slave, for contact
 /// pressures: half of every element edge joining two slave nodes of a side.

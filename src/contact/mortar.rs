@@ -30,7 +30,7 @@
 use rstar::primitives::{GeomWithData, Line, Rectangle};
 use rstar::{RTree, RTreeObject};
 
-use super::detect::{Candidate, Contactee, Weights};
+use super::rows::{Candidate, Contactee, Weights};
 
 /// The least covered fraction of a slave node's shape-function integral for the node
 /// to get a row: below it the node sees the master over a sliver of its support
@@ -59,7 +59,7 @@ struct Gathered {
     total: f64,
     /// The master's outward normals weighted as the row's master weights.
     master_normal: [f64; 2],
-    /// Entries that did not fit the row ([`super::detect::ROW_NODES`]).
+    /// Entries that did not fit the row ([`super::rows::ROW_NODES`]).
     overflow: usize,
 }
 
@@ -67,7 +67,7 @@ struct Gathered {
 /// `segments` at the geometry `x`, appended to `out` in slave order. `slaves` are the
 /// side's slave nodes (sorted), `slave_segments` its slave surface; master segments
 /// farther than `radius` from a slave segment are not looked at. Returns the most
-/// nodes a row needed (more than [`super::detect::ROW_NODES`] means rows were cut:
+/// nodes a row needed (more than [`super::rows::ROW_NODES`] means rows were cut:
 /// validation refuses such a pair at the initial geometry).
 #[allow(clippy::too_many_arguments)]
 pub fn rows<X: Fn(usize) -> [f64; 2]>(

@@ -5,9 +5,8 @@
 use rstar::primitives::GeomWithData;
 use rstar::{RTree, RTreeObject};
 
-use super::detect::{
-    closest, segment_candidate, within_ends, Candidate, Chain, Contactee, RigidHistory,
-};
+use super::detect::{closest, segment_candidate, within_ends, Chain, RigidHistory};
+use super::rows::{Candidate, Contactee};
 use crate::model::{ContactPair, Master};
 
 /// Slaves whose motion over the step, from the geometry `x0(node)` to `x1(node)`,

@@ -89,81 +89,9 @@ pub(crate) struct Operators {
     /// Every material is rate-independent ([`crate::material::Material::is_rate_independent`]).
     pub rate_independent: bool,
     /// Statics: the multiple of `M` added to the matrix (never to the residual) while
-    /// a body in contact has rigid motions no support holds ([`STATIC_SEAT`]).
+    /// a body in contact has rigid motions no support holds
+    /// ([`super::statics::STATIC_SEAT`]).
     pub seat: f64,
-}
-
-/// The multiple of `M`, relative to `trace K / trace M`, that statics adds to the
-/// matrix it solves with when a body in contact is held by contact alone (a block
-/// pressed onto a support, a punch on a beam): its rigid motions make `K` singular,
-/// and the contact constraints only hold them once found. The residual is the static
-/// one, so the iterations converge to static equilibrium; the term only makes the
-/// matrix positive definite and contracts the error of each elastic mode by about
-/// `1e-8 ω²_max/ω²` per iteration (`theory/contact.md`).
-pub const STATIC_SEAT: f64 = 1e-8;
-
-/// Whether some body with a contact side has a rigid motion (translation or
-/// rotation) that its supports and prescribed displacements do not hold.
-fn held_by_contact_only(model: &Model) -> bool {
-    let mesh = &model.mesh;
-    let mut in_contact = vec![false; model.bodies.len()];
-    for p in &model.contacts {
-        for side in &p.sides {
-            for &n in &side.slaves {
-                in_contact[mesh.node_body[n]] = true;
-            }
-            if let crate::model::Master::Segments(segs) = &side.master {
-                for &n in segs.iter().flatten() {
-                    in_contact[mesh.node_body[n]] = true;
-                }
-            }
-        }
-    }
-    (0..model.bodies.len()).filter(|&b| in_contact[b]).any(|b| {
-        // Gram matrix of the rigid modes (x, y, rotation about the body's centroid)
-        // on the body's constrained dofs: singular when a mode is free.
-        let nodes: Vec<usize> = (0..mesh.n_nodes())
-            .filter(|&n| mesh.node_body[n] == b)
-            .collect();
-        let c = nodes.iter().fold([0.0, 0.0], |a, &n| {
-            [a[0] + mesh.coords[n][0], a[1] + mesh.coords[n][1]]
-        });
-        let c = [c[0] / nodes.len() as f64, c[1] / nodes.len() as f64];
-        let mut g = [[0.0f64; 3]; 3];
-        let mut size: f64 = 0.0;
-        for con in &model.constraints {
-            let n = con.dof / 2;
-            if mesh.node_body[n] != b {
-                continue;
-            }
-            let [x, y] = [mesh.coords[n][0] - c[0], mesh.coords[n][1] - c[1]];
-            size = size.max(x.abs()).max(y.abs());
-            let row = if con.dof % 2 == 0 {
-                [1.0, 0.0, -y]
-            } else {
-                [0.0, 1.0, x]
-            };
-            for i in 0..3 {
-                for j in 0..3 {
-                    g[i][j] += row[i] * row[j];
-                }
-            }
-        }
-        if size == 0.0 {
-            return true;
-        }
-        for row in &mut g {
-            row[2] /= size;
-        }
-        for j in 0..3 {
-            g[2][j] /= size;
-        }
-        let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1])
-            - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
-            + g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
-        let scale = g[0][0].max(g[1][1]).max(g[2][2]);
-        det <= 1e-10 * scale * scale * scale
-    })
 }
 
 impl Operators {
@@ -219,21 +147,8 @@ impl Operators {
             }
         }
         ops.update_constant_tangent(model);
-        if matches!(scheme, Scheme::Static { .. }) && held_by_contact_only(model) {
-            let p = &ops.asm.pattern;
-            let (mut tk, mut tm) = (0.0, 0.0);
-            for n in 0..model.mesh.n_nodes() {
-                for c in 0..2 {
-                    tk += ops.k[p.position(n, c, n, c)];
-                    tm += match &ops.mass {
-                        Mass::Consistent(m) => m[p.position(n, c, n, c)],
-                        Mass::Lumped(m) => m[2 * n + c],
-                    };
-                }
-            }
-            if tk > 0.0 && tm > 0.0 {
-                ops.seat = STATIC_SEAT * tk / tm;
-            }
+        if matches!(scheme, Scheme::Static { .. }) {
+            ops.seat = super::statics::seat(model, &ops.asm.pattern, &ops.k, &ops.mass);
         }
         ops
     }

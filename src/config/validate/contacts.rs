@@ -73,7 +73,7 @@ fn master_edges(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<[usize; 2]>>
 }
 
 /// Refuses a mortar pair whose rows need more than
-/// [`crate::contact::detect::ROW_NODES`] nodes at the initial geometry: a slave node's
+/// [`crate::contact::rows::ROW_NODES`] nodes at the initial geometry: a slave node's
 /// two segments facing more master segments than a row holds (the master locally
 /// much finer than the slave).
 fn mortar_reach(
@@ -94,7 +94,7 @@ fn mortar_reach(
         &|n| mesh.coords[n],
         &mut rows,
     );
-    if needed > crate::contact::detect::ROW_NODES {
+    if needed > crate::contact::rows::ROW_NODES {
         return Err(Error::config(
             field,
             format!(
@@ -102,7 +102,7 @@ fn mortar_reach(
                  weighted gap would hold {needed} nodes, at most {} fit; refine the slave \
                  side where it faces the finer master, or give \
                  `formulation = \"node_to_segment\"`",
-                crate::contact::detect::ROW_NODES
+                crate::contact::rows::ROW_NODES
             ),
         ));
     }

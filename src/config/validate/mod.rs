@@ -199,11 +199,11 @@ fn initial_overlap(model: &Model) -> Result<()> {
     let count = cands.iter().filter(|c| c.gap < -tol).count();
     let pair = &model.contacts[c.pair];
     let master = match c.master {
-        crate::contact::detect::Contactee::Rigid => "its rigid line".to_string(),
-        crate::contact::detect::Contactee::Segment { nodes, .. } => {
+        crate::contact::rows::Contactee::Rigid => "its rigid line".to_string(),
+        crate::contact::rows::Contactee::Segment { nodes, .. } => {
             format!("the master segment of nodes {} and {}", nodes[0], nodes[1])
         }
-        crate::contact::detect::Contactee::Mortar => "the master surface (mortar)".to_string(),
+        crate::contact::rows::Contactee::Mortar => "the master surface (mortar)".to_string(),
     };
     Err(Error::config(
         format!("contact[{}]", c.pair),

@@ -1,0 +1,274 @@
+//! The rows of contact: what every formulation hands to the QP. A row is a gap
+//! `g = n · Σ_k w_k x_k` over a few nodes `k` with weights `w_k` (slave weights
+//! summing to 1, master ones to −1) along a normal `n`, and its tangential twin along
+//! `t = (n_y, −n_x)`; node to segment ([`super::detect`]) and mortar
+//! ([`super::mortar`]) build them, the implicit correction, friction and the ledger
+//! read them the same way. Here too the sparse gap matrices of a set of rows.
+
+/// What a slave node is in contact with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Contactee {
+    /// Segment `index` of the side's master, nodes `[a, b]`.
+    Segment {
+        /// Index among the side's master segments.
+        index: usize,
+        /// End nodes.
+        nodes: [usize; 2],
+    },
+    /// The rigid line of the pair's side.
+    Rigid,
+    /// The master segments the slave node's shape function sees (mortar: the
+    /// weighted gap of the node, [`super::mortar`]).
+    Mortar,
+}
+
+/// The most nodes one gap row spans: a mortar row holds the slave node, its two
+/// neighbours and the master nodes facing its two segments (validation refuses a
+/// mortar pair whose rows need more at the initial geometry: a master locally more
+/// than about 14 times finer than the slave).
+pub const ROW_NODES: usize = 32;
+
+/// The nodes of a gap row and their weights: the gap is
+/// `n · Σ w_k x_k` (slave weights summing to 1, master weights to −1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Weights {
+    len: u8,
+    entries: [(u32, f64); ROW_NODES],
+}
+
+impl Weights {
+    /// No nodes.
+    pub const EMPTY: Weights = Weights {
+        len: 0,
+        entries: [(0, 0.0); ROW_NODES],
+    };
+
+    /// Adds `w` to node `node`'s weight (a new entry if it has none). False, and
+    /// nothing added, when the row is full.
+    pub fn add(&mut self, node: usize, w: f64) -> bool {
+        let n = self.len as usize;
+        if let Some(e) = self.entries[..n].iter_mut().find(|e| e.0 as usize == node) {
+            e.1 += w;
+            return true;
+        }
+        if n == ROW_NODES {
+            return false;
+        }
+        self.entries[n] = (node as u32, w);
+        self.len += 1;
+        true
+    }
+
+    /// `(node, weight)` pairs.
+    pub fn iter(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.entries[..self.len as usize]
+            .iter()
+            .map(|&(n, w)| (n as usize, w))
+    }
+
+    /// Multiplies every weight by `f`.
+    pub fn scale(&mut self, f: f64) {
+        for e in &mut self.entries[..self.len as usize] {
+            e.1 *= f;
+        }
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.len as usize
+    }
+
+    /// Whether the row has no node.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// A candidate constraint: the gap of one slave node to its master, linearised as
+/// `g(u + δ) ≈ g + n · Σ w_k δ_k` over the row's nodes (node to segment: `+1` on the
+/// slave, `−(1−ξ)` and `−ξ` on the segment's ends; mortar: the normalised integrals
+/// of the slave node's shape function, [`super::mortar`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Candidate {
+    /// Pair index.
+    pub pair: usize,
+    /// Direction within the pair.
+    pub side: usize,
+    /// Slave node.
+    pub slave: usize,
+    /// Master segment, rigid line or the mortar projection.
+    pub master: Contactee,
+    /// Local coordinate of the closest point on the segment, in `[0, 1]` (0 for a
+    /// mortar row).
+    pub xi: f64,
+    /// Gap along the normal (m): positive open, negative penetrating.
+    pub gap: f64,
+    /// Unit outward normal of the master (mortar: opposite to the slave's nodal
+    /// normal).
+    pub normal: [f64; 2],
+    /// The row's nodes and weights.
+    pub weights: Weights,
+    /// The length (m) the row's gap stands for: the slave's tributary length, the
+    /// integral of its shape function over the part facing the master (mortar), or
+    /// 0 (node to segment: the tributary length of the node is used).
+    pub length: f64,
+}
+
+/// The key of a mortar row's master in [`Candidate::key`].
+pub const MORTAR_KEY: usize = usize::MAX - 1;
+
+impl Candidate {
+    /// The key of the constraint: pair, side, slave node and master segment (the
+    /// segment's index in the side, `usize::MAX` for a rigid line, [`MORTAR_KEY`]
+    /// for a mortar row).
+    pub fn key(&self) -> (usize, usize, usize, usize) {
+        let master = match self.master {
+            Contactee::Segment { index, .. } => index,
+            Contactee::Rigid => usize::MAX,
+            Contactee::Mortar => MORTAR_KEY,
+        };
+        (self.pair, self.side, self.slave, master)
+    }
+
+    /// The slave's key: pair, side, slave node.
+    pub fn slave_key(&self) -> (usize, usize, usize) {
+        (self.pair, self.side, self.slave)
+    }
+
+    /// The unit tangent `t = (n_y, −n_x)`: the direction of the tangential row and of
+    /// the friction force on the slave.
+    pub fn tangent(&self) -> [f64; 2] {
+        [self.normal[1], -self.normal[0]]
+    }
+
+    /// The nonzeros `(dof, coefficient)` of the linearised gap row (all dofs).
+    pub fn row(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.along(self.normal)
+    }
+
+    /// The nonzeros of the tangential row: the relative tangential displacement of
+    /// the slave and its master, `t · Σ w_k δ_k`.
+    pub fn tangent_row(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.along(self.tangent())
+    }
+
+    /// `d · Σ w_k δ_k` as `(dof, coefficient)`.
+    fn along(&self, d: [f64; 2]) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.weights
+            .iter()
+            .flat_map(move |(n, w)| [(2 * n, w * d[0]), (2 * n + 1, w * d[1])])
+    }
+
+    /// `Σ w_k p_k` of the nodal vectors `p(node)`.
+    pub fn combine(&self, p: impl Fn(usize) -> [f64; 2]) -> [f64; 2] {
+        self.weights.iter().fold([0.0, 0.0], |a, (n, w)| {
+            let q = p(n);
+            [a[0] + w * q[0], a[1] + w * q[1]]
+        })
+    }
+
+    /// A node-to-segment or rigid-line candidate: the weights `+1` on the slave and
+    /// `−(1−ξ), −ξ` on a segment's ends.
+    pub fn nodal(
+        (pair, side, slave): (usize, usize, usize),
+        master: Contactee,
+        xi: f64,
+        gap: f64,
+        normal: [f64; 2],
+    ) -> Candidate {
+        let mut weights = Weights::EMPTY;
+        weights.add(slave, 1.0);
+        if let Contactee::Segment { nodes: [a, b], .. } = master {
+            weights.add(a, -(1.0 - xi));
+            weights.add(b, -xi);
+        }
+        Candidate {
+            pair,
+            side,
+            slave,
+            master,
+            xi,
+            gap,
+            normal,
+            weights,
+            length: 0.0,
+        }
+    }
+}
+
+/// The linearised gap rows `G` of `cands` as a CSR matrix: one row per candidate,
+/// columns the dofs numbered by `columns` (`columns[d]` the column of dof `d`, or
+/// `usize::MAX` to leave the dof out: a constrained one), `ncols` columns.
+pub fn gap_matrix(
+    cands: &[Candidate],
+    columns: &[usize],
+    ncols: usize,
+) -> nalgebra_sparse::CsrMatrix<f64> {
+    let mut offsets = Vec::with_capacity(cands.len() + 1);
+    let mut cols = Vec::with_capacity(6 * cands.len());
+    let mut values = Vec::with_capacity(6 * cands.len());
+    offsets.push(0);
+    for c in cands {
+        gap_row(c.row(), columns, &mut cols, &mut values);
+        offsets.push(cols.len());
+    }
+    nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(
+        cands.len(),
+        ncols,
+        offsets,
+        cols,
+        values,
+    )
+    .expect("distinct in-range columns per row")
+}
+
+/// The gap rows of `cands` followed by their tangential rows (rows `cands.len() + i`),
+/// as [`gap_matrix`].
+pub fn gap_and_tangent_matrix(
+    cands: &[Candidate],
+    columns: &[usize],
+    ncols: usize,
+) -> nalgebra_sparse::CsrMatrix<f64> {
+    let mut offsets = Vec::with_capacity(2 * cands.len() + 1);
+    let mut cols = Vec::with_capacity(2 * ROW_NODES * cands.len());
+    let mut values = Vec::with_capacity(2 * ROW_NODES * cands.len());
+    offsets.push(0);
+    for c in cands {
+        gap_row(c.row(), columns, &mut cols, &mut values);
+        offsets.push(cols.len());
+    }
+    for c in cands {
+        gap_row(c.tangent_row(), columns, &mut cols, &mut values);
+        offsets.push(cols.len());
+    }
+    nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(
+        2 * cands.len(),
+        ncols,
+        offsets,
+        cols,
+        values,
+    )
+    .expect("distinct in-range columns per row")
+}
+
+/// Appends one row's entries, summed by column, leaving out dofs without a column.
+fn gap_row(
+    row: impl Iterator<Item = (usize, f64)>,
+    columns: &[usize],
+    cols: &mut Vec<usize>,
+    values: &mut Vec<f64>,
+) {
+    let start = cols.len();
+    for (d, v) in row {
+        let j = columns[d];
+        if j != usize::MAX {
+            match cols[start..].iter().position(|&x| x == j) {
+                Some(p) => values[start + p] += v,
+                None => {
+                    cols.push(j);
+                    values.push(v);
+                }
+            }
+        }
+    }
+}
