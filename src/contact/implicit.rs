@@ -287,8 +287,11 @@ impl<'m> ContactCorrection<'m> {
         }
         self.lambda = committed.active.iter().copied().collect();
         self.lambda_t = committed.tangential.iter().copied().collect();
+        // Slips are measured from the start of the step (friction only).
         self.u0.clear();
-        self.u0.extend_from_slice(u);
+        if self.frictional {
+            self.u0.extend_from_slice(u);
+        }
         let values: Vec<f64> = committed.active.iter().map(|(_, l)| *l).collect();
         let threshold = self.active_threshold(&values);
         self.current = committed
