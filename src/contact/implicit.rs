@@ -24,7 +24,6 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use super::compliance::Compliance;
-use super::detect::detect;
 use super::qp::{primal_qp, solve_by_active_set, DualQp, QpStats};
 use super::rows::Candidate;
 use crate::error::Result;
@@ -32,9 +31,8 @@ use crate::model::{ContactPair, ContactQp, Model};
 use crate::nonlinear::{ConstraintStatus, Corrected, Correction};
 use crate::system::EffectiveSystem;
 
-/// Key of a constraint across re-linearisations: pair, side, slave node, master
-/// segment (`Candidate::key`).
-type Key = (usize, usize, usize, usize);
+use super::state::Key;
+pub use super::state::{ContactState, PairRecord};
 
 /// The slaves (pair, side, node) of a sorted list of constraint keys, distinct.
 fn slaves(keys: &[Key]) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
@@ -55,51 +53,6 @@ const ACTIVE_FRACTION: f64 = 1e-6;
 /// A pressed node sticks when its tangential force is below `1 − STICK_MARGIN` of
 /// the cone's bound (the cone program ends within its tolerance of the bound).
 const STICK_MARGIN: f64 = 1e-6;
-
-/// One pair's contact at the end of a step.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
-pub struct PairRecord {
-    /// Total normal force `Σ λ` (N).
-    pub force: f64,
-    /// Active constraints (nodes pressed against the master).
-    pub active: usize,
-    /// Largest penetration (m), zero when none.
-    pub penetration: f64,
-    /// Total tangential (friction) force `Σ λ_T` on the slaves, along each row's
-    /// tangent (N).
-    pub tangential_force: f64,
-    /// Total magnitude of the tangential forces `Σ |λ_T|` (N): the net force above
-    /// cancels where a symmetric body slides outwards on both sides.
-    pub tangential_magnitude: f64,
-    /// Pressed nodes of a frictional pair that stick (`|λ_T| < μ λ_N`).
-    pub sticking: usize,
-    /// Pressed nodes of a frictional pair that slip (on the cone).
-    pub slipping: usize,
-    /// The longest slip path of a pressed node of the pair so far (m).
-    pub max_slip: f64,
-}
-
-/// The contact state a step leaves: kept in `time::State`, so a cut-back restores
-/// it with the rest.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ContactState {
-    /// The positive multipliers (N), by key (the active constraints are those above
-    /// a millionth of the largest).
-    pub active: Vec<(Key, f64)>,
-    /// Per pair.
-    pub pairs: Vec<PairRecord>,
-    /// Gap at each node (m); NaN where the node is no candidate.
-    pub gap: Vec<f64>,
-    /// Contact pressure at each node (Pa): its force over its tributary area.
-    pub pressure: Vec<f64>,
-    /// The tangential multipliers (N) of the frictional rows, by key.
-    pub tangential: Vec<(Key, f64)>,
-    /// Tangential traction at each node (Pa), along its row's tangent.
-    pub traction: Vec<f64>,
-    /// Slip path of each node (m): the sum of the magnitudes of its relative
-    /// tangential displacement over the steps it was pressed in.
-    pub slip: Vec<f64>,
-}
 
 /// Time spent in the contact correction.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -443,6 +396,204 @@ impl<'m> ContactCorrection<'m> {
         d[0] * t[0] + d[1] * t[1]
     }
 
+    /// The condensed dual on the `m` rows of `g` chosen: `W = G A⁻¹ Gᵀ` (from the kept
+    /// compliance or a blocked solve), the QP (on the last active set first, or the
+    /// Coulomb cone programs with friction), and `δ = δ₀ + A⁻¹Gᵀλ` into `delta0`.
+    /// The inner error is the QP's failure, for the step to be cut.
+    fn condensed(
+        &mut self,
+        sys: &mut EffectiveSystem,
+        g: &nalgebra_sparse::CsrMatrix<f64>,
+        m: usize,
+    ) -> Result<std::result::Result<(), String>> {
+        let nf = self.dofs.free.len();
+        let t = Instant::now();
+        // S pays once the factor has outlived a QP (theory/contact.md).
+        let generation = sys.factorizations();
+        let compliant = self.compliance.is_current(sys) || self.qp_generation == generation;
+        self.qp_generation = generation;
+        if compliant {
+            self.needed.clear();
+            for &i in &self.rows {
+                self.needed.extend_from_slice(g.row(i).col_indices());
+            }
+            self.compliance.cover(sys, &self.needed)?;
+            self.stats.compliant += 1;
+            self.w.clear();
+            self.w.resize(m * m, 0.0);
+            for (j, &ij) in self.rows.iter().enumerate() {
+                let rj = g.row(ij);
+                for (k, &ik) in self.rows.iter().enumerate().skip(j) {
+                    let rk = g.row(ik);
+                    let mut w = 0.0;
+                    for (&e, v) in rk.col_indices().iter().zip(rk.values()) {
+                        for (&f, u) in rj.col_indices().iter().zip(rj.values()) {
+                            w += v * u * self.compliance.at(e, f);
+                        }
+                    }
+                    self.w[k + j * m] = w;
+                    self.w[j + k * m] = w;
+                }
+            }
+        } else {
+            self.y.clear();
+            self.y.resize(nf * m, 0.0);
+            for (j, &i) in self.rows.iter().enumerate() {
+                let row = g.row(i);
+                for (&e, v) in row.col_indices().iter().zip(row.values()) {
+                    self.y[j * nf + e] += v;
+                }
+            }
+            sys.solve_block(&mut self.y, m)?;
+            self.w.clear();
+            self.w.resize(m * m, 0.0);
+            for j in 0..m {
+                let yj = &self.y[j * nf..(j + 1) * nf];
+                for (k, &i) in self.rows.iter().enumerate() {
+                    let row = g.row(i);
+                    self.w[k + j * m] = row
+                        .col_indices()
+                        .iter()
+                        .zip(row.values())
+                        .map(|(&e, v)| v * yj[e])
+                        .sum();
+                }
+            }
+        }
+        self.stats.w_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        // The previous active set first: accepted only if it satisfies the
+        // KKT conditions, so the QP's solution either way.
+        self.guess.clear();
+        for (j, &i) in self.rows[..self.normal_rows].iter().enumerate() {
+            if self.previous.binary_search(&self.cands[i].key()).is_ok() {
+                self.guess.push(j);
+            }
+        }
+        let gap_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let slip_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let r = if !self.cones.is_empty()
+            && super::coulomb::solve_by_guess(
+                &self.w,
+                &self.c,
+                self.normal_rows,
+                &self.cones,
+                &self.pressed,
+                &self.guess_t,
+                slip_tol,
+                &mut self.lambda_rows,
+            ) {
+            self.stats.guessed += 1;
+            self.stats.frictional += 1;
+            self.stats.friction_guessed += 1;
+            Ok(QpStats::default())
+        } else if !self.cones.is_empty() {
+            let r = super::coulomb::solve(
+                &self.w,
+                &self.c,
+                self.normal_rows,
+                &self.cones,
+                &mut self.lambda_rows,
+            );
+            if let Ok(q) = &r {
+                self.stats.frictional += 1;
+                self.stats.cone_programs += q.programs as usize;
+            }
+            r
+        } else if !self.guess.is_empty()
+            && solve_by_active_set(
+                &self.w,
+                &self.c,
+                &mut self.guess,
+                gap_tol,
+                &mut self.lambda_rows,
+                &mut self.guess_work,
+            )
+        {
+            self.stats.guessed += 1;
+            Ok(QpStats::default())
+        } else {
+            self.dual.solve(&self.w, &self.c, &mut self.lambda_rows)
+        };
+        self.stats.qp_s += t.elapsed().as_secs_f64();
+        if r.is_ok() {
+            if compliant {
+                // δ = δ₀ + A⁻¹Gᵀλ: one solve of a right-hand side on the
+                // contact dofs (its forward sweep over their reach only).
+                self.push_entries.clear();
+                for (j, &i) in self.rows.iter().enumerate() {
+                    let row = g.row(i);
+                    for (&e, v) in row.col_indices().iter().zip(row.values()) {
+                        self.push_entries.push((e, self.lambda_rows[j] * v));
+                    }
+                }
+                self.push.clear();
+                self.push.resize(nf, 0.0);
+                sys.solve_sparse(&self.push_entries, &mut self.push)?;
+                for (d, p) in self.delta0.iter_mut().zip(&self.push) {
+                    *d += p;
+                }
+            } else {
+                for (j, &l) in self.lambda_rows.iter().enumerate() {
+                    if l != 0.0 {
+                        let yj = &self.y[j * nf..(j + 1) * nf];
+                        for (d, y) in self.delta0.iter_mut().zip(yj) {
+                            *d += l * y;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(r.map(|_| ()))
+    }
+
+    /// The primal QP over all free dofs (the frictionless reference), its `δ` into
+    /// `delta0`.
+    fn full(
+        &mut self,
+        sys: &EffectiveSystem,
+        g: &nalgebra_sparse::CsrMatrix<f64>,
+        rhs: &[f64],
+    ) -> std::result::Result<(), String> {
+        let free = &self.dofs.free;
+        debug_assert!(self.cones.is_empty(), "validation: friction is condensed");
+        let t = Instant::now();
+        let r_free: Vec<f64> = free
+            .iter()
+            .zip(rhs.iter())
+            .map(|(&d, &b)| self.f_c[d] - b)
+            .collect();
+        let gaps: Vec<f64> = self.rows.iter().map(|&i| self.gaps[i]).collect();
+        let row_entries: Vec<Vec<(usize, f64)>> = self
+            .rows
+            .iter()
+            .map(|&i| {
+                let row = g.row(i);
+                row.col_indices()
+                    .iter()
+                    .copied()
+                    .zip(row.values().iter().copied())
+                    .collect()
+            })
+            .collect();
+        let mut delta = Vec::new();
+        let sigma = self.delta0.iter().fold(self.tol, |a, x| a.max(x.abs()));
+        let r = primal_qp(
+            sys.matrix(),
+            &r_free,
+            &gaps,
+            &row_entries,
+            sigma,
+            &mut delta,
+            &mut self.lambda_rows,
+        );
+        self.stats.qp_s += t.elapsed().as_secs_f64();
+        if r.is_ok() {
+            self.delta0.copy_from_slice(&delta);
+        }
+        r.map(|_| ())
+    }
+
     /// The threshold below which a multiplier counts as zero: a millionth of the
     /// largest. A constraint that is only weakly active (its gap and its force both
     /// about zero, as at the instant of a release) would otherwise flip in and out of
@@ -641,188 +792,9 @@ impl Correction for ContactCorrection<'_> {
         }
         self.stats.qps += 1;
         self.stats.rows += m;
-        let nf = free.len();
         let status = match self.qp {
-            ContactQp::Condensed => {
-                let t = Instant::now();
-                // S pays once the factor has outlived a QP (theory/contact.md).
-                let generation = sys.factorizations();
-                let compliant = self.compliance.is_current(sys) || self.qp_generation == generation;
-                self.qp_generation = generation;
-                if compliant {
-                    self.needed.clear();
-                    for &i in &self.rows {
-                        self.needed.extend_from_slice(g.row(i).col_indices());
-                    }
-                    self.compliance.cover(sys, &self.needed)?;
-                    self.stats.compliant += 1;
-                    self.w.clear();
-                    self.w.resize(m * m, 0.0);
-                    for (j, &ij) in self.rows.iter().enumerate() {
-                        let rj = g.row(ij);
-                        for (k, &ik) in self.rows.iter().enumerate().skip(j) {
-                            let rk = g.row(ik);
-                            let mut w = 0.0;
-                            for (&e, v) in rk.col_indices().iter().zip(rk.values()) {
-                                for (&f, u) in rj.col_indices().iter().zip(rj.values()) {
-                                    w += v * u * self.compliance.at(e, f);
-                                }
-                            }
-                            self.w[k + j * m] = w;
-                            self.w[j + k * m] = w;
-                        }
-                    }
-                } else {
-                    self.y.clear();
-                    self.y.resize(nf * m, 0.0);
-                    for (j, &i) in self.rows.iter().enumerate() {
-                        let row = g.row(i);
-                        for (&e, v) in row.col_indices().iter().zip(row.values()) {
-                            self.y[j * nf + e] += v;
-                        }
-                    }
-                    sys.solve_block(&mut self.y, m)?;
-                    self.w.clear();
-                    self.w.resize(m * m, 0.0);
-                    for j in 0..m {
-                        let yj = &self.y[j * nf..(j + 1) * nf];
-                        for (k, &i) in self.rows.iter().enumerate() {
-                            let row = g.row(i);
-                            self.w[k + j * m] = row
-                                .col_indices()
-                                .iter()
-                                .zip(row.values())
-                                .map(|(&e, v)| v * yj[e])
-                                .sum();
-                        }
-                    }
-                }
-                self.stats.w_s += t.elapsed().as_secs_f64();
-                let t = Instant::now();
-                // The previous active set first: accepted only if it satisfies the
-                // KKT conditions, so the QP's solution either way.
-                self.guess.clear();
-                for (j, &i) in self.rows[..self.normal_rows].iter().enumerate() {
-                    if self.previous.binary_search(&self.cands[i].key()).is_ok() {
-                        self.guess.push(j);
-                    }
-                }
-                let gap_tol =
-                    GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-                let slip_tol =
-                    GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-                let r = if !self.cones.is_empty()
-                    && super::coulomb::solve_by_guess(
-                        &self.w,
-                        &self.c,
-                        self.normal_rows,
-                        &self.cones,
-                        &self.pressed,
-                        &self.guess_t,
-                        slip_tol,
-                        &mut self.lambda_rows,
-                    ) {
-                    self.stats.guessed += 1;
-                    self.stats.frictional += 1;
-                    self.stats.friction_guessed += 1;
-                    Ok(QpStats::default())
-                } else if !self.cones.is_empty() {
-                    let r = super::coulomb::solve(
-                        &self.w,
-                        &self.c,
-                        self.normal_rows,
-                        &self.cones,
-                        &mut self.lambda_rows,
-                    );
-                    if let Ok(q) = &r {
-                        self.stats.frictional += 1;
-                        self.stats.cone_programs += q.programs as usize;
-                    }
-                    r
-                } else if !self.guess.is_empty()
-                    && solve_by_active_set(
-                        &self.w,
-                        &self.c,
-                        &mut self.guess,
-                        gap_tol,
-                        &mut self.lambda_rows,
-                        &mut self.guess_work,
-                    )
-                {
-                    self.stats.guessed += 1;
-                    Ok(QpStats::default())
-                } else {
-                    self.dual.solve(&self.w, &self.c, &mut self.lambda_rows)
-                };
-                self.stats.qp_s += t.elapsed().as_secs_f64();
-                if r.is_ok() {
-                    if compliant {
-                        // δ = δ₀ + A⁻¹Gᵀλ: one solve of a right-hand side on the
-                        // contact dofs (its forward sweep over their reach only).
-                        self.push_entries.clear();
-                        for (j, &i) in self.rows.iter().enumerate() {
-                            let row = g.row(i);
-                            for (&e, v) in row.col_indices().iter().zip(row.values()) {
-                                self.push_entries.push((e, self.lambda_rows[j] * v));
-                            }
-                        }
-                        self.push.clear();
-                        self.push.resize(nf, 0.0);
-                        sys.solve_sparse(&self.push_entries, &mut self.push)?;
-                        for (d, p) in self.delta0.iter_mut().zip(&self.push) {
-                            *d += p;
-                        }
-                    } else {
-                        for (j, &l) in self.lambda_rows.iter().enumerate() {
-                            if l != 0.0 {
-                                let yj = &self.y[j * nf..(j + 1) * nf];
-                                for (d, y) in self.delta0.iter_mut().zip(yj) {
-                                    *d += l * y;
-                                }
-                            }
-                        }
-                    }
-                }
-                r.map(|_| ())
-            }
-            ContactQp::Full => {
-                debug_assert!(self.cones.is_empty(), "validation: friction is condensed");
-                let t = Instant::now();
-                let r_free: Vec<f64> = free
-                    .iter()
-                    .zip(rhs.iter())
-                    .map(|(&d, &b)| self.f_c[d] - b)
-                    .collect();
-                let gaps: Vec<f64> = self.rows.iter().map(|&i| self.gaps[i]).collect();
-                let row_entries: Vec<Vec<(usize, f64)>> = self
-                    .rows
-                    .iter()
-                    .map(|&i| {
-                        let row = g.row(i);
-                        row.col_indices()
-                            .iter()
-                            .copied()
-                            .zip(row.values().iter().copied())
-                            .collect()
-                    })
-                    .collect();
-                let mut delta = Vec::new();
-                let sigma = self.delta0.iter().fold(self.tol, |a, x| a.max(x.abs()));
-                let r = primal_qp(
-                    sys.matrix(),
-                    &r_free,
-                    &gaps,
-                    &row_entries,
-                    sigma,
-                    &mut delta,
-                    &mut self.lambda_rows,
-                );
-                self.stats.qp_s += t.elapsed().as_secs_f64();
-                if r.is_ok() {
-                    self.delta0.copy_from_slice(&delta);
-                }
-                r.map(|_| ())
-            }
+            ContactQp::Condensed => self.condensed(sys, &g, m)?,
+            ContactQp::Full => self.full(sys, &g, rhs),
         };
         if let Err(status) = status {
             let worst = self
@@ -877,35 +849,5 @@ impl Correction for ContactCorrection<'_> {
         self.current.sort_unstable();
         rhs.copy_from_slice(&self.delta0);
         Ok(Corrected::Ok)
-    }
-}
-
-impl ContactState {
-    /// The state at the start of a run: no forces, the gaps of the initial geometry
-    /// (displacements `u`).
-    pub fn initial(model: &Model, u: &[f64]) -> ContactState {
-        let mut out = ContactState {
-            pairs: vec![PairRecord::default(); model.contacts.len()],
-            ..Default::default()
-        };
-        if model.contacts.is_empty() {
-            return out;
-        }
-        let coords = &model.mesh.coords;
-        let mut cands = Vec::new();
-        detect(
-            &model.contacts,
-            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            &mut cands,
-        );
-        out.gap = vec![f64::NAN; model.mesh.n_nodes()];
-        out.pressure = vec![0.0; model.mesh.n_nodes()];
-        for c in &cands {
-            let g = &mut out.gap[c.slave];
-            *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
-            let rec = &mut out.pairs[c.pair];
-            rec.penetration = rec.penetration.max(-c.gap);
-        }
-        out
     }
 }

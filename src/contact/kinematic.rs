@@ -22,15 +22,11 @@ use rstar::primitives::{GeomWithData, Line};
 use rstar::RTree;
 
 use super::collision::node_segment;
-use super::implicit::{ContactState, PairRecord};
 use super::qp::{on_active_set, solve_by_active_set, DualQp};
 use super::rows::Candidate;
+use super::state::{ContactState, Key, PairRecord};
 use crate::error::{Error, Result};
 use crate::model::{Master, Model};
-
-/// Key of a contact row: pair, side, slave node, master segment (`usize::MAX` for a
-/// rigid line), as in the implicit path.
-type Key = (usize, usize, usize, usize);
 
 /// Sweeps of the end-of-step projection.
 const PROJECTION_SWEEPS: usize = 4;

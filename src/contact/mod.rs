@@ -23,10 +23,12 @@ pub mod kinematic;
 pub mod mortar;
 mod qp;
 pub mod rows;
+pub mod state;
 pub mod sweep;
 
-pub use implicit::{ContactCorrection, ContactState, PairRecord};
+pub use implicit::ContactCorrection;
 pub use rows::{gap_matrix, Candidate, Contactee};
+pub use state::{ContactState, PairRecord};
 
 /// The tributary area (length × thickness) of every node as a slave, for contact
 /// pressures: half of every element edge joining two slave nodes of a side.

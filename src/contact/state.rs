@@ -1,0 +1,86 @@
+//! The contact state a step leaves, shared by both paths: the multipliers by key
+//! (the implicit path's first guess of the next step), the per-pair record that
+//! `history.csv` and `summary.json` read, and the nodal fields of the VTK output
+//! (gap, pressure, friction traction, slip path).
+
+use super::detect::detect;
+use crate::model::Model;
+
+/// Key of a constraint across re-linearisations: pair, side, slave node, master
+/// segment (`rows::Candidate::key`).
+pub type Key = (usize, usize, usize, usize);
+
+/// One pair's contact at the end of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct PairRecord {
+    /// Total normal force `Σ λ` (N).
+    pub force: f64,
+    /// Active constraints (nodes pressed against the master).
+    pub active: usize,
+    /// Largest penetration (m), zero when none.
+    pub penetration: f64,
+    /// Total tangential (friction) force `Σ λ_T` on the slaves, along each row's
+    /// tangent (N).
+    pub tangential_force: f64,
+    /// Total magnitude of the tangential forces `Σ |λ_T|` (N): the net force above
+    /// cancels where a symmetric body slides outwards on both sides.
+    pub tangential_magnitude: f64,
+    /// Pressed nodes of a frictional pair that stick (`|λ_T| < μ λ_N`).
+    pub sticking: usize,
+    /// Pressed nodes of a frictional pair that slip (on the cone).
+    pub slipping: usize,
+    /// The longest slip path of a pressed node of the pair so far (m).
+    pub max_slip: f64,
+}
+
+/// The contact state a step leaves: kept in `time::State`, so a cut-back restores
+/// it with the rest.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ContactState {
+    /// The positive multipliers (N), by key (the active constraints are those above
+    /// a millionth of the largest).
+    pub active: Vec<(Key, f64)>,
+    /// Per pair.
+    pub pairs: Vec<PairRecord>,
+    /// Gap at each node (m); NaN where the node is no candidate.
+    pub gap: Vec<f64>,
+    /// Contact pressure at each node (Pa): its force over its tributary area.
+    pub pressure: Vec<f64>,
+    /// The tangential multipliers (N) of the frictional rows, by key.
+    pub tangential: Vec<(Key, f64)>,
+    /// Tangential traction at each node (Pa), along its row's tangent.
+    pub traction: Vec<f64>,
+    /// Slip path of each node (m): the sum of the magnitudes of its relative
+    /// tangential displacement over the steps it was pressed in.
+    pub slip: Vec<f64>,
+}
+
+impl ContactState {
+    /// The state at the start of a run: no forces, the gaps of the initial geometry
+    /// (displacements `u`).
+    pub fn initial(model: &Model, u: &[f64]) -> ContactState {
+        let mut out = ContactState {
+            pairs: vec![PairRecord::default(); model.contacts.len()],
+            ..Default::default()
+        };
+        if model.contacts.is_empty() {
+            return out;
+        }
+        let coords = &model.mesh.coords;
+        let mut cands = Vec::new();
+        detect(
+            &model.contacts,
+            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+            &mut cands,
+        );
+        out.gap = vec![f64::NAN; model.mesh.n_nodes()];
+        out.pressure = vec![0.0; model.mesh.n_nodes()];
+        for c in &cands {
+            let g = &mut out.gap[c.slave];
+            *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
+            let rec = &mut out.pairs[c.pair];
+            rec.penetration = rec.penetration.max(-c.gap);
+        }
+        out
+    }
+}
