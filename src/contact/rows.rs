@@ -204,22 +204,7 @@ pub fn gap_matrix(
     columns: &[usize],
     ncols: usize,
 ) -> nalgebra_sparse::CsrMatrix<f64> {
-    let mut offsets = Vec::with_capacity(cands.len() + 1);
-    let mut cols = Vec::with_capacity(6 * cands.len());
-    let mut values = Vec::with_capacity(6 * cands.len());
-    offsets.push(0);
-    for c in cands {
-        gap_row(c.row(), columns, &mut cols, &mut values);
-        offsets.push(cols.len());
-    }
-    nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(
-        cands.len(),
-        ncols,
-        offsets,
-        cols,
-        values,
-    )
-    .expect("distinct in-range columns per row")
+    rows_matrix(cands, columns, ncols, false)
 }
 
 /// The gap rows of `cands` followed by their tangential rows (rows `cands.len() + i`),
@@ -229,26 +214,33 @@ pub fn gap_and_tangent_matrix(
     columns: &[usize],
     ncols: usize,
 ) -> nalgebra_sparse::CsrMatrix<f64> {
-    let mut offsets = Vec::with_capacity(2 * cands.len() + 1);
-    let mut cols = Vec::with_capacity(2 * ROW_NODES * cands.len());
-    let mut values = Vec::with_capacity(2 * ROW_NODES * cands.len());
+    rows_matrix(cands, columns, ncols, true)
+}
+
+/// The gap rows, and the tangential rows after them when `tangents`.
+fn rows_matrix(
+    cands: &[Candidate],
+    columns: &[usize],
+    ncols: usize,
+    tangents: bool,
+) -> nalgebra_sparse::CsrMatrix<f64> {
+    let n = if tangents { 2 } else { 1 } * cands.len();
+    let mut offsets = Vec::with_capacity(n + 1);
+    let mut cols = Vec::with_capacity(6 * n);
+    let mut values = Vec::with_capacity(6 * n);
     offsets.push(0);
     for c in cands {
         gap_row(c.row(), columns, &mut cols, &mut values);
         offsets.push(cols.len());
     }
-    for c in cands {
-        gap_row(c.tangent_row(), columns, &mut cols, &mut values);
-        offsets.push(cols.len());
+    if tangents {
+        for c in cands {
+            gap_row(c.tangent_row(), columns, &mut cols, &mut values);
+            offsets.push(cols.len());
+        }
     }
-    nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(
-        2 * cands.len(),
-        ncols,
-        offsets,
-        cols,
-        values,
-    )
-    .expect("distinct in-range columns per row")
+    nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(n, ncols, offsets, cols, values)
+        .expect("distinct in-range columns per row")
 }
 
 /// Appends one row's entries, summed by column, leaving out dofs without a column.
