@@ -424,7 +424,11 @@ pub fn write_matrices(model: &Model, dir: &std::path::Path) -> Result<Vec<std::p
     if !model.contacts.is_empty() {
         let mut cands = Vec::new();
         let coords = &model.mesh.coords;
-        crate::contact::detect::detect(&model.contacts, |nd| coords[nd], &mut cands);
+        crate::contact::detect::detect(
+            &model.contacts,
+            |nd| crate::mesh::xy(coords[nd]),
+            &mut cands,
+        );
         let all: Vec<usize> = (0..n).collect();
         let g = crate::contact::gap_matrix(&cands, &all, n);
         let path = dir.join("G.mtx");

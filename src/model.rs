@@ -381,9 +381,10 @@ impl Model {
     /// Initial velocity field (per dof) from the bodies' velocities.
     pub fn initial_velocity(&self) -> Vec<f64> {
         let mut v = vec![0.0; self.mesh.n_dofs()];
+        let d = self.mesh.dim;
         for (n, &b) in self.mesh.node_body.iter().enumerate() {
-            v[2 * n] = self.bodies[b].velocity[0];
-            v[2 * n + 1] = self.bodies[b].velocity[1];
+            v[d * n] = self.bodies[b].velocity[0];
+            v[d * n + 1] = self.bodies[b].velocity[1];
         }
         for c in &self.constraints {
             v[c.dof] = 0.0;
@@ -396,10 +397,11 @@ impl Model {
     /// Where dof `d` sits, for messages: node, coordinates, body, one element
     /// holding it, component.
     pub fn describe_dof(&self, d: usize) -> String {
+        let dim = self.mesh.dim;
         format!(
             "{}, component {}",
-            self.describe_node(d / 2),
-            if d % 2 == 0 { "x" } else { "y" }
+            self.describe_node(d / dim),
+            ["x", "y", "z"][d % dim]
         )
     }
 

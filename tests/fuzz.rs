@@ -553,7 +553,7 @@ fn apply_gmsh(bytes: &[u8], m: &GmshMutation) -> Vec<u8> {
 fn exercise_gmsh(
     bytes: &[u8],
     keeps_geometry: bool,
-    reference: &std::collections::HashMap<u64, [f64; 2]>,
+    reference: &std::collections::HashMap<u64, [f64; 3]>,
     scale: u64,
 ) -> Result<(), String> {
     let part = match rothe::mesh::gmsh::parse(bytes).and_then(|p| p.check().map(|_| p)) {
@@ -584,7 +584,7 @@ fn mutated_gmsh_files_read_right_or_are_refused() {
     std::panic::set_hook(Box::new(|_| {}));
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plate_tri.msh");
     let original = std::fs::read(&path).unwrap();
-    let reference: std::collections::HashMap<u64, [f64; 2]> = {
+    let reference: std::collections::HashMap<u64, [f64; 3]> = {
         let p = rothe::mesh::gmsh::parse(&original).unwrap();
         p.node_tags.unwrap().into_iter().zip(p.coords).collect()
     };

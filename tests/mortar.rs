@@ -87,7 +87,7 @@ fn patch(lower: usize, upper: usize, formulation: &str) -> (f64, f64) {
     let stress = cell_stress(&m, &s.u, &points);
     let stress_error = stress
         .iter()
-        .map(|[sxx, syy, sxy]| (sxx.abs()).max((syy + p).abs()).max(sxy.abs()) / p)
+        .map(|s| (s[0].abs()).max((s[1] + p).abs()).max(s[2].abs()) / p)
         .fold(0.0, f64::max);
     let pressed: Vec<f64> = s
         .contact

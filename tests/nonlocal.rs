@@ -113,7 +113,7 @@ fn softening_bar(nx: usize, radius: Option<f64>) -> BarResult {
     let block = &model.mesh.blocks[0];
     let mut dens: Vec<(f64, f64)> = Vec::new();
     for e in 0..block.elements.len() {
-        let x: Vec<[f64; 2]> = block
+        let x: Vec<[f64; 3]> = block
             .elements
             .element(e)
             .iter()

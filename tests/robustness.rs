@@ -405,7 +405,7 @@ fn plate(name: &str) -> Vec<u8> {
 }
 
 /// The coordinates of every node of `part` by its Gmsh tag.
-fn by_tag(part: &rothe::mesh::Part) -> std::collections::BTreeMap<u64, [f64; 2]> {
+fn by_tag(part: &rothe::mesh::Part) -> std::collections::BTreeMap<u64, [f64; 3]> {
     let tags = part.node_tags.as_ref().unwrap();
     tags.iter()
         .copied()
@@ -443,7 +443,7 @@ fn gmsh_nodes_get_their_own_coordinates_whatever_the_order_of_their_tags() {
     // The geometry is where the file says it is: every node of `hole` on the circle,
     // of `left` at x = 0, of `right` at x = 2.
     for &n in &ascii.node_sets["hole"] {
-        let [x, y] = ascii.coords[n];
+        let [x, y, _] = ascii.coords[n];
         assert!(((x - 1.0).hypot(y - 0.5) - 0.2).abs() < 1e-9, "{x}, {y}");
     }
     assert!(ascii.node_sets["left"]
@@ -518,7 +518,7 @@ fn gmsh_nodes_get_their_own_coordinates_whatever_the_order_of_their_tags() {
     }
     rebuilt += &text[text.find("$EndElements\n").unwrap() + "$EndElements\n".len()..];
     let part = rothe::mesh::gmsh::parse(rebuilt.as_bytes()).unwrap();
-    let tens: std::collections::BTreeMap<u64, [f64; 2]> =
+    let tens: std::collections::BTreeMap<u64, [f64; 3]> =
         reference.iter().map(|(t, x)| (10 * t, *x)).collect();
     assert_eq!(by_tag(&part), tens);
     assert_eq!(part.node_sets, ascii.node_sets);

@@ -201,7 +201,7 @@ fn the_two_thread_solve_gives_the_sequential_one() {
     let a = w1(60);
     let dofs =
         rothe::system::DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let xy: Vec<[f64; 2]> = dofs
+    let xy: Vec<[f64; 3]> = dofs
         .free
         .iter()
         .map(|&d| model.mesh.coords[d / 2])

@@ -50,7 +50,7 @@ fn patch_test(kind: ElementKind) {
     prescribe(&mut model, &boundary, 1, |x| exact(x)[1]);
     let sol = &statics::solve(&model, Backend::Faer, &[1.0]).unwrap()[0];
     for (n, x) in model.mesh.coords.iter().enumerate() {
-        let e = exact(*x);
+        let e = exact([x[0], x[1]]);
         assert!((sol.u[2 * n] - e[0]).abs() < 1e-14, "node {n} ux");
         assert!((sol.u[2 * n + 1] - e[1]).abs() < 1e-14, "node {n} uy");
     }
@@ -116,7 +116,7 @@ fn cantilever_static_vs_timoshenko() {
         );
         model.loads.push(load_from(&f, TimeFunction::Constant));
         let sol = &statics::solve(&model, Backend::Faer, &[1.0]).unwrap()[0];
-        let tip = model.mesh.nearest_node([l, h / 2.0]).unwrap();
+        let tip = model.mesh.nearest_node([l, h / 2.0, 0.0]).unwrap();
         errs.push((-sol.u[2 * tip + 1] - delta).abs() / delta);
     }
     assert!(errs[0] > errs[1] && errs[1] > errs[2], "errors {errs:?}");
@@ -194,7 +194,7 @@ fn mms_orders(kind: ElementKind) -> (Vec<f64>, Vec<f64>) {
         let block = &model.mesh.blocks[0];
         for el in 0..block.elements.len() {
             let nodes = block.elements.element(el);
-            let x: Vec<[f64; 2]> = nodes.iter().map(|&n| model.mesh.coords[n]).collect();
+            let x: Vec<[f64; 3]> = nodes.iter().map(|&n| model.mesh.coords[n]).collect();
             for &(xi, w) in accurate_rule(kind) {
                 let k = kinematics(kind, &x, xi);
                 let (mut p, mut uh, mut gh) = ([0.0; 2], [0.0; 2], [[0.0; 2]; 2]);

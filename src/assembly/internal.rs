@@ -179,12 +179,12 @@ fn element_points<F>(
     trial: Option<TrialOut>,
     mut point: F,
 ) where
-    F: FnMut(f64, &PointResponse, Option<&crate::fe::PointKinematics>, &[[f64; 2]], [f64; 3]),
+    F: FnMut(f64, &PointResponse, Option<&crate::fe::PointKinematics>, &[[f64; 3]], [f64; 3]),
 {
     let (x, ue, nn) = gather(cx.mesh, nodes, u);
     if cx.kind == ElementKind::Bar2 {
         let g = e;
-        let eps = element::bar_strain(&x[..2], &ue[..4]);
+        let eps = element::bar_strain(&x[..2], 2, &ue[..4]);
         let eps_n = if cx.at_rest { eps } else { committed.eps(g)[0] };
         let de = eps - eps_n;
         let (_, l) = element::bar_axis(&x[..2]);
@@ -271,10 +271,12 @@ fn element_points<F>(
     }
 }
 
-/// The coordinates and displacements of an element's nodes, and their number.
+/// The coordinates and displacements of an element's nodes, and their number (plane
+/// elements: the Gauss-point pass is the plane's; solids of constant tangent take
+/// the nodal path, `time::nodal`).
 #[inline(always)]
-pub(crate) fn gather(mesh: &Mesh, nodes: &[usize], u: &[f64]) -> ([[f64; 2]; 4], [f64; 8], usize) {
-    let mut x = [[0.0; 2]; 4];
+pub(crate) fn gather(mesh: &Mesh, nodes: &[usize], u: &[f64]) -> ([[f64; 3]; 4], [f64; 8], usize) {
+    let mut x = [[0.0; 3]; 4];
     let mut ue = [0.0; 8];
     for (a, &n) in nodes.iter().enumerate() {
         x[a] = mesh.coords[n];
@@ -297,7 +299,7 @@ fn write3(out: &mut [f64], v: &[f64; 3]) {
 #[inline]
 fn add_point_tangent(
     k: Option<&crate::fe::PointKinematics>,
-    x: &[[f64; 2]],
+    x: &[[f64; 3]],
     nn: usize,
     w: f64,
     d: &[[f64; 3]; 3],
@@ -305,7 +307,7 @@ fn add_point_tangent(
 ) {
     match k {
         Some(k) => element::add_btdb(k, nn, d, w, ke),
-        None => element::bar_stiffness(x, d[0][0] * w / element::bar_axis(x).1, ke),
+        None => element::bar_stiffness(x, 2, d[0][0] * w / element::bar_axis(x).1, ke),
     }
 }
 
@@ -313,7 +315,7 @@ fn add_point_tangent(
 #[inline]
 fn add_bt_sigma(
     k: Option<&crate::fe::PointKinematics>,
-    x: &[[f64; 2]],
+    x: &[[f64; 3]],
     nn: usize,
     w: f64,
     sigma: &[f64; 3],

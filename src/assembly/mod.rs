@@ -11,7 +11,8 @@ pub mod pattern;
 
 use rayon::prelude::*;
 
-use crate::fe::{element, Plane};
+use crate::fe::element::{self, Voigt};
+use crate::fe::{Plane, MAX_ELEMENT_DOFS, MAX_NODES};
 use crate::material::Material;
 use crate::mesh::{ElementKind, Mesh};
 pub use pattern::{Pattern, Stored};
@@ -40,15 +41,19 @@ impl ConsistentMass {
     /// The mass with `values` on `pattern`, its node-pair form found exactly (each
     /// block's off-diagonal entries zero and its diagonal entries equal).
     pub fn new(pattern: &Pattern, values: Vec<f64>) -> Self {
+        let d = pattern.dim;
         let pairs = (0..pattern.n_nodes)
             .into_par_iter()
             .map(|n| {
                 let len = pattern.adj_ptr[n + 1] - pattern.adj_ptr[n];
-                let (c0, c1) = pattern.node_columns(&values, n);
+                let cols = pattern.node_columns(&values, n);
                 (0..len)
                     .map(|k| {
-                        let (a, b) = (c0[2 * k], c1[2 * k + 1]);
-                        (a == b && c0[2 * k + 1] == 0.0 && c1[2 * k] == 0.0).then_some(a)
+                        let a = cols[0][d * k];
+                        let is_pair = (0..d).all(|j| {
+                            (0..d).all(|i| cols[j][d * k + i] == if i == j { a } else { 0.0 })
+                        });
+                        is_pair.then_some(a)
                     })
                     .collect::<Option<Vec<f64>>>()
             })
@@ -196,10 +201,10 @@ impl Assembler {
     }
 
     /// Assembles `Σ_e element(block, e, x_e, out)` where `out` is the row-major element
-    /// matrix (`2nn x 2nn`) of element `e`.
+    /// matrix (`d nn x d nn`, `d` the mesh's dimension) of element `e`.
     pub fn assemble<F>(&self, mesh: &Mesh, element: F) -> Vec<f64>
     where
-        F: Fn(usize, usize, &[[f64; 2]], &mut [f64]) + Sync,
+        F: Fn(usize, usize, &[[f64; 3]], &mut [f64]) + Sync,
     {
         let mut values = crate::memory::zeroed(self.pattern.nnz());
         let shared = SharedValues(values.as_mut_ptr());
@@ -207,11 +212,12 @@ impl Assembler {
             let nn = block.elements.kind.nodes();
             for colour in &self.colours[bi] {
                 colour.par_chunks(256).for_each(|chunk| {
-                    // Capture the whole wrapper (Send + Sync), not its raw-pointer field.
+                    // Rebind the whole wrapper (not its raw-pointer field) so the closure
+                    // captures a `Sync` value under edition-2021 disjoint captures.
                     #[allow(clippy::redundant_locals)]
                     let shared = shared;
-                    let mut ke = [0.0; 64];
-                    let mut x = [[0.0; 2]; 4];
+                    let mut ke = [0.0; MAX_ELEMENT_DOFS * MAX_ELEMENT_DOFS];
+                    let mut x = [[0.0; 3]; MAX_NODES];
                     for &e in chunk {
                         let nodes = block.elements.element(e);
                         for (a, &n) in nodes.iter().enumerate() {
@@ -226,23 +232,35 @@ impl Assembler {
         values
     }
 
+    /// Adds the element matrix `ke` (row-major, `d nn x d nn`) of `nodes` into the
+    /// values behind `shared`.
+    ///
+    /// The caller guarantees that no other thread adds to the columns of `nodes`
+    /// at the same time (elements of one colour share no node).
     #[inline]
     pub(crate) fn scatter(&self, nodes: &[usize], ke: &[f64], shared: SharedValues) {
+        match self.pattern.dim {
+            3 => self.scatter_d::<3>(nodes, ke, shared),
+            _ => self.scatter_d::<2>(nodes, ke, shared),
+        }
+    }
+
+    #[inline]
+    fn scatter_d<const D: usize>(&self, nodes: &[usize], ke: &[f64], shared: SharedValues) {
         let nn = nodes.len();
-        let nd = 2 * nn;
+        let nd = D * nn;
         let p = &self.pattern;
         for (b, &nb) in nodes.iter().enumerate() {
-            let c0 = p.col_start(nb, 0);
-            let c1 = p.col_start(nb, 1);
+            let c: [usize; D] = std::array::from_fn(|j| p.col_start(nb, j));
             for (a, &na) in nodes.iter().enumerate() {
-                let k = 2 * p.rank(nb, na);
-                // SAFETY: columns of node `nb` are written only by elements holding
-                // `nb`, and no two elements of the running colour share a node.
-                unsafe {
-                    *shared.0.add(c0 + k) += ke[2 * a * nd + 2 * b];
-                    *shared.0.add(c0 + k + 1) += ke[(2 * a + 1) * nd + 2 * b];
-                    *shared.0.add(c1 + k) += ke[2 * a * nd + 2 * b + 1];
-                    *shared.0.add(c1 + k + 1) += ke[(2 * a + 1) * nd + 2 * b + 1];
+                let k = D * p.rank(nb, na);
+                for (j, &cj) in c.iter().enumerate() {
+                    for i in 0..D {
+                        // SAFETY: the caller holds the columns of `nodes` exclusively.
+                        unsafe {
+                            *shared.0.add(cj + k + i) += ke[(D * a + i) * nd + D * b + j];
+                        }
+                    }
                 }
             }
         }
@@ -250,12 +268,22 @@ impl Assembler {
 
     /// Elastic stiffness `K` (bars: `EA/L` along the axis).
     pub fn stiffness(&self, mesh: &Mesh, materials: &[Material], plane: Plane) -> Vec<f64> {
+        if mesh.dim == 3 {
+            let ds: Vec<_> = materials.iter().map(|m| m.c_solid()).collect();
+            return self.elastic_matrix(mesh, materials, &ds);
+        }
         let ds: Vec<[[f64; 3]; 3]> = materials.iter().map(|m| m.c(plane)).collect();
+        self.elastic_matrix(mesh, materials, &ds)
+    }
+
+    /// `Σ ∫ Bᵀ D B t dA` with the elasticity `ds[material]`, bars `E A / L`.
+    fn elastic_matrix<D: Voigt>(&self, mesh: &Mesh, materials: &[Material], ds: &[D]) -> Vec<f64> {
+        let dim = mesh.dim;
         self.assemble(mesh, |bi, _e, x, ke| {
             let block = &mesh.blocks[bi];
             let mat = &materials[block.material];
             match block.elements.kind {
-                ElementKind::Bar2 => element::bar_stiffness(x, mat.e * block.section, ke),
+                ElementKind::Bar2 => element::bar_stiffness(x, dim, mat.e * block.section, ke),
                 kind => {
                     element::continuum_stiffness(kind, x, &ds[block.material], block.section, ke)
                 }
@@ -265,11 +293,12 @@ impl Assembler {
 
     /// A stiffness-like matrix `∫ Bᵀ D B t dA` with one `D` per material (bars skipped),
     /// for viscosity matrices and the like.
-    pub fn continuum_matrix(&self, mesh: &Mesh, d_of_material: &[[[f64; 3]; 3]]) -> Vec<f64> {
+    pub fn continuum_matrix<D: Voigt>(&self, mesh: &Mesh, d_of_material: &[D]) -> Vec<f64> {
+        let nd = 2 * mesh.dim;
         self.assemble(mesh, |bi, _e, x, ke| {
             let block = &mesh.blocks[bi];
             match block.elements.kind {
-                ElementKind::Bar2 => ke[..16].fill(0.0),
+                ElementKind::Bar2 => ke[..nd * nd].fill(0.0),
                 kind => element::continuum_stiffness(
                     kind,
                     x,
@@ -283,11 +312,12 @@ impl Assembler {
 
     /// Mass matrix, consistent or row-sum lumped.
     pub fn mass(&self, mesh: &Mesh, materials: &[Material], lumped: bool) -> Mass {
+        let dim = mesh.dim;
         let consistent = self.assemble(mesh, |bi, _e, x, me| {
             let block = &mesh.blocks[bi];
             let rho = materials[block.material].rho;
             match block.elements.kind {
-                ElementKind::Bar2 => element::bar_mass(x, rho * block.section, me),
+                ElementKind::Bar2 => element::bar_mass(x, dim, rho * block.section, me),
                 kind => element::continuum_mass(kind, x, rho * block.section, me),
             }
         });

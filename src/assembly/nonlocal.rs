@@ -65,7 +65,7 @@ fn point_geometry(mesh: &Mesh, bi: usize, e: usize, q: usize) -> ([f64; 2], f64)
     let block = &mesh.blocks[bi];
     let kind = block.elements.kind;
     let nodes = block.elements.element(e);
-    let mut x = [[0.0; 2]; 4];
+    let mut x = [[0.0; 3]; 4];
     for (a, &n) in nodes.iter().enumerate() {
         x[a] = mesh.coords[n];
     }

@@ -1,21 +1,25 @@
 //! The sparsity pattern of all global matrices, built once from the connectivity.
 //!
 //! Storage is node-blocked compressed columns over all dofs (full symmetric storage):
-//! column `2n+j` (node `n`, component `j`) holds, for each neighbour `m` of `n` in
-//! ascending order, the rows `2m` and `2m+1`. Row indices are therefore never stored:
-//! they follow from the node adjacency, and the position of `(2m+i, 2n+j)` is
-//! `col_ptr[2n+j] + 2k + i` with `k` the rank of `m` among the neighbours of `n`.
-//! Mass and stiffness share one pattern.
+//! with `d` dofs per node (the mesh's dimension), column `d n + j` (node `n`,
+//! component `j`) holds, for each neighbour `m` of `n` in ascending order, the rows
+//! `d m .. d m + d`. Row indices are therefore never stored: they follow from the
+//! node adjacency, and the position of `(d m + i, d n + j)` is
+//! `col_ptr[d n + j] + d k + i` with `k` the rank of `m` among the neighbours of
+//! `n`. Mass and stiffness share one pattern. The products are written once for a
+//! dimension `D` (a const parameter) and dispatched on the pattern's `dim`.
 
 use rayon::prelude::*;
 
 use crate::mesh::Mesh;
 
-/// Node-blocked sparsity pattern shared by the mass and stiffness matrices.
+/// Node-blocked symmetric sparsity pattern (see the module docs).
 #[derive(Clone, Debug)]
 pub struct Pattern {
     /// Number of nodes.
     pub n_nodes: usize,
+    /// Dofs per node (the mesh's dimension, 2 or 3).
+    pub dim: usize,
     /// Offsets into `adj` per node (`n_nodes + 1`).
     pub adj_ptr: Vec<usize>,
     /// Sorted neighbour lists (each node is its own neighbour).
@@ -69,6 +73,7 @@ impl Pattern {
         }
         Pattern {
             n_nodes: n,
+            dim: mesh.dim,
             adj_ptr,
             adj,
         }
@@ -76,21 +81,22 @@ impl Pattern {
 
     /// Number of dofs.
     pub fn n_dofs(&self) -> usize {
-        2 * self.n_nodes
+        self.dim * self.n_nodes
     }
 
-    /// Number of stored entries (full symmetric storage).
+    /// Number of stored values (`d²` per node pair).
     pub fn nnz(&self) -> usize {
-        4 * self.adj.len()
+        self.dim * self.dim * self.adj.len()
     }
 
-    /// Start of column `2n + j`.
+    /// Start of column `d n + j` in the value array.
     #[inline]
     pub fn col_start(&self, n: usize, j: usize) -> usize {
-        4 * self.adj_ptr[n] + 2 * j * (self.adj_ptr[n + 1] - self.adj_ptr[n])
+        let d = self.dim;
+        d * d * self.adj_ptr[n] + d * j * (self.adj_ptr[n + 1] - self.adj_ptr[n])
     }
 
-    /// Rank of node `m` among the neighbours of `n` (panics if not a neighbour).
+    /// Rank of node `m` among the neighbours of node `n`.
     #[inline]
     pub fn rank(&self, n: usize, m: usize) -> usize {
         let l = &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]];
@@ -99,45 +105,61 @@ impl Pattern {
             .expect("node pair outside the sparsity pattern")
     }
 
-    /// Position of entry `(2m+i, 2n+j)` in a value array.
+    /// Position of entry `(d m + i, d n + j)` in the value array.
     #[inline]
     pub fn position(&self, m: usize, i: usize, n: usize, j: usize) -> usize {
-        self.col_start(n, j) + 2 * self.rank(n, m) + i
+        self.col_start(n, j) + self.dim * self.rank(n, m) + i
     }
 
-    /// `y = A x` for a matrix stored on this pattern (symmetric, full storage),
-    /// in parallel over nodes.
+    /// `y = A x` for a matrix stored on this pattern (symmetric storage, so row
+    /// `d n + j` is column `d n + j`). Parallel over nodes, one node's rows per task.
     pub fn matvec(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
-        y.par_chunks_mut(2).enumerate().for_each(|(n, yn)| {
-            let (c0, c1) = self.node_columns(a, n);
-            let (mut s0, mut s1) = (0.0, 0.0);
+        match self.dim {
+            3 => self.matvec_d::<3>(a, x, y),
+            _ => self.matvec_d::<2>(a, x, y),
+        }
+    }
+
+    fn matvec_d<const D: usize>(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
+        y.par_chunks_mut(D).enumerate().for_each(|(n, yn)| {
+            let cols = self.node_columns_d::<D>(a, n);
+            let mut s = [0.0; D];
             for (k, &m) in self.neighbours(n).iter().enumerate() {
-                let (p, q) = block_terms(c0, c1, k, x, m);
-                s0 += p;
-                s1 += q;
+                let t = block_terms::<D>(&cols, k, x, m);
+                for j in 0..D {
+                    s[j] += t[j];
+                }
             }
-            (yn[0], yn[1]) = (s0, s1);
+            yn.copy_from_slice(&s);
         });
     }
 
-    /// `y = M x` for a matrix whose 2×2 node blocks are `m_k I`, `m` holding one
-    /// value per node pair in adjacency order (the sums of [`Self::matvec`] on the
-    /// full values, whose zero entries add nothing).
+    /// `y = M x` for a matrix whose node blocks are all `m_nk I` (see
+    /// [`crate::assembly::ConsistentMass`]), `m` one value per node pair.
     pub fn matvec_pairs(&self, m: &[f64], x: &[f64], y: &mut [f64]) {
-        y.par_chunks_mut(2).enumerate().for_each(|(n, yn)| {
+        match self.dim {
+            3 => self.matvec_pairs_d::<3>(m, x, y),
+            _ => self.matvec_pairs_d::<2>(m, x, y),
+        }
+    }
+
+    fn matvec_pairs_d<const D: usize>(&self, m: &[f64], x: &[f64], y: &mut [f64]) {
+        y.par_chunks_mut(D).enumerate().for_each(|(n, yn)| {
             let lo = self.adj_ptr[n];
-            let (mut s0, mut s1) = (0.0, 0.0);
+            let mut s = [0.0; D];
             for (k, &j) in self.neighbours(n).iter().enumerate() {
-                let (p, q) = pair_terms(m[lo + k], x, j);
-                s0 += p;
-                s1 += q;
+                let t = pair_terms::<D>(m[lo + k], x, j);
+                for i in 0..D {
+                    s[i] += t[i];
+                }
             }
-            (yn[0], yn[1]) = (s0, s1);
+            yn.copy_from_slice(&s);
         });
     }
 
-    /// `y = A x` and `z = B w` in one pass over the pattern (the adjacency and each
-    /// neighbour read once for both), `B` on the pattern or in node-pair form.
+    /// `y = A x` and `z = B w` in one pass over the pattern (both matrices on it):
+    /// the adjacency is read once for two products. Each output is summed in the
+    /// order of [`Pattern::matvec`], so both equal separate products bit for bit.
     pub fn matvec2(
         &self,
         a: &[f64],
@@ -147,14 +169,15 @@ impl Pattern {
         w: &[f64],
         z: &mut [f64],
     ) {
-        match b {
-            Stored::Full(b) => self.fused::<false>(a, x, y, b, w, z),
-            Stored::Pairs(m) => self.fused::<true>(a, x, y, m, w, z),
+        match (self.dim, b) {
+            (3, Stored::Full(b)) => self.fused::<3, false>(a, x, y, b, w, z),
+            (3, Stored::Pairs(m)) => self.fused::<3, true>(a, x, y, m, w, z),
+            (_, Stored::Full(b)) => self.fused::<2, false>(a, x, y, b, w, z),
+            (_, Stored::Pairs(m)) => self.fused::<2, true>(a, x, y, m, w, z),
         }
     }
 
-    /// [`Self::matvec2`] with `b` in node-pair form if `PAIRS`, else on the pattern.
-    fn fused<const PAIRS: bool>(
+    fn fused<const D: usize, const PAIRS: bool>(
         &self,
         a: &[f64],
         x: &[f64],
@@ -163,75 +186,88 @@ impl Pattern {
         w: &[f64],
         z: &mut [f64],
     ) {
-        y.par_chunks_mut(2)
-            .zip(z.par_chunks_mut(2))
+        y.par_chunks_mut(D)
+            .zip(z.par_chunks_mut(D))
             .enumerate()
             .for_each(|(n, (yn, zn))| {
                 let lo = self.adj_ptr[n];
-                let (a0, a1) = self.node_columns(a, n);
-                let (b0, b1) = if PAIRS {
-                    (&[][..], &[][..])
+                let ac = self.node_columns_d::<D>(a, n);
+                let bc = if PAIRS {
+                    [&[][..]; D]
                 } else {
-                    self.node_columns(b, n)
+                    self.node_columns_d::<D>(b, n)
                 };
-                let (mut s0, mut s1, mut t0, mut t1) = (0.0, 0.0, 0.0, 0.0);
+                let (mut s, mut t) = ([0.0; D], [0.0; D]);
                 for (k, &j) in self.neighbours(n).iter().enumerate() {
-                    let (p, q) = block_terms(a0, a1, k, x, j);
-                    s0 += p;
-                    s1 += q;
-                    let (p, q) = if PAIRS {
-                        pair_terms(b[lo + k], w, j)
+                    let p = block_terms::<D>(&ac, k, x, j);
+                    for i in 0..D {
+                        s[i] += p[i];
+                    }
+                    let q = if PAIRS {
+                        pair_terms::<D>(b[lo + k], w, j)
                     } else {
-                        block_terms(b0, b1, k, w, j)
+                        block_terms::<D>(&bc, k, w, j)
                     };
-                    t0 += p;
-                    t1 += q;
+                    for i in 0..D {
+                        t[i] += q[i];
+                    }
                 }
-                (yn[0], yn[1], zn[0], zn[1]) = (s0, s1, t0, t1);
+                yn.copy_from_slice(&s);
+                zn.copy_from_slice(&t);
             });
     }
 
-    /// The neighbours of node `n` (itself included), ascending.
     #[inline]
     fn neighbours(&self, n: usize) -> &[u32] {
         &self.adj[self.adj_ptr[n]..self.adj_ptr[n + 1]]
     }
 
-    /// The two columns of node `n` of a matrix `a` stored on this pattern.
+    /// The `d` stored columns of node `n` (each `d · neighbours` long).
     #[inline]
-    pub(crate) fn node_columns<'a>(&self, a: &'a [f64], n: usize) -> (&'a [f64], &'a [f64]) {
-        let len = 2 * (self.adj_ptr[n + 1] - self.adj_ptr[n]);
-        let c = 4 * self.adj_ptr[n];
-        (&a[c..c + len], &a[c + len..c + 2 * len])
+    pub(crate) fn node_columns<'a>(&self, a: &'a [f64], n: usize) -> Vec<&'a [f64]> {
+        let d = self.dim;
+        let len = d * (self.adj_ptr[n + 1] - self.adj_ptr[n]);
+        let c = d * d * self.adj_ptr[n];
+        (0..d).map(|j| &a[c + j * len..c + (j + 1) * len]).collect()
+    }
+
+    #[inline(always)]
+    fn node_columns_d<'a, const D: usize>(&self, a: &'a [f64], n: usize) -> [&'a [f64]; D] {
+        let len = D * (self.adj_ptr[n + 1] - self.adj_ptr[n]);
+        let c = D * D * self.adj_ptr[n];
+        std::array::from_fn(|j| &a[c + j * len..c + (j + 1) * len])
     }
 }
 
-/// How the second matrix of [`Pattern::matvec2`] is stored.
+/// A second matrix of [`Pattern::matvec2`]: full node blocks, or one value per node
+/// pair (`m I` blocks).
 #[derive(Clone, Copy, Debug)]
 pub enum Stored<'a> {
     /// Values on the pattern.
     Full(&'a [f64]),
-    /// One value per node pair (2×2 blocks `m_k I`), in adjacency order.
+    /// One value per node pair.
     Pairs(&'a [f64]),
 }
 
-/// The contributions of neighbour `m` (its `k`-th) to both rows of a node: the
-/// node's columns `c0, c1` times `x` at `m` (both of `x`'s values loaded once).
+/// The contributions of neighbour `m` (rank `k`) to the `D` rows of a node.
 #[inline(always)]
-fn block_terms(c0: &[f64], c1: &[f64], k: usize, x: &[f64], m: u32) -> (f64, f64) {
-    let m = 2 * m as usize;
-    let (x0, x1) = (x[m], x[m + 1]);
-    (
-        c0[2 * k] * x0 + c0[2 * k + 1] * x1,
-        c1[2 * k] * x0 + c1[2 * k + 1] * x1,
-    )
+fn block_terms<const D: usize>(cols: &[&[f64]; D], k: usize, x: &[f64], m: u32) -> [f64; D] {
+    let m = D * m as usize;
+    std::array::from_fn(|j| {
+        let c = &cols[j][D * k..D * k + D];
+        let mut s = c[0] * x[m];
+        for i in 1..D {
+            s += c[i] * x[m + i];
+        }
+        s
+    })
 }
 
-/// The contributions of neighbour `m` to both rows of a node for a block `mk I`.
+/// The contributions of neighbour `m` to the `D` rows of a node for a block `mk I`.
 #[inline(always)]
-fn pair_terms(mk: f64, x: &[f64], m: u32) -> (f64, f64) {
-    let m = 2 * m as usize;
-    (mk * x[m], mk * x[m + 1])
+fn pair_terms<const D: usize>(mk: f64, x: &[f64], m: u32) -> [f64; D] {
+    let m = D * m as usize;
+    std::array::from_fn(|i| mk * x[m + i])
 }
 
 /// Greedy colouring of the elements of one block so that no two elements of a colour

@@ -15,6 +15,22 @@ where
     exactly(v)
 }
 
+/// Reads a vector of two (a plane model's, `z = 0`) or three components into
+/// `[x, y, z]`; any other length is an error naming it.
+pub fn vector<'de, D>(d: D) -> Result<[f64; 3], D::Error>
+where
+    D: Deserializer<'de>,
+{
+    let v = Vec::<f64>::deserialize(d)?;
+    match v.len() {
+        2 => Ok([v[0], v[1], 0.0]),
+        3 => Ok([v[0], v[1], v[2]]),
+        n => Err(D::Error::custom(format!(
+            "expected a vector of 2 (plane) or 3 (solid) components, found {n}"
+        ))),
+    }
+}
+
 /// Reads an optional `[T; N]` (with `#[serde(default)]`).
 pub fn option_array<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
 where

@@ -502,8 +502,9 @@ pub struct BodySpec {
     pub name: String,
     /// Material name.
     pub material: String,
-    /// Thickness (m) of its elements.
-    pub thickness: f64,
+    /// Thickness (m) of its elements: required for plane bodies, absent for solids.
+    #[serde(default)]
+    pub thickness: Option<f64>,
     /// Initial velocity (m/s). Default at rest.
     #[serde(default)]
     #[serde(deserialize_with = "exact::array")]
@@ -546,6 +547,35 @@ pub enum MeshSpec {
         #[serde(default = "default_element")]
         element: ElementKind,
     },
+    /// Structured box of hexahedra or tetrahedra (a solid).
+    Box {
+        /// The corner of least coordinates. Default the origin.
+        #[serde(default)]
+        #[serde(deserialize_with = "exact::array")]
+        origin: [f64; 3],
+        /// Lengths along x, y and z.
+        #[serde(deserialize_with = "exact::array")]
+        size: [f64; 3],
+        /// Cells along x, y and z (equal cells). Give this, or `element_size` (here
+        /// or in `[meshing]`).
+        #[serde(default, deserialize_with = "exact::option_array")]
+        divisions: Option<[usize; 3]>,
+        /// Largest cell size (m), as the rectangle's.
+        #[serde(default)]
+        element_size: Option<f64>,
+        /// Grid planes along x the mesh must have (distances from `origin`).
+        #[serde(default)]
+        x_lines: Vec<f64>,
+        /// The same along y.
+        #[serde(default)]
+        y_lines: Vec<f64>,
+        /// The same along z.
+        #[serde(default)]
+        z_lines: Vec<f64>,
+        /// `hex8` (default) or `tet4`.
+        #[serde(default = "default_solid_element")]
+        element: ElementKind,
+    },
     /// Gmsh v4.1 file, relative to the scenario file.
     Gmsh {
         /// Path of the `.msh` file.
@@ -555,6 +585,10 @@ pub enum MeshSpec {
 
 fn default_element() -> ElementKind {
     ElementKind::Quad4
+}
+
+fn default_solid_element() -> ElementKind {
+    ElementKind::Hex8
 }
 
 /// Bars along a straight line through nodes of a body (perfect bond: shared nodes).
@@ -585,6 +619,19 @@ pub enum Component {
     X,
     /// Vertical.
     Y,
+    /// Out of the plane (solids only).
+    Z,
+}
+
+impl Component {
+    /// The component's index in a node's dofs.
+    pub fn index(self) -> usize {
+        match self {
+            Component::X => 0,
+            Component::Y => 1,
+            Component::Z => 2,
+        }
+    }
 }
 
 /// `[[supports]]`: fixed components of a node set.
@@ -620,13 +667,14 @@ fn constant() -> TimeFunction {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
 pub enum LoadSpec {
-    /// Traction (Pa) on an edge set, times the body's thickness.
+    /// Traction (Pa) on an edge set, times the body's thickness (plane), or on a
+    /// face set (solid).
     Traction {
-        /// Edge set.
+        /// Edge set (plane) or face set (solid).
         set: String,
-        /// Traction vector.
-        #[serde(deserialize_with = "exact::array")]
-        value: [f64; 2],
+        /// Traction vector (two components, or three in a solid).
+        #[serde(deserialize_with = "exact::vector")]
+        value: [f64; 3],
         /// Time function (default constant).
         #[serde(default = "constant")]
         function: TimeFunction,
@@ -635,9 +683,9 @@ pub enum LoadSpec {
     Nodal {
         /// Node set.
         set: String,
-        /// Force vector per node.
-        #[serde(deserialize_with = "exact::array")]
-        value: [f64; 2],
+        /// Force vector per node (two components, or three in a solid).
+        #[serde(deserialize_with = "exact::vector")]
+        value: [f64; 3],
         /// Time function (default constant).
         #[serde(default = "constant")]
         function: TimeFunction,

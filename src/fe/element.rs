@@ -1,8 +1,79 @@
 //! Element matrices and vectors: stiffness, consistent and lumped mass, internal
-//! force, for continuum elements (Quad4, Tri3) and bars. All write into caller-owned
-//! slices (row-major `n_dof x n_dof`), so the assembly loop allocates nothing.
+//! force, for continuum elements (Quad4, Tri3, Hex8, Tet4) and bars. All write into
+//! caller-owned slices (row-major `n_dof x n_dof`, `n_dof = dim x nodes`), so the
+//! assembly loop allocates nothing.
 
 use super::{kinematics, mass_rule, stiffness_rule, ElementKind, PointKinematics};
+
+/// An elasticity matrix in Voigt form: the plane's 3x3 or the solid's 6x6. Its
+/// `Bᵀ D B` and `Bᵀ σ` are the element kernels of its dimension.
+pub trait Voigt: Copy + Sync {
+    /// Adds `w Bᵀ D B` at one point to the element matrix `ke` (row-major).
+    fn add_btdb(&self, k: &PointKinematics, nn: usize, w: f64, ke: &mut [f64]);
+}
+
+impl Voigt for [[f64; 3]; 3] {
+    #[inline]
+    fn add_btdb(&self, k: &PointKinematics, nn: usize, w: f64, ke: &mut [f64]) {
+        add_btdb(k, nn, self, w, ke)
+    }
+}
+
+impl Voigt for [[f64; 6]; 6] {
+    #[inline]
+    fn add_btdb(&self, k: &PointKinematics, nn: usize, w: f64, ke: &mut [f64]) {
+        add_btdb_solid(k, nn, self, w, ke)
+    }
+}
+
+/// The rows of `B` of node `a` of a solid: `B_a` is 6x3, row `i` the Voigt
+/// component `i` (order of `fe`).
+#[inline]
+fn b_solid(g: [f64; 3]) -> [[f64; 3]; 6] {
+    let [x, y, z] = g;
+    [
+        [x, 0.0, 0.0],
+        [0.0, y, 0.0],
+        [y, x, 0.0],
+        [0.0, 0.0, z],
+        [0.0, z, y],
+        [z, 0.0, x],
+    ]
+}
+
+/// Adds `w Bᵀ D B` of a solid at one point to `ke` (row-major, `3nn x 3nn`).
+#[inline]
+pub fn add_btdb_solid(k: &PointKinematics, nn: usize, d: &[[f64; 6]; 6], w: f64, ke: &mut [f64]) {
+    let nd = 3 * nn;
+    for b in 0..nn {
+        let bb = b_solid(k.dndx[b]);
+        // D B_b (6x3)
+        let mut db = [[0.0; 3]; 6];
+        for i in 0..6 {
+            for j in 0..3 {
+                db[i][j] = (0..6).map(|l| d[i][l] * bb[l][j]).sum();
+            }
+        }
+        for a in 0..nn {
+            let ba = b_solid(k.dndx[a]);
+            for r in 0..3 {
+                for c in 0..3 {
+                    let v: f64 = (0..6).map(|l| ba[l][r] * db[l][c]).sum();
+                    ke[(3 * a + r) * nd + 3 * b + c] += w * v;
+                }
+            }
+        }
+    }
+}
+
+/// The measure of a continuum element: its area (plane kinds, from the Jacobian) or
+/// volume (solids), signed by the Jacobian.
+pub fn measure(kind: ElementKind, x: &[[f64; 3]]) -> f64 {
+    stiffness_rule(kind)
+        .iter()
+        .map(|&(xi, w)| w * kinematics(kind, x, xi).det_j)
+        .sum()
+}
 
 /// Adds `w Bᵀ D B` at one point to the element matrix `ke` (row-major, `2nn x 2nn`).
 #[inline]
@@ -34,26 +105,29 @@ pub fn add_btdb(k: &PointKinematics, nn: usize, d: &[[f64; 3]; 3], w: f64, ke: &
     }
 }
 
-/// Continuum element stiffness `∫ Bᵀ D B t dA` into `ke` (zeroed here).
-pub fn continuum_stiffness(
+/// Continuum element stiffness `∫ Bᵀ D B t dA` (plane, `t` the thickness) or
+/// `∫ Bᵀ D B dV` (solid, `t = 1`) into `ke` (zeroed here).
+pub fn continuum_stiffness<D: Voigt>(
     kind: ElementKind,
-    x: &[[f64; 2]],
-    d: &[[f64; 3]; 3],
+    x: &[[f64; 3]],
+    d: &D,
     thickness: f64,
     ke: &mut [f64],
 ) {
     let nn = kind.nodes();
-    ke[..4 * nn * nn].fill(0.0);
+    let nd = kind.dim() * nn;
+    ke[..nd * nd].fill(0.0);
     for &(xi, w) in stiffness_rule(kind) {
         let k = kinematics(kind, x, xi);
-        add_btdb(&k, nn, d, w * k.det_j * thickness, ke);
+        d.add_btdb(&k, nn, w * k.det_j * thickness, ke);
     }
 }
 
-/// Continuum consistent mass `∫ ρ Nᵀ N t dA` into `me` (zeroed here).
-pub fn continuum_mass(kind: ElementKind, x: &[[f64; 2]], rho_t: f64, me: &mut [f64]) {
+/// Continuum consistent mass `∫ ρ Nᵀ N t dA` (solids: `dV`) into `me` (zeroed here).
+pub fn continuum_mass(kind: ElementKind, x: &[[f64; 3]], rho_t: f64, me: &mut [f64]) {
     let nn = kind.nodes();
-    let nd = 2 * nn;
+    let dim = kind.dim();
+    let nd = dim * nn;
     me[..nd * nd].fill(0.0);
     for &(xi, w) in mass_rule(kind) {
         let k = kinematics(kind, x, xi);
@@ -61,8 +135,9 @@ pub fn continuum_mass(kind: ElementKind, x: &[[f64; 2]], rho_t: f64, me: &mut [f
         for a in 0..nn {
             for b in 0..nn {
                 let m = f * k.n[a] * k.n[b];
-                me[2 * a * nd + 2 * b] += m;
-                me[(2 * a + 1) * nd + 2 * b + 1] += m;
+                for i in 0..dim {
+                    me[(dim * a + i) * nd + dim * b + i] += m;
+                }
             }
         }
     }
@@ -70,43 +145,46 @@ pub fn continuum_mass(kind: ElementKind, x: &[[f64; 2]], rho_t: f64, me: &mut [f
 
 /// Unit axis and length of a bar.
 #[inline]
-pub fn bar_axis(x: &[[f64; 2]]) -> ([f64; 2], f64) {
-    let d = [x[1][0] - x[0][0], x[1][1] - x[0][1]];
-    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
-    ([d[0] / l, d[1] / l], l)
+pub fn bar_axis(x: &[[f64; 3]]) -> ([f64; 3], f64) {
+    let d = [x[1][0] - x[0][0], x[1][1] - x[0][1], x[1][2] - x[0][2]];
+    let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    ([d[0] / l, d[1] / l, d[2] / l], l)
 }
 
-/// Bar stiffness `EA/L (e⊗e)` in the 4x4 block pattern, into `ke` (row-major 4x4).
-pub fn bar_stiffness(x: &[[f64; 2]], ea: f64, ke: &mut [f64]) {
+/// Bar stiffness `EA/L (e⊗e)` in the `2d x 2d` block pattern of a mesh of dimension
+/// `dim`, into `ke` (row-major).
+pub fn bar_stiffness(x: &[[f64; 3]], dim: usize, ea: f64, ke: &mut [f64]) {
     let (e, l) = bar_axis(x);
     let k = ea / l;
-    for i in 0..2 {
-        for j in 0..2 {
+    let nd = 2 * dim;
+    for i in 0..dim {
+        for j in 0..dim {
             let v = k * e[i] * e[j];
-            ke[i * 4 + j] = v;
-            ke[(i + 2) * 4 + j + 2] = v;
-            ke[i * 4 + j + 2] = -v;
-            ke[(i + 2) * 4 + j] = -v;
+            ke[i * nd + j] = v;
+            ke[(i + dim) * nd + j + dim] = v;
+            ke[i * nd + j + dim] = -v;
+            ke[(i + dim) * nd + j] = -v;
         }
     }
 }
 
-/// Bar consistent mass `ρAL/6 [2 1; 1 2]` per direction, into `me` (4x4).
-pub fn bar_mass(x: &[[f64; 2]], rho_a: f64, me: &mut [f64]) {
+/// Bar consistent mass `ρAL/6 [2 1; 1 2]` per direction, into `me` (`2d x 2d`).
+pub fn bar_mass(x: &[[f64; 3]], dim: usize, rho_a: f64, me: &mut [f64]) {
     let (_, l) = bar_axis(x);
     let m = rho_a * l / 6.0;
-    me[..16].fill(0.0);
-    for i in 0..2 {
-        me[i * 4 + i] = 2.0 * m;
-        me[(i + 2) * 4 + i + 2] = 2.0 * m;
-        me[i * 4 + i + 2] = m;
-        me[(i + 2) * 4 + i] = m;
+    let nd = 2 * dim;
+    me[..nd * nd].fill(0.0);
+    for i in 0..dim {
+        me[i * nd + i] = 2.0 * m;
+        me[(i + dim) * nd + i + dim] = 2.0 * m;
+        me[i * nd + i + dim] = m;
+        me[(i + dim) * nd + i] = m;
     }
 }
 
-/// Axial strain of a bar from its element displacements.
+/// Axial strain of a bar from its element displacements (`dim` per node).
 #[inline]
-pub fn bar_strain(x: &[[f64; 2]], ue: &[f64]) -> f64 {
+pub fn bar_strain(x: &[[f64; 3]], dim: usize, ue: &[f64]) -> f64 {
     let (e, l) = bar_axis(x);
-    ((ue[2] - ue[0]) * e[0] + (ue[3] - ue[1]) * e[1]) / l
+    (0..dim).fold(0.0, |s, i| s + (ue[dim + i] - ue[i]) * e[i]) / l
 }

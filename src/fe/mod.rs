@@ -1,8 +1,13 @@
-//! Reference elements, quadrature and the element matrices of plane (2D) elasticity.
+//! Reference elements, quadrature and the element matrices of plane (2D) and solid
+//! (3D) elasticity.
 //!
-//! Voigt order everywhere: strain `[ε_xx, ε_yy, γ_xy]` (engineering shear
-//! `γ_xy = 2 ε_xy`), stress `[σ_xx, σ_yy, σ_xy]`. Element dofs are ordered
-//! `[u_0x, u_0y, u_1x, u_1y, ...]`. See `theory/discretisation.md`.
+//! Voigt order everywhere: in the plane, strain `[ε_xx, ε_yy, γ_xy]` (engineering
+//! shear `γ_xy = 2 ε_xy`) and stress `[σ_xx, σ_yy, σ_xy]`; in solids the plane's
+//! three components come first, then the out-of-plane ones,
+//! `[ε_xx, ε_yy, γ_xy, ε_zz, γ_yz, γ_zx]` (so a plane-strain vector is a solid one
+//! with its last three components zero). Element dofs are ordered
+//! `[u_0x, u_0y, (u_0z,) u_1x, ...]`. See `theory/discretisation.md` and
+//! `theory/solids.md`.
 
 pub mod element;
 
@@ -16,7 +21,20 @@ pub enum ElementKind {
     Tri3,
     /// Two-node bar (truss) carrying axial force only.
     Bar2,
+    /// Trilinear hexahedron, 2x2x2 Gauss: nodes 0-3 one face, counter-clockwise seen
+    /// from the side of the opposite face, nodes 4-7 opposite them in the same order
+    /// (Gmsh's and VTK's numbering).
+    Hex8,
+    /// Linear (constant-strain) tetrahedron, 1 Gauss point: node 3 on the side
+    /// where `(x1 − x0) × (x2 − x0)` points.
+    Tet4,
 }
+
+/// The most nodes an element has (Hex8).
+pub const MAX_NODES: usize = 8;
+
+/// The most dofs an element has (Hex8: 8 nodes x 3).
+pub const MAX_ELEMENT_DOFS: usize = 24;
 
 impl ElementKind {
     /// Number of nodes of one element.
@@ -25,9 +43,97 @@ impl ElementKind {
             ElementKind::Quad4 => 4,
             ElementKind::Tri3 => 3,
             ElementKind::Bar2 => 2,
+            ElementKind::Hex8 => 8,
+            ElementKind::Tet4 => 4,
+        }
+    }
+
+    /// The spatial dimension of a continuum kind (bars live in any: 0).
+    pub fn dim(self) -> usize {
+        match self {
+            ElementKind::Quad4 | ElementKind::Tri3 => 2,
+            ElementKind::Hex8 | ElementKind::Tet4 => 3,
+            ElementKind::Bar2 => 0,
+        }
+    }
+
+    /// Number of material points of one element: the points of its stiffness rule
+    /// (bars: one).
+    pub fn points(self) -> usize {
+        match self {
+            ElementKind::Bar2 => 1,
+            k => stiffness_rule(k).len(),
+        }
+    }
+
+    /// The element's edges as pairs of local node indices (for plane kinds, the
+    /// boundary in node order).
+    pub fn edges(self) -> &'static [[usize; 2]] {
+        match self {
+            ElementKind::Quad4 => &[[0, 1], [1, 2], [2, 3], [3, 0]],
+            ElementKind::Tri3 => &[[0, 1], [1, 2], [2, 0]],
+            ElementKind::Bar2 => &[[0, 1]],
+            ElementKind::Hex8 => &[
+                [0, 1],
+                [1, 2],
+                [2, 3],
+                [3, 0],
+                [4, 5],
+                [5, 6],
+                [6, 7],
+                [7, 4],
+                [0, 4],
+                [1, 5],
+                [2, 6],
+                [3, 7],
+            ],
+            ElementKind::Tet4 => &[[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]],
+        }
+    }
+
+    /// The faces of a solid kind as local node lists, each counter-clockwise seen
+    /// from outside (empty for plane kinds and bars).
+    pub fn faces(self) -> &'static [&'static [usize]] {
+        match self {
+            ElementKind::Hex8 => &[
+                &[0, 3, 2, 1],
+                &[4, 5, 6, 7],
+                &[0, 1, 5, 4],
+                &[1, 2, 6, 5],
+                &[2, 3, 7, 6],
+                &[3, 0, 4, 7],
+            ],
+            ElementKind::Tet4 => &[&[0, 2, 1], &[0, 1, 3], &[1, 2, 3], &[2, 0, 3]],
+            _ => &[],
+        }
+    }
+
+    /// The reference coordinates of the nodes (for shape checks at the corners).
+    pub fn corners(self) -> &'static [[f64; 3]] {
+        match self {
+            ElementKind::Quad4 => &[
+                [-1.0, -1.0, 0.0],
+                [1.0, -1.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [-1.0, 1.0, 0.0],
+            ],
+            ElementKind::Hex8 => &HEX_CORNERS,
+            _ => &[],
         }
     }
 }
+
+/// The reference nodes of the hexahedron on `[-1,1]^3`.
+const HEX_CORNERS: [[f64; 3]; 8] = [
+    [-1.0, -1.0, -1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, -1.0],
+    [-1.0, 1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [-1.0, 1.0, 1.0],
+];
 
 /// In-plane idealisation of the third direction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
@@ -38,29 +144,71 @@ pub enum Plane {
     Stress,
     /// `ε_zz = 0`: long bodies; the thickness is the length represented.
     Strain,
+    /// No idealisation: a three-dimensional solid (six strain components).
+    Solid,
 }
 
-/// A quadrature point: reference coordinates and weight.
-pub type QuadPoint = ([f64; 2], f64);
+impl Plane {
+    /// The number of Voigt components of strain and stress: 3 in the plane, 6 in
+    /// a solid.
+    pub fn voigt(self) -> usize {
+        match self {
+            Plane::Stress | Plane::Strain => 3,
+            Plane::Solid => 6,
+        }
+    }
+}
+
+/// A quadrature point: reference coordinates (plane kinds keep the third zero) and
+/// weight.
+pub type QuadPoint = ([f64; 3], f64);
 
 const G: f64 = 0.577_350_269_189_625_8; // 1/sqrt(3)
 
 /// 2x2 Gauss rule on `[-1,1]^2` (exact for bicubic integrands).
 pub const QUAD_2X2: [QuadPoint; 4] = [
-    ([-G, -G], 1.0),
-    ([G, -G], 1.0),
-    ([G, G], 1.0),
-    ([-G, G], 1.0),
+    ([-G, -G, 0.0], 1.0),
+    ([G, -G, 0.0], 1.0),
+    ([G, G, 0.0], 1.0),
+    ([-G, G, 0.0], 1.0),
 ];
 
 /// One-point rule on the reference triangle `(0,0),(1,0),(0,1)` (exact for linears).
-pub const TRI_1: [QuadPoint; 1] = [([1.0 / 3.0, 1.0 / 3.0], 0.5)];
+pub const TRI_1: [QuadPoint; 1] = [([1.0 / 3.0, 1.0 / 3.0, 0.0], 0.5)];
 
 /// Three-point rule on the reference triangle (exact for quadratics).
 pub const TRI_3: [QuadPoint; 3] = [
-    ([1.0 / 6.0, 1.0 / 6.0], 1.0 / 6.0),
-    ([2.0 / 3.0, 1.0 / 6.0], 1.0 / 6.0),
-    ([1.0 / 6.0, 2.0 / 3.0], 1.0 / 6.0),
+    ([1.0 / 6.0, 1.0 / 6.0, 0.0], 1.0 / 6.0),
+    ([2.0 / 3.0, 1.0 / 6.0, 0.0], 1.0 / 6.0),
+    ([1.0 / 6.0, 2.0 / 3.0, 0.0], 1.0 / 6.0),
+];
+
+/// 2x2x2 Gauss rule on `[-1,1]^3` (exact for tricubic integrands), in the order of
+/// the hexahedron's nodes.
+pub const HEX_2X2X2: [QuadPoint; 8] = [
+    ([-G, -G, -G], 1.0),
+    ([G, -G, -G], 1.0),
+    ([G, G, -G], 1.0),
+    ([-G, G, -G], 1.0),
+    ([-G, -G, G], 1.0),
+    ([G, -G, G], 1.0),
+    ([G, G, G], 1.0),
+    ([-G, G, G], 1.0),
+];
+
+/// One-point rule on the reference tetrahedron `(0,0,0),(1,0,0),(0,1,0),(0,0,1)`
+/// (exact for linears).
+pub const TET_1: [QuadPoint; 1] = [([0.25, 0.25, 0.25], 1.0 / 6.0)];
+
+const TA: f64 = 0.585_410_196_624_968_5; // (5 + 3 sqrt 5) / 20
+const TB: f64 = 0.138_196_601_125_010_5; // (5 - sqrt 5) / 20
+
+/// Four-point rule on the reference tetrahedron (exact for quadratics).
+pub const TET_4: [QuadPoint; 4] = [
+    ([TB, TB, TB], 1.0 / 24.0),
+    ([TA, TB, TB], 1.0 / 24.0),
+    ([TB, TA, TB], 1.0 / 24.0),
+    ([TB, TB, TA], 1.0 / 24.0),
 ];
 
 /// The stiffness / internal-force rule of an element kind.
@@ -69,6 +217,8 @@ pub fn stiffness_rule(kind: ElementKind) -> &'static [QuadPoint] {
         ElementKind::Quad4 => &QUAD_2X2,
         ElementKind::Tri3 => &TRI_1,
         ElementKind::Bar2 => &TRI_1[..0],
+        ElementKind::Hex8 => &HEX_2X2X2,
+        ElementKind::Tet4 => &TET_1,
     }
 }
 
@@ -78,12 +228,54 @@ pub fn mass_rule(kind: ElementKind) -> &'static [QuadPoint] {
         ElementKind::Quad4 => &QUAD_2X2,
         ElementKind::Tri3 => &TRI_3,
         ElementKind::Bar2 => &TRI_1[..0],
+        // 2x2x2 integrates N_a N_b det J exactly for a parallelepiped and to the
+        // rule's order otherwise (the usual choice).
+        ElementKind::Hex8 => &HEX_2X2X2,
+        ElementKind::Tet4 => &TET_4,
     }
 }
 
-/// Shape functions and their reference derivatives at `xi` (first `kind.nodes()` used).
+/// Shape functions and their reference derivatives at `xi` (first `kind.nodes()`
+/// used; plane kinds leave the third derivative zero).
 #[inline]
-pub fn shape(kind: ElementKind, xi: [f64; 2]) -> ([f64; 4], [[f64; 2]; 4]) {
+pub fn shape(kind: ElementKind, xi: [f64; 3]) -> ([f64; MAX_NODES], [[f64; 3]; MAX_NODES]) {
+    let mut n = [0.0; MAX_NODES];
+    let mut d = [[0.0; 3]; MAX_NODES];
+    match kind {
+        ElementKind::Hex8 => {
+            for (a, c) in HEX_CORNERS.iter().enumerate() {
+                let f = [1.0 + c[0] * xi[0], 1.0 + c[1] * xi[1], 1.0 + c[2] * xi[2]];
+                n[a] = 0.125 * f[0] * f[1] * f[2];
+                d[a] = [
+                    0.125 * c[0] * f[1] * f[2],
+                    0.125 * f[0] * c[1] * f[2],
+                    0.125 * f[0] * f[1] * c[2],
+                ];
+            }
+        }
+        ElementKind::Tet4 => {
+            n[..4].copy_from_slice(&[1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]]);
+            d[..4].copy_from_slice(&[
+                [-1.0, -1.0, -1.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+            ]);
+        }
+        _ => {
+            let (n2, d2) = shape_plane(kind, [xi[0], xi[1]]);
+            for a in 0..4 {
+                n[a] = n2[a];
+                d[a] = [d2[a][0], d2[a][1], 0.0];
+            }
+        }
+    }
+    (n, d)
+}
+
+/// Shape functions and their reference derivatives of a plane kind at `xi`.
+#[inline]
+fn shape_plane(kind: ElementKind, xi: [f64; 2]) -> ([f64; 4], [[f64; 2]; 4]) {
     match kind {
         ElementKind::Quad4 => {
             let (r, s) = (xi[0], xi[1]);
@@ -108,7 +300,7 @@ pub fn shape(kind: ElementKind, xi: [f64; 2]) -> ([f64; 4], [[f64; 2]; 4]) {
                 [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0], [0.0, 0.0]],
             )
         }
-        ElementKind::Bar2 => unreachable!("bars have no 2D shape functions"),
+        _ => unreachable!("bars and solids have no plane shape functions"),
     }
 }
 
@@ -116,17 +308,21 @@ pub fn shape(kind: ElementKind, xi: [f64; 2]) -> ([f64; 4], [[f64; 2]; 4]) {
 #[derive(Clone, Copy, Debug)]
 pub struct PointKinematics {
     /// Shape function values.
-    pub n: [f64; 4],
-    /// `∂N_a/∂x`, `∂N_a/∂y`.
-    pub dndx: [[f64; 2]; 4],
-    /// Jacobian determinant of the reference map.
+    pub n: [f64; MAX_NODES],
+    /// `∂N_a/∂x`, `∂N_a/∂y`, `∂N_a/∂z` (the last zero for plane kinds).
+    pub dndx: [[f64; 3]; MAX_NODES],
+    /// Jacobian determinant of the reference map (an area ratio in the plane, a
+    /// volume ratio in a solid).
     pub det_j: f64,
 }
 
 /// Evaluates shape functions and physical gradients at `xi` for nodes `x`.
 #[inline]
-pub fn kinematics(kind: ElementKind, x: &[[f64; 2]], xi: [f64; 2]) -> PointKinematics {
-    let (n, d) = shape(kind, xi);
+pub fn kinematics(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKinematics {
+    if kind.dim() == 3 {
+        return kinematics_solid(kind, x, xi);
+    }
+    let (n2, d) = shape_plane(kind, [xi[0], xi[1]]);
     let nn = kind.nodes();
     let mut j = [[0.0; 2]; 2]; // j[i][k] = ∂x_i/∂ξ_k
     for a in 0..nn {
@@ -143,8 +339,10 @@ pub fn kinematics(kind: ElementKind, x: &[[f64; 2]], xi: [f64; 2]) -> PointKinem
         [j[1][1] * inv, -j[0][1] * inv],
         [-j[1][0] * inv, j[0][0] * inv],
     ];
-    let mut dndx = [[0.0; 2]; 4];
+    let mut dndx = [[0.0; 3]; MAX_NODES];
+    let mut n = [0.0; MAX_NODES];
     for a in 0..nn {
+        n[a] = n2[a];
         for i in 0..2 {
             dndx[a][i] = d[a][0] * ji[0][i] + d[a][1] * ji[1][i];
         }
@@ -152,13 +350,69 @@ pub fn kinematics(kind: ElementKind, x: &[[f64; 2]], xi: [f64; 2]) -> PointKinem
     PointKinematics { n, dndx, det_j }
 }
 
+/// [`kinematics`] of a solid kind: the 3x3 Jacobian inverted by cofactors.
+#[inline]
+fn kinematics_solid(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKinematics {
+    let (n, d) = shape(kind, xi);
+    let mut j = [[0.0; 3]; 3]; // j[i][k] = ∂x_i/∂ξ_k
+    for a in 0..kind.nodes() {
+        for i in 0..3 {
+            for k in 0..3 {
+                j[i][k] += x[a][i] * d[a][k];
+            }
+        }
+    }
+    let (inv, det_j) = inverse3(&j);
+    // ∂N_a/∂x_i = Σ_k ∂N_a/∂ξ_k (J⁻¹)_{k i}
+    let mut dndx = [[0.0; 3]; MAX_NODES];
+    for a in 0..kind.nodes() {
+        for i in 0..3 {
+            dndx[a][i] = d[a][0] * inv[0][i] + d[a][1] * inv[1][i] + d[a][2] * inv[2][i];
+        }
+    }
+    PointKinematics { n, dndx, det_j }
+}
+
+/// The inverse and determinant of a 3x3 matrix (cofactors; the inverse is not
+/// finite when the determinant vanishes).
+#[inline]
+pub fn inverse3(j: &[[f64; 3]; 3]) -> ([[f64; 3]; 3], f64) {
+    let c00 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
+    let c01 = j[1][2] * j[2][0] - j[1][0] * j[2][2];
+    let c02 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
+    let det = j[0][0] * c00 + j[0][1] * c01 + j[0][2] * c02;
+    let r = 1.0 / det;
+    let inv = [
+        [
+            c00 * r,
+            (j[0][2] * j[2][1] - j[0][1] * j[2][2]) * r,
+            (j[0][1] * j[1][2] - j[0][2] * j[1][1]) * r,
+        ],
+        [
+            c01 * r,
+            (j[0][0] * j[2][2] - j[0][2] * j[2][0]) * r,
+            (j[0][2] * j[1][0] - j[0][0] * j[1][2]) * r,
+        ],
+        [
+            c02 * r,
+            (j[0][1] * j[2][0] - j[0][0] * j[2][1]) * r,
+            (j[0][0] * j[1][1] - j[0][1] * j[1][0]) * r,
+        ],
+    ];
+    (inv, det)
+}
+
 /// Smallest and largest Jacobian determinant over the element's corners and Gauss
 /// points (a non-positive minimum means an inverted, degenerate or distorted
 /// element; see `mesh::Shape`).
-pub fn jacobian_range(kind: ElementKind, x: &[[f64; 2]]) -> (f64, f64) {
-    let corners: &[[f64; 2]] = match kind {
-        ElementKind::Quad4 => &[[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]],
-        _ => &[[1.0 / 3.0, 1.0 / 3.0]],
+pub fn jacobian_range(kind: ElementKind, x: &[[f64; 3]]) -> (f64, f64) {
+    let centroid: &[[f64; 3]] = match kind {
+        ElementKind::Tet4 => &[[0.25, 0.25, 0.25]],
+        _ => &[[1.0 / 3.0, 1.0 / 3.0, 0.0]],
+    };
+    let corners = match kind {
+        ElementKind::Quad4 | ElementKind::Hex8 => kind.corners(),
+        _ => centroid,
     };
     corners
         .iter()
@@ -188,7 +442,44 @@ pub fn elasticity(e: f64, nu: f64, plane: Plane) -> [[f64; 3]; 3] {
                 [0.0, 0.0, c * 0.5 * (1.0 - 2.0 * nu)],
             ]
         }
+        Plane::Solid => panic!("a solid's elasticity has six components: `elasticity_solid`"),
     }
+}
+
+/// Isotropic linear elasticity of a solid (Voigt order of the module, engineering
+/// shears): `λ` on the normal block, `λ + 2μ` on its diagonal, `μ` on the shears.
+pub fn elasticity_solid(e: f64, nu: f64) -> [[f64; 6]; 6] {
+    let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let mu = 0.5 * e / (1.0 + nu);
+    let mut c = [[0.0; 6]; 6];
+    for i in [0, 1, 3] {
+        for j in [0, 1, 3] {
+            c[i][j] = lambda;
+        }
+        c[i][i] = lambda + 2.0 * mu;
+    }
+    for i in [2, 4, 5] {
+        c[i][i] = mu;
+    }
+    c
+}
+
+/// Strain `[ε_xx, ε_yy, γ_xy, ε_zz, γ_yz, γ_zx]` at a point of a solid from the
+/// element displacements `ue` (three per node).
+#[inline]
+pub fn strain_solid(k: &PointKinematics, nn: usize, ue: &[f64]) -> [f64; 6] {
+    let mut eps = [0.0; 6];
+    for a in 0..nn {
+        let [dx, dy, dz] = k.dndx[a];
+        let (ux, uy, uz) = (ue[3 * a], ue[3 * a + 1], ue[3 * a + 2]);
+        eps[0] += dx * ux;
+        eps[1] += dy * uy;
+        eps[2] += dy * ux + dx * uy;
+        eps[3] += dz * uz;
+        eps[4] += dz * uy + dy * uz;
+        eps[5] += dx * uz + dz * ux;
+    }
+    eps
 }
 
 /// Strain `[ε_xx, ε_yy, γ_xy]` at a point from the element displacements `ue`.

@@ -46,7 +46,7 @@ fn adjacency(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> (Vec<usize>, Vec
 const LEAF: usize = 512;
 
 struct Graph<'a> {
-    coords: &'a [[f64; 2]],
+    coords: &'a [[f64; 3]],
     ptr: Vec<usize>,
     adj: Vec<usize>,
 }
@@ -54,7 +54,7 @@ struct Graph<'a> {
 /// Nested-dissection elimination order of the matrix with lower pattern
 /// `(col_ptr, row_idx)` whose column `j` sits at `coords[j]`: `order[k]` is the
 /// column eliminated `k`-th.
-pub fn nested_dissection(coords: &[[f64; 2]], col_ptr: &[usize], row_idx: &[usize]) -> Vec<usize> {
+pub fn nested_dissection(coords: &[[f64; 3]], col_ptr: &[usize], row_idx: &[usize]) -> Vec<usize> {
     let n = coords.len();
     let (ptr, adj) = adjacency(n, col_ptr, row_idx);
     let g = Graph { coords, ptr, adj };
@@ -85,14 +85,22 @@ fn dissect(
         minimum_degree(g, &set, local, order);
         return;
     }
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for &v in &set {
-        for d in 0..2 {
+        for d in 0..3 {
             lo[d] = lo[d].min(g.coords[v][d]);
             hi[d] = hi[d].max(g.coords[v][d]);
         }
     }
-    let axis = if hi[0] - lo[0] >= hi[1] - lo[1] { 0 } else { 1 };
+    // The longest extent (the first of equals): plane meshes have no z extent.
+    let ext = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    let axis = if ext[0] >= ext[1] && ext[0] >= ext[2] {
+        0
+    } else if ext[1] >= ext[2] {
+        1
+    } else {
+        2
+    };
     // Cut at the median coordinate: vertices strictly below it go one way, so a mesh
     // line never straddles the cut and the separator is one line of the mesh.
     let mut sorted = set.clone();
@@ -245,7 +253,9 @@ mod tests {
         let n = nx * ny;
         let mut col_ptr = vec![0];
         let mut row_idx = Vec::new();
-        let coords: Vec<[f64; 2]> = (0..n).map(|c| [(c % nx) as f64, (c / nx) as f64]).collect();
+        let coords: Vec<[f64; 3]> = (0..n)
+            .map(|c| [(c % nx) as f64, (c / nx) as f64, 0.0])
+            .collect();
         for c in 0..n {
             let (i, j) = (c % nx, c / nx);
             row_idx.push(c);

@@ -137,6 +137,7 @@ fn principal3(eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
     let ezz = match plane {
         Plane::Stress => -nu / (1.0 - nu) * (eps[0] + eps[1]),
         Plane::Strain => 0.0,
+        Plane::Solid => unreachable!("validation keeps Mazars to the plane"),
     };
     [e1, e2, ezz]
 }
@@ -148,6 +149,7 @@ fn principal_stress3(c: &[[f64; 3]; 3], eps: &[f64; 3], nu: f64, plane: Plane) -
     let szz = match plane {
         Plane::Stress => 0.0,
         Plane::Strain => nu * (s[0] + s[1]),
+        Plane::Solid => unreachable!("validation keeps Mazars to the plane"),
     };
     [s1, s2, szz]
 }
@@ -248,7 +250,7 @@ fn damage(
 pub fn e_modulus(c: &[[f64; 3]; 3], nu: f64, plane: Plane) -> f64 {
     match plane {
         Plane::Stress => c[0][0] * (1.0 - nu * nu),
-        Plane::Strain => c[0][0] * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu),
+        Plane::Strain | Plane::Solid => c[0][0] * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu),
     }
 }
 

@@ -223,6 +223,11 @@ impl Material {
         elasticity(self.e, self.nu, plane)
     }
 
+    /// Elasticity matrix `C` of a solid (six Voigt components, order of `fe`).
+    pub fn c_solid(&self) -> [[f64; 6]; 6] {
+        crate::fe::elasticity_solid(self.e, self.nu)
+    }
+
     /// The stiffness the material shows to a sudden strain (what an explicit step
     /// sees): `C`, and `(1 + α) C` for the standard linear solid (`α C` without the
     /// parallel spring), whose Maxwell branch answers at once.

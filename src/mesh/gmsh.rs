@@ -155,10 +155,12 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     }
     orient_edges(&blocks, &mut edge_sets);
     Ok(Part {
+        dim: 2,
         coords,
         blocks,
         node_sets,
         edge_sets,
+        face_sets: BTreeMap::new(),
         node_tags: Some(node_tags),
     })
 }
@@ -192,7 +194,7 @@ fn orient_edges(blocks: &[Elements], edge_sets: &mut BTreeMap<String, Vec<[usize
 #[allow(clippy::type_complexity)]
 fn nodes(
     msh: &MshFile,
-) -> std::result::Result<(Vec<[f64; 2]>, Vec<u64>, HashMap<u64, usize>), String> {
+) -> std::result::Result<(Vec<[f64; 3]>, Vec<u64>, HashMap<u64, usize>), String> {
     let n: usize = msh.node_blocks.iter().map(|b| b.tags.len()).sum();
     let mut coords = Vec::with_capacity(n);
     let mut tags = Vec::with_capacity(n);
@@ -216,7 +218,7 @@ fn nodes(
                      (a 2D model takes x and y only)"
                 ));
             }
-            coords.push([p[0], p[1]]);
+            coords.push([p[0], p[1], 0.0]);
             tags.push(tag);
         }
     }
@@ -258,7 +260,7 @@ fn type_name(t: i32) -> &'static str {
     }
 }
 
-fn signed_area(coords: &[[f64; 2]], poly: &[usize]) -> f64 {
+fn signed_area(coords: &[[f64; 3]], poly: &[usize]) -> f64 {
     let n = poly.len();
     (0..n)
         .map(|i| {

@@ -7,6 +7,7 @@
 
 pub mod gmsh;
 pub mod msh41;
+pub mod solid;
 pub mod structured;
 
 use std::collections::BTreeMap;
@@ -61,10 +62,25 @@ impl Elements {
     }
 }
 
+/// A point in space: `[x, y, z]`; plane models keep `z = 0`.
+pub type Point = [f64; 3];
+
+/// The distance between two points.
+#[inline]
+pub fn distance(p: Point, q: Point) -> f64 {
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+}
+
+/// The in-plane coordinates `[x, y]` of a point.
+#[inline]
+pub fn xy(p: Point) -> [f64; 2] {
+    [p[0], p[1]]
+}
+
 /// The signed area of the polygon `x` (positive when its vertices run
 /// counter-clockwise).
 #[inline]
-pub fn polygon_area(x: &[[f64; 2]]) -> f64 {
+pub fn polygon_area(x: &[Point]) -> f64 {
     0.5 * (0..x.len())
         .map(|a| {
             let b = (a + 1) % x.len();
@@ -79,7 +95,8 @@ pub fn polygon_area(x: &[[f64; 2]]) -> f64 {
 pub enum Shape {
     /// Positive Jacobian everywhere.
     Valid,
-    /// Negative Jacobian everywhere: the nodes run clockwise.
+    /// Negative Jacobian everywhere: the nodes run clockwise (in a solid: the wrong
+    /// handedness).
     Inverted,
     /// Zero area: coincident or collinear nodes.
     Degenerate,
@@ -88,12 +105,12 @@ pub enum Shape {
 }
 
 impl Shape {
-    /// The shape of a Quad4 or Tri3 with node coordinates `x` (bars: by length).
-    pub fn of(kind: ElementKind, x: &[[f64; 2]]) -> Shape {
-        let dist =
-            |p: [f64; 2], q: [f64; 2]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
-        let size = (0..x.len())
-            .map(|a| dist(x[a], x[(a + 1) % x.len()]))
+    /// The shape of a continuum element with node coordinates `x` (bars: by length).
+    pub fn of(kind: ElementKind, x: &[Point]) -> Shape {
+        let size = kind
+            .edges()
+            .iter()
+            .map(|&[a, b]| distance(x[a], x[b]))
             .fold(0.0, f64::max);
         if kind == ElementKind::Bar2 {
             return if size > 0.0 {
@@ -102,9 +119,16 @@ impl Shape {
                 Shape::Degenerate
             };
         }
-        let area = polygon_area(x);
-        if area.is_nan() || area.abs() <= 1e-12 * size * size {
-            return Shape::Degenerate;
+        if kind.dim() == 3 {
+            let volume = crate::fe::element::measure(kind, x);
+            if volume.is_nan() || volume.abs() <= 1e-12 * size * size * size {
+                return Shape::Degenerate;
+            }
+        } else {
+            let area = polygon_area(x);
+            if area.is_nan() || area.abs() <= 1e-12 * size * size {
+                return Shape::Degenerate;
+            }
         }
         let (lo, hi) = crate::fe::jacobian_range(kind, x);
         if lo > 0.0 {
@@ -120,28 +144,53 @@ impl Shape {
     pub fn describe(self) -> &'static str {
         match self {
             Shape::Valid => "valid",
-            Shape::Inverted => "inverted: its nodes run clockwise (they must run counter-clockwise)",
-            Shape::Degenerate => "degenerate: its area is zero (coincident or collinear nodes)",
+            Shape::Inverted => {
+                "inverted: its nodes run clockwise (they must run counter-clockwise; in a \
+                 solid, the first face counter-clockwise seen from the opposite node or face)"
+            }
+            Shape::Degenerate => {
+                "degenerate: its area (volume) is zero (coincident, collinear or coplanar nodes)"
+            }
             Shape::Distorted => {
-                "distorted: its Jacobian changes sign (a non-convex or self-intersecting quadrilateral)"
+                "distorted: its Jacobian changes sign (a non-convex or self-intersecting element)"
             }
         }
     }
 }
 
 /// The geometry of one body: nodes, continuum elements and named sets.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Part {
+    /// The spatial dimension, 2 or 3 (plane parts keep `z = 0`).
+    pub dim: usize,
     /// Node coordinates.
-    pub coords: Vec<[f64; 2]>,
+    pub coords: Vec<Point>,
     /// Element blocks (one per element kind present).
     pub blocks: Vec<Elements>,
     /// Named node sets.
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Named boundary edge sets (node pairs, oriented with the body on the left).
     pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
+    /// Named boundary face sets of a solid (quadrilaterals, or triangles with
+    /// `usize::MAX` in the fourth slot; counter-clockwise seen from outside).
+    pub face_sets: BTreeMap<String, Vec<[usize; 4]>>,
     /// The node tags of the file the part came from (Gmsh), for messages.
     pub node_tags: Option<Vec<u64>>,
+}
+
+impl Default for Part {
+    /// An empty plane part.
+    fn default() -> Self {
+        Part {
+            dim: 2,
+            coords: Vec::new(),
+            blocks: Vec::new(),
+            node_sets: BTreeMap::new(),
+            edge_sets: BTreeMap::new(),
+            face_sets: BTreeMap::new(),
+            node_tags: None,
+        }
+    }
 }
 
 impl Part {
@@ -159,7 +208,7 @@ impl Part {
         if let Some(n) = self
             .coords
             .iter()
-            .position(|c| !(c[0].is_finite() && c[1].is_finite()))
+            .position(|c| !c.iter().all(|x| x.is_finite()))
         {
             return Err(format!("{} has a non-finite coordinate", self.node_name(n)));
         }
@@ -178,7 +227,7 @@ impl Part {
         }
         for b in &self.blocks {
             for e in 0..b.len() {
-                let x: Vec<[f64; 2]> = b.element(e).iter().map(|&n| self.coords[n]).collect();
+                let x: Vec<Point> = b.element(e).iter().map(|&n| self.coords[n]).collect();
                 let shape = Shape::of(b.kind, &x);
                 if shape != Shape::Valid {
                     return Err(format!(
@@ -208,10 +257,13 @@ pub struct Block {
 }
 
 /// The whole model's mesh: all bodies' nodes and element blocks.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Mesh {
+    /// The spatial dimension, 2 or 3: the number of displacement components per
+    /// node (plane meshes keep `z = 0`).
+    pub dim: usize,
     /// Node coordinates.
-    pub coords: Vec<[f64; 2]>,
+    pub coords: Vec<Point>,
     /// Body index of every node.
     pub node_body: Vec<usize>,
     /// Element blocks.
@@ -220,6 +272,23 @@ pub struct Mesh {
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Edge sets, named `body.set`.
     pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
+    /// Face sets of solids, named `body.set` (see [`Part::face_sets`]).
+    pub face_sets: BTreeMap<String, Vec<[usize; 4]>>,
+}
+
+impl Default for Mesh {
+    /// An empty plane mesh (its first part sets its dimension).
+    fn default() -> Self {
+        Mesh {
+            dim: 2,
+            coords: Vec::new(),
+            node_body: Vec::new(),
+            blocks: Vec::new(),
+            node_sets: BTreeMap::new(),
+            edge_sets: BTreeMap::new(),
+            face_sets: BTreeMap::new(),
+        }
+    }
 }
 
 impl Mesh {
@@ -228,9 +297,15 @@ impl Mesh {
         self.coords.len()
     }
 
-    /// Number of degrees of freedom (two per node).
+    /// Number of degrees of freedom (`dim` per node).
     pub fn n_dofs(&self) -> usize {
-        2 * self.coords.len()
+        self.dim * self.coords.len()
+    }
+
+    /// The in-plane coordinates of node `n`.
+    #[inline]
+    pub fn xy(&self, n: usize) -> [f64; 2] {
+        xy(self.coords[n])
     }
 
     /// Number of elements over all blocks.
@@ -248,6 +323,9 @@ impl Mesh {
         thickness: f64,
     ) -> usize {
         let off = self.coords.len();
+        if off == 0 {
+            self.dim = part.dim;
+        }
         self.coords.extend_from_slice(&part.coords);
         self.node_body
             .extend(std::iter::repeat_n(body, part.coords.len()));
@@ -275,23 +353,33 @@ impl Mesh {
                 edges.iter().map(|e| [e[0] + off, e[1] + off]).collect(),
             );
         }
+        for (name, faces) in &part.face_sets {
+            self.face_sets.insert(
+                format!("{body_name}.{name}"),
+                faces
+                    .iter()
+                    .map(|f| f.map(|n| if n == usize::MAX { n } else { n + off }))
+                    .collect(),
+            );
+        }
         let all: Vec<usize> = (off..off + part.coords.len()).collect();
         self.node_sets.insert(format!("{body_name}.all"), all);
         off
     }
 
     /// Nodes of `body` lying on the segment `a`-`b` (within `tol`), ordered from `a`.
-    pub fn nodes_on_segment(&self, body: usize, a: [f64; 2], b: [f64; 2], tol: f64) -> Vec<usize> {
-        let d = [b[0] - a[0], b[1] - a[1]];
-        let len2 = d[0] * d[0] + d[1] * d[1];
+    pub fn nodes_on_segment(&self, body: usize, a: Point, b: Point, tol: f64) -> Vec<usize> {
+        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         let mut hits: Vec<(f64, usize)> = Vec::new();
         for (n, x) in self.coords.iter().enumerate() {
             if self.node_body[n] != body {
                 continue;
             }
-            let r = [x[0] - a[0], x[1] - a[1]];
-            let s = (r[0] * d[0] + r[1] * d[1]) / len2;
-            let dist2 = (r[0] - s * d[0]).powi(2) + (r[1] - s * d[1]).powi(2);
+            let r = [x[0] - a[0], x[1] - a[1], x[2] - a[2]];
+            let s = (r[0] * d[0] + r[1] * d[1] + r[2] * d[2]) / len2;
+            let dist2 =
+                (r[0] - s * d[0]).powi(2) + (r[1] - s * d[1]).powi(2) + (r[2] - s * d[2]).powi(2);
             if dist2 <= tol * tol && s >= -tol / len2.sqrt() && s <= 1.0 + tol / len2.sqrt() {
                 hits.push((s, n));
             }
@@ -301,11 +389,16 @@ impl Mesh {
     }
 
     /// The node nearest to `x`.
-    pub fn nearest_node(&self, x: [f64; 2]) -> Option<usize> {
+    pub fn nearest_node(&self, x: Point) -> Option<usize> {
         self.coords
             .iter()
             .enumerate()
-            .map(|(n, c)| (n, (c[0] - x[0]).powi(2) + (c[1] - x[1]).powi(2)))
+            .map(|(n, c)| {
+                (
+                    n,
+                    (c[0] - x[0]).powi(2) + (c[1] - x[1]).powi(2) + (c[2] - x[2]).powi(2),
+                )
+            })
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(n, _)| n)
     }
@@ -317,7 +410,7 @@ impl Mesh {
         for block in &self.blocks {
             for e in 0..block.elements.len() {
                 let nodes = block.elements.element(e);
-                let x: Vec<[f64; 2]> = nodes.iter().map(|&n| self.coords[n]).collect();
+                let x: Vec<Point> = nodes.iter().map(|&n| self.coords[n]).collect();
                 let shape = Shape::of(block.elements.kind, &x);
                 if shape != Shape::Valid {
                     return Err(Error::Mesh(format!(
@@ -334,16 +427,13 @@ impl Mesh {
 
     /// The largest edge of the elements holding node `n` (0 for a node of no element).
     pub fn element_size_at(&self, n: usize) -> f64 {
-        let dist =
-            |p: [f64; 2], q: [f64; 2]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
         let mut size: f64 = 0.0;
         for b in &self.blocks {
             for e in 0..b.elements.len() {
                 let nodes = b.elements.element(e);
                 if nodes.contains(&n) {
-                    for a in 0..nodes.len() {
-                        let c = (a + 1) % nodes.len();
-                        size = size.max(dist(self.coords[nodes[a]], self.coords[nodes[c]]));
+                    for &[a, c] in b.elements.kind.edges() {
+                        size = size.max(distance(self.coords[nodes[a]], self.coords[nodes[c]]));
                     }
                 }
             }
@@ -351,29 +441,36 @@ impl Mesh {
         size
     }
 
-    /// The area of continuum element `e` of `block`.
-    pub fn element_area(&self, block: usize, e: usize) -> f64 {
-        let nodes = self.blocks[block].elements.element(e);
-        let mut x = [[0.0; 2]; 4];
-        for (a, &n) in nodes.iter().enumerate() {
-            x[a] = self.coords[n];
-        }
-        polygon_area(&x[..nodes.len()]).abs()
-    }
-
-    /// Characteristic length of element `e` of `block` (the CFL estimate takes the minimum):
-    /// for a triangle its smallest altitude, for a quadrilateral its area over its
-    /// longest diagonal, for a bar its length.
-    pub fn element_length(&self, block: usize, e: usize) -> f64 {
-        let b = &self.blocks[block];
-        let x: Vec<[f64; 2]> = b
+    /// The node coordinates of element `e` of `block`.
+    fn element_points(&self, block: usize, e: usize) -> Vec<Point> {
+        self.blocks[block]
             .elements
             .element(e)
             .iter()
             .map(|&n| self.coords[n])
-            .collect();
-        let dist =
-            |p: [f64; 2], q: [f64; 2]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+            .collect()
+    }
+
+    /// The measure of continuum element `e` of `block`: its area in the plane, its
+    /// volume in a solid.
+    pub fn element_area(&self, block: usize, e: usize) -> f64 {
+        let kind = self.blocks[block].elements.kind;
+        let x = self.element_points(block, e);
+        if kind.dim() == 3 {
+            return crate::fe::element::measure(kind, &x);
+        }
+        polygon_area(&x).abs()
+    }
+
+    /// Characteristic length of element `e` of `block` (the CFL estimate takes the minimum):
+    /// for a triangle its smallest altitude, for a quadrilateral its area over its
+    /// longest diagonal, for a bar its length; for a tetrahedron its smallest
+    /// altitude, for a hexahedron `√3 V / d²` with `d` its longest body diagonal (a
+    /// cube's `h/√3`, the counterpart of the quadrilateral's `h/√2`).
+    pub fn element_length(&self, block: usize, e: usize) -> f64 {
+        let b = &self.blocks[block];
+        let x = self.element_points(block, e);
+        let dist = distance;
         match b.elements.kind {
             ElementKind::Bar2 => dist(x[0], x[1]),
             ElementKind::Tri3 => {
@@ -392,6 +489,45 @@ impl Mesh {
                 let dmax = dist(x[0], x[2]).max(dist(x[1], x[3]));
                 area / dmax
             }
+            ElementKind::Tet4 => {
+                let v = crate::fe::element::measure(ElementKind::Tet4, &x);
+                let amax = ElementKind::Tet4
+                    .faces()
+                    .iter()
+                    .map(|f| triangle_area(x[f[0]], x[f[1]], x[f[2]]))
+                    .fold(0.0, f64::max);
+                3.0 * v / amax
+            }
+            ElementKind::Hex8 => {
+                let v = crate::fe::element::measure(ElementKind::Hex8, &x);
+                let d = [[0, 6], [1, 7], [2, 4], [3, 5]]
+                    .iter()
+                    .map(|&[a, c]| dist(x[a], x[c]))
+                    .fold(0.0, f64::max);
+                3f64.sqrt() * v / (d * d)
+            }
         }
     }
+}
+
+/// The area of the triangle `a b c` in space.
+pub fn triangle_area(a: Point, b: Point, c: Point) -> f64 {
+    let n = cross(sub(b, a), sub(c, a));
+    0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+}
+
+/// `a − b`.
+#[inline]
+pub fn sub(a: Point, b: Point) -> Point {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// `a × b`.
+#[inline]
+pub fn cross(a: Point, b: Point) -> Point {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }

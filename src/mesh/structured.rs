@@ -60,7 +60,7 @@ pub fn grid(origin: [f64; 2], xs: &[f64], ys: &[f64], kind: ElementKind) -> Part
     let mut coords = Vec::with_capacity((nx + 1) * (ny + 1));
     for y in ys {
         for x in xs {
-            coords.push([origin[0] + x, origin[1] + y]);
+            coords.push([origin[0] + x, origin[1] + y, 0.0]);
         }
     }
     let mut conn = Vec::with_capacity(nx * ny * 6);
@@ -70,7 +70,7 @@ pub fn grid(origin: [f64; 2], xs: &[f64], ys: &[f64], kind: ElementKind) -> Part
             match kind {
                 ElementKind::Quad4 => conn.extend_from_slice(&[a, b, c, d]),
                 ElementKind::Tri3 => conn.extend_from_slice(&[a, b, c, a, c, d]),
-                ElementKind::Bar2 => panic!("a rectangle is meshed with quad4 or tri3"),
+                _ => panic!("a rectangle is meshed with quad4 or tri3"),
             }
         }
     }
@@ -101,10 +101,12 @@ pub fn grid(origin: [f64; 2], xs: &[f64], ys: &[f64], kind: ElementKind) -> Part
         (0..ny).rev().map(|j| [id(0, j + 1), id(0, j)]).collect(),
     );
     Part {
+        dim: 2,
         coords,
         blocks: vec![Elements::new(kind, conn)],
         node_sets,
         edge_sets,
+        face_sets: BTreeMap::new(),
         node_tags: None,
     }
 }
@@ -120,7 +122,7 @@ mod tests {
         assert_eq!(p.blocks[0].len(), 8);
         assert_eq!(p.node_sets["left"].len(), 3);
         assert_eq!(p.edge_sets["top"].len(), 4);
-        assert_eq!(p.coords[p.node_sets["top_right"][0]], [2.0, 1.0]);
+        assert_eq!(p.coords[p.node_sets["top_right"][0]], [2.0, 1.0, 0.0]);
         let t = rectangle([0.0, 0.0], [2.0, 1.0], 4, 2, ElementKind::Tri3);
         assert_eq!(t.blocks[0].len(), 16);
     }

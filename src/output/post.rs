@@ -8,7 +8,9 @@
 //! the element means of the fields.
 
 use crate::assembly::internal::points_per_element;
-use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind};
+use crate::fe::{
+    element, kinematics, stiffness_rule, strain, strain_solid, ElementKind, MAX_NODES,
+};
 use crate::material::mul3;
 use crate::material::store::StateStore;
 use crate::mesh::Mesh;
@@ -16,14 +18,14 @@ use crate::model::Model;
 
 /// Quadrature weights `w det J` of the points of element `e` of `block` (bars: one
 /// point of weight 1).
-fn point_weights(mesh: &Mesh, block: usize, e: usize, out: &mut [f64; 4]) -> usize {
+fn point_weights(mesh: &Mesh, block: usize, e: usize, out: &mut [f64; MAX_NODES]) -> usize {
     let b = &mesh.blocks[block];
     let kind = b.elements.kind;
     if kind == ElementKind::Bar2 {
         out[0] = 1.0;
         return 1;
     }
-    let mut x = [[0.0; 2]; 4];
+    let mut x = [[0.0; 3]; MAX_NODES];
     let nodes = b.elements.element(e);
     for (a, &n) in nodes.iter().enumerate() {
         x[a] = mesh.coords[n];
@@ -36,64 +38,78 @@ fn point_weights(mesh: &Mesh, block: usize, e: usize, out: &mut [f64; 4]) -> usi
 }
 
 /// Weighted mean of `f(point)` over the points of element `e`.
-fn element_mean(
+fn element_mean<const V: usize>(
     mesh: &Mesh,
     block: usize,
     e: usize,
     ng: usize,
-    mut f: impl FnMut(usize) -> [f64; 3],
-) -> [f64; 3] {
-    let mut w = [0.0; 4];
+    mut f: impl FnMut(usize) -> [f64; V],
+) -> [f64; V] {
+    let mut w = [0.0; MAX_NODES];
     let n = point_weights(mesh, block, e, &mut w);
     debug_assert_eq!(n, ng);
     let total: f64 = w[..n].iter().sum();
-    let mut avg = [0.0; 3];
+    let mut avg = [0.0; V];
     for q in 0..n {
         let v = f(e * ng + q);
-        for i in 0..3 {
+        for i in 0..V {
             avg[i] += w[q] / total * v[i];
         }
     }
     avg
 }
 
-/// Element-mean stress `[σ_xx, σ_yy, σ_xy]` of every element, blocks in order (bars:
-/// axial stress in the first slot): from the committed Gauss-point stresses when
-/// `points` holds them, else `C ε(u)`.
-pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64; 3]> {
+/// Element-mean stress of every element, blocks in order, in the Voigt order of
+/// `fe` (plane: `[σ_xx, σ_yy, σ_xy]` and three zeros; solid:
+/// `[σ_xx, σ_yy, σ_xy, σ_zz, σ_yz, σ_zx]`; bars: axial stress in the first slot):
+/// from the committed Gauss-point stresses when `points` holds them, else `C ε(u)`.
+pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64; 6]> {
     let mesh = &model.mesh;
+    let dim = mesh.dim;
+    let pad = |s: [f64; 3]| [s[0], s[1], s[2], 0.0, 0.0, 0.0];
     let mut out = Vec::with_capacity(mesh.n_elements());
     for (bi, block) in mesh.blocks.iter().enumerate() {
         let kind = block.elements.kind;
-        let ng = points_per_element(kind);
+        let ng = kind.points();
         if let Some(store) = points.get(bi) {
             let c = store.committed();
             for e in 0..block.elements.len() {
-                out.push(element_mean(mesh, bi, e, ng, |g| c.sigma(g)));
+                out.push(pad(element_mean(mesh, bi, e, ng, |g| c.sigma(g))));
             }
             continue;
         }
         let mat = &model.materials[block.material];
-        let d = mat.c(model.plane);
         let nn = kind.nodes();
         for e in 0..block.elements.len() {
             let nodes = block.elements.element(e);
-            let mut x = [[0.0; 2]; 4];
-            let mut ue = [0.0; 8];
+            let mut x = [[0.0; 3]; MAX_NODES];
+            let mut ue = [0.0; 3 * MAX_NODES];
             for (a, &n) in nodes.iter().enumerate() {
                 x[a] = mesh.coords[n];
-                ue[2 * a] = u[2 * n];
-                ue[2 * a + 1] = u[2 * n + 1];
+                for i in 0..dim {
+                    ue[dim * a + i] = u[dim * n + i];
+                }
             }
             if kind == ElementKind::Bar2 {
-                out.push([mat.e * element::bar_strain(&x[..2], &ue[..4]), 0.0, 0.0]);
+                let eps = element::bar_strain(&x[..2], dim, &ue[..2 * dim]);
+                out.push(pad([mat.e * eps, 0.0, 0.0]));
                 continue;
             }
             let rule = stiffness_rule(kind);
-            out.push(element_mean(mesh, bi, e, ng, |g| {
+            if kind.dim() == 3 {
+                let d = mat.c_solid();
+                out.push(element_mean(mesh, bi, e, ng, |g| {
+                    let k = kinematics(kind, &x[..nn], rule[g - e * ng].0);
+                    let eps = strain_solid(&k, nn, &ue);
+                    std::array::from_fn(|i| (0..6).map(|j| d[i][j] * eps[j]).sum())
+                }));
+                continue;
+            }
+            let d = mat.c(model.plane);
+            out.push(pad(element_mean(mesh, bi, e, ng, |g| {
                 let k = kinematics(kind, &x[..nn], rule[g - e * ng].0);
                 mul3(&d, &strain(&k, nn, &ue))
-            }));
+            })));
         }
     }
     out

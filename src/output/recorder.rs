@@ -99,8 +99,9 @@ impl Recorder {
     /// cadence.
     pub fn record(&mut self, model: &Model, s: &Snapshot) -> Result<()> {
         self.samples.clear();
+        let d = model.mesh.dim;
         for p in &model.probes {
-            let x = [s.u[2 * p.node], s.u[2 * p.node + 1]];
+            let x = [s.u[d * p.node], s.u[d * p.node + 1]];
             if let Some(summary) = self.probes.get_mut(&p.name) {
                 summary.sample(x[1]);
             }

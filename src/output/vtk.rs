@@ -14,6 +14,8 @@ use crate::mesh::{ElementKind, Mesh};
 /// Writes the VTK series of a run.
 pub struct VtkSeries {
     dir: PathBuf,
+    /// Dofs per node of the mesh.
+    dim: usize,
     entries: Vec<(f64, String)>,
     connectivity: Vec<u64>,
     offsets: Vec<u64>,
@@ -34,6 +36,8 @@ impl VtkSeries {
                 ElementKind::Quad4 => CellType::Quad,
                 ElementKind::Tri3 => CellType::Triangle,
                 ElementKind::Bar2 => CellType::Line,
+                ElementKind::Hex8 => CellType::Hexahedron,
+                ElementKind::Tet4 => CellType::Tetra,
             };
             for e in 0..b.elements.len() {
                 connectivity.extend(b.elements.element(e).iter().map(|&n| n as u64));
@@ -41,8 +45,9 @@ impl VtkSeries {
                 types.push(t);
             }
         }
-        let points = mesh.coords.iter().flat_map(|c| [c[0], c[1], 0.0]).collect();
+        let points = mesh.coords.iter().flatten().copied().collect();
         Ok(VtkSeries {
+            dim: mesh.dim,
             dir: dir.into(),
             entries: Vec::new(),
             connectivity,
@@ -62,14 +67,25 @@ impl VtkSeries {
         u: &[f64],
         v: &[f64],
         point_extra: &[(&str, &[f64])],
-        stress: &[[f64; 3]],
+        stress: &[[f64; 6]],
         extra: &[(&str, Vec<f64>)],
     ) -> Result<()> {
+        let dim = self.dim;
         let vec3 = |x: &[f64]| -> IOBuffer {
-            x.chunks_exact(2)
-                .flat_map(|p| [p[0], p[1], 0.0])
+            x.chunks_exact(dim)
+                .flat_map(|p| [p[0], p[1], if dim == 3 { p[2] } else { 0.0 }])
                 .collect::<Vec<f64>>()
                 .into()
+        };
+        // The plane's three components as they are; a solid's six in VTK's
+        // symmetric-tensor order `xx, yy, zz, xy, yz, xz`.
+        let stress: Vec<f64> = if dim == 3 {
+            stress
+                .iter()
+                .flat_map(|s| [s[0], s[1], s[3], s[2], s[4], s[5]])
+                .collect()
+        } else {
+            stress.iter().flat_map(|s| [s[0], s[1], s[2]]).collect()
         };
         let piece = UnstructuredGridPiece {
             points: self.points.clone().into(),
@@ -107,13 +123,8 @@ impl VtkSeries {
                 .collect(),
                 cell: std::iter::once(Attribute::DataArray(DataArray {
                     name: "stress".into(),
-                    elem: ElementType::Generic(3),
-                    data: stress
-                        .iter()
-                        .flatten()
-                        .copied()
-                        .collect::<Vec<f64>>()
-                        .into(),
+                    elem: ElementType::Generic(if dim == 3 { 6 } else { 3 }),
+                    data: stress.into(),
                 }))
                 .chain(extra.iter().map(|(name, values)| {
                     Attribute::DataArray(DataArray {

@@ -8,21 +8,23 @@
 //! nothing. The domain is the plane section (no thickness weight): the norms of the
 //! Rothe theory on `Ω ⊂ R²`.
 
-use crate::fe::{kinematics, mass_rule, ElementKind};
+use crate::fe::{kinematics, mass_rule, ElementKind, MAX_NODES};
 use crate::mesh::Mesh;
 
 /// One Gauss point: weight × det J, shape values and gradients, element nodes.
 struct Point {
     w: f64,
-    n: [f64; 4],
-    dndx: [[f64; 2]; 4],
-    nodes: [usize; 4],
+    n: [f64; MAX_NODES],
+    dndx: [[f64; 3]; MAX_NODES],
+    nodes: [usize; MAX_NODES],
     nn: usize,
 }
 
 /// The quadrature of a mesh, computed once and reused for every inner product.
 pub struct Norms {
     points: Vec<Point>,
+    /// Dofs per node.
+    dim: usize,
 }
 
 /// `(x, y)` in `L2` and in `H1`.
@@ -46,8 +48,8 @@ impl Norms {
             let nn = kind.nodes();
             for e in 0..b.elements.len() {
                 let conn = b.elements.element(e);
-                let x: Vec<[f64; 2]> = conn.iter().map(|&n| mesh.coords[n]).collect();
-                let mut nodes = [0; 4];
+                let x: Vec<[f64; 3]> = conn.iter().map(|&n| mesh.coords[n]).collect();
+                let mut nodes = [0; MAX_NODES];
                 nodes[..nn].copy_from_slice(conn);
                 for &(xi, w) in mass_rule(kind) {
                     let k = kinematics(kind, &x, xi);
@@ -61,31 +63,42 @@ impl Norms {
                 }
             }
         }
-        Norms { points }
+        Norms {
+            points,
+            dim: mesh.dim,
+        }
     }
 
-    /// `(x, y)` for two nodal displacement vectors (two dofs per node).
+    /// `(x, y)` for two nodal displacement vectors (`dim` dofs per node).
     pub fn products(&self, x: &[f64], y: &[f64]) -> Products {
+        let dim = self.dim;
         let mut p = Products::default();
         for q in &self.points {
-            let (mut vx, mut vy) = ([0.0; 2], [0.0; 2]);
-            let (mut gx, mut gy) = ([[0.0; 2]; 2], [[0.0; 2]; 2]);
+            let (mut vx, mut vy) = ([0.0; 3], [0.0; 3]);
+            let (mut gx, mut gy) = ([[0.0; 3]; 3], [[0.0; 3]; 3]);
             for a in 0..q.nn {
-                let d = 2 * q.nodes[a];
-                for c in 0..2 {
+                let d = dim * q.nodes[a];
+                for c in 0..dim {
                     vx[c] += q.n[a] * x[d + c];
                     vy[c] += q.n[a] * y[d + c];
-                    for k in 0..2 {
+                    for k in 0..dim {
                         gx[c][k] += q.dndx[a][k] * x[d + c];
                         gy[c][k] += q.dndx[a][k] * y[d + c];
                     }
                 }
             }
-            let v = vx[0] * vy[0] + vx[1] * vy[1];
-            let g = gx[0][0] * gy[0][0]
-                + gx[0][1] * gy[0][1]
-                + gx[1][0] * gy[1][0]
-                + gx[1][1] * gy[1][1];
+            let mut v = vx[0] * vy[0];
+            for c in 1..dim {
+                v += vx[c] * vy[c];
+            }
+            let mut g = gx[0][0] * gy[0][0];
+            for c in 0..dim {
+                for k in 0..dim {
+                    if c + k > 0 {
+                        g += gx[c][k] * gy[c][k];
+                    }
+                }
+            }
             p.l2 += q.w * v;
             p.h1 += q.w * (v + g);
         }
@@ -121,7 +134,8 @@ mod tests {
         // u = 1 − 2x − y vanishes at the centroid, yet ∫u² = A/6 (the mass matrix
         // A/12 (1 + δ_ab) applied to (1, −1, 0)) and ∫|∇u|² = A |(−2, −1)|² = 5A.
         let part = Part {
-            coords: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            dim: 2,
+            coords: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
             blocks: vec![crate::mesh::Elements::new(ElementKind::Tri3, vec![0, 1, 2])],
             ..Default::default()
         };

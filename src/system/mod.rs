@@ -120,7 +120,7 @@ impl EffectiveSystem {
         dofs: DofMap,
         backend: Backend,
         ordering: Ordering,
-        coords: &[[f64; 2]],
+        coords: &[[f64; 3]],
     ) -> Result<Self> {
         let reduced = ReducedMatrix::new(pattern, &dofs);
         let t = Instant::now();

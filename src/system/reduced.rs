@@ -28,23 +28,24 @@ impl ReducedMatrix {
         let mut row_idx = Vec::with_capacity(cap);
         let mut src = Vec::with_capacity(cap);
         let mut diag_pos = Vec::with_capacity(nf);
+        let d = pattern.dim;
         for n in 0..pattern.n_nodes {
             let nbrs = &pattern.adj[pattern.adj_ptr[n]..pattern.adj_ptr[n + 1]];
-            for j in 0..2 {
-                let ec = dofs.eq[2 * n + j];
+            for j in 0..d {
+                let ec = dofs.eq[d * n + j];
                 if ec == super::CONSTRAINED {
                     continue;
                 }
                 let c0 = pattern.col_start(n, j);
                 for (k, &m) in nbrs.iter().enumerate() {
-                    for i in 0..2 {
-                        let er = dofs.eq[2 * m as usize + i];
+                    for i in 0..d {
+                        let er = dofs.eq[d * m as usize + i];
                         if er != super::CONSTRAINED && er >= ec {
                             if er == ec {
                                 diag_pos.push(row_idx.len());
                             }
                             row_idx.push(er);
-                            src.push(c0 + 2 * k + i);
+                            src.push(c0 + d * k + i);
                         }
                     }
                 }
@@ -65,8 +66,9 @@ impl ReducedMatrix {
     }
 
     /// Nested-dissection elimination order of the free dofs from the node coordinates.
-    pub fn nested_dissection(&self, dofs: &DofMap, coords: &[[f64; 2]]) -> Vec<usize> {
-        let xy: Vec<[f64; 2]> = dofs.free.iter().map(|&d| coords[d / 2]).collect();
+    pub fn nested_dissection(&self, dofs: &DofMap, coords: &[[f64; 3]]) -> Vec<usize> {
+        let dim = dofs.eq.len() / coords.len().max(1);
+        let xy: Vec<[f64; 3]> = dofs.free.iter().map(|&d| coords[d / dim]).collect();
         crate::linsolve::ordering::nested_dissection(&xy, &self.csc.col_ptr, &self.csc.row_idx)
     }
 

@@ -3,6 +3,10 @@
 //! `c = sqrt(E(1−ν) / (ρ(1+ν)(1−2ν)))` of the paper's formula (ω = 1 here), and
 //! `c = sqrt(E/ρ)` for bars.
 
+use crate::fe::MAX_ELEMENT_DOFS;
+
+/// The size of the largest element matrix.
+const ELEMENT_MATRIX: usize = MAX_ELEMENT_DOFS * MAX_ELEMENT_DOFS;
 use crate::mesh::ElementKind;
 use crate::model::Model;
 
@@ -74,22 +78,28 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
         let a_k = model.analysis.rayleigh[1];
         for e in 0..b.elements.len() {
             let nodes = b.elements.element(e);
-            let x: Vec<[f64; 2]> = nodes.iter().map(|&n| mesh.coords[n]).collect();
+            let x: Vec<[f64; 3]> = nodes.iter().map(|&n| mesh.coords[n]).collect();
             // Shape key: coordinates relative to the first node, to 1e-12 of the size.
             let size = mesh.element_length(bi, e).max(f64::MIN_POSITIVE);
             let key: Vec<i64> = x
                 .iter()
-                .flat_map(|p| [p[0] - x[0][0], p[1] - x[0][1]])
+                .flat_map(|p| [p[0] - x[0][0], p[1] - x[0][1], p[2] - x[0][2]])
                 .map(|c| (c / size * 1e12).round() as i64)
                 .collect();
             let dt = *seen.entry((bi, key)).or_insert_with(|| {
-                let nd = 2 * nodes.len();
-                let mut ke = [0.0; 64];
-                let mut me = [0.0; 64];
+                let dim = mesh.dim;
+                let nd = dim * nodes.len();
+                let mut ke = [0.0; ELEMENT_MATRIX];
+                let mut me = [0.0; ELEMENT_MATRIX];
                 match b.elements.kind {
                     ElementKind::Bar2 => {
-                        crate::fe::element::bar_stiffness(&x, m.e * b.section, &mut ke);
-                        crate::fe::element::bar_mass(&x, m.rho * b.section, &mut me);
+                        crate::fe::element::bar_stiffness(&x, dim, m.e * b.section, &mut ke);
+                        crate::fe::element::bar_mass(&x, dim, m.rho * b.section, &mut me);
+                    }
+                    kind if dim == 3 => {
+                        let d = m.c_solid();
+                        crate::fe::element::continuum_stiffness(kind, &x, &d, b.section, &mut ke);
+                        crate::fe::element::continuum_mass(kind, &x, m.rho * b.section, &mut me);
                     }
                     kind => {
                         crate::fe::element::continuum_stiffness(kind, &x, &d, b.section, &mut ke);
@@ -97,13 +107,13 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
                     }
                 }
                 // Lumped: row sums. Symmetric form D^{-1/2} K D^{-1/2}.
-                let mut s = [0.0; 8];
+                let mut s = [0.0; MAX_ELEMENT_DOFS];
                 for i in 0..nd {
                     let row: f64 = (0..nd).map(|j| me[i * nd + j]).sum();
                     s[i] = if row > 0.0 { 1.0 / row.sqrt() } else { 0.0 };
                 }
-                let scaled = |k: &[f64; 64]| {
-                    let mut a = [0.0; 64];
+                let scaled = |k: &[f64; ELEMENT_MATRIX]| {
+                    let mut a = [0.0; ELEMENT_MATRIX];
                     for i in 0..nd {
                         for j in 0..nd {
                             a[i * nd + j] = s[i] * k[i * nd + j] * s[j];
@@ -120,7 +130,7 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
                 let mut c_max = a_k * omega2;
                 if let (Some(eta), ElementKind::Quad4 | ElementKind::Tri3) = (eta, b.elements.kind)
                 {
-                    let mut ce = [0.0; 64];
+                    let mut ce = [0.0; ELEMENT_MATRIX];
                     crate::fe::element::continuum_stiffness(
                         b.elements.kind,
                         &x,
@@ -205,7 +215,7 @@ pub fn mesh_stable_step(model: &Model, iterations: usize) -> f64 {
 
 /// The largest eigenvalue of the symmetric `n x n` (row-major, `n ≤ 8`) matrix `a`,
 /// by cyclic Jacobi rotations (`a` is overwritten).
-fn largest_eigenvalue(a: &mut [f64; 64], n: usize) -> f64 {
+fn largest_eigenvalue(a: &mut [f64; ELEMENT_MATRIX], n: usize) -> f64 {
     for _ in 0..50 {
         let off: f64 = (0..n)
             .flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j)))
@@ -253,7 +263,7 @@ mod tests {
     #[test]
     fn jacobi_finds_the_largest_eigenvalue() {
         // [[2, 1, 0], [1, 2, 1], [0, 1, 2]]: eigenvalues 2 − √2, 2, 2 + √2.
-        let mut a = [0.0; 64];
+        let mut a = [0.0; ELEMENT_MATRIX];
         let m = [[2.0, 1.0, 0.0], [1.0, 2.0, 1.0], [0.0, 1.0, 2.0]];
         for i in 0..3 {
             for j in 0..3 {

@@ -90,20 +90,20 @@ pub(crate) fn likely_cause(
         Scheme::Static { .. } => {
             let mut free_bodies = Vec::new();
             for (b, body) in model.bodies.iter().enumerate() {
-                let mut held = [0usize; 2];
+                let mut held = [0usize; 3];
                 let mut nodes = std::collections::BTreeSet::new();
                 for c in &model.constraints {
-                    if model.mesh.node_body[c.dof / 2] == b {
-                        held[c.dof % 2] += 1;
-                        nodes.insert(c.dof / 2);
+                    let dim = model.mesh.dim;
+                    if model.mesh.node_body[c.dof / dim] == b {
+                        held[c.dof % dim] += 1;
+                        nodes.insert(c.dof / dim);
                     }
                 }
-                let why = if held == [0, 0] {
+                let dim = model.mesh.dim;
+                let why = if held[..dim].iter().all(|&h| h == 0) {
                     Some("has no supports".to_string())
-                } else if held[0] == 0 {
-                    Some("is free to move in x".to_string())
-                } else if held[1] == 0 {
-                    Some("is free to move in y".to_string())
+                } else if let Some(c) = (0..dim).find(|&c| held[c] == 0) {
+                    Some(format!("is free to move in {}", ["x", "y", "z"][c]))
                 } else if nodes.len() < 2 {
                     Some("is held at one node only and free to rotate".to_string())
                 } else {

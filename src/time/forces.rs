@@ -22,7 +22,9 @@ pub fn external_force(model: &Model, gravity: Option<&[f64]>, t: f64, f: &mut [f
 /// Gravity force `M g` (exact for a constant acceleration field), if any.
 pub fn gravity_force(model: &Model, mass: &Mass, pattern: &Pattern) -> Option<Vec<f64>> {
     model.gravity.map(|g| {
-        let field: Vec<f64> = (0..model.mesh.n_dofs()).map(|d| g[d % 2]).collect();
+        let dim = model.mesh.dim;
+        let g3 = [g[0], g[1], 0.0];
+        let field: Vec<f64> = (0..model.mesh.n_dofs()).map(|d| g3[d % dim]).collect();
         let mut f = vec![0.0; field.len()];
         mass.matvec(pattern, &field, &mut f);
         f

@@ -346,7 +346,7 @@ impl NodalLaws {
             let rule = stiffness_rule(kind);
             for e in 0..block.elements.len() {
                 let nodes = block.elements.element(e);
-                let mut x = [[0.0; 2]; 4];
+                let mut x = [[0.0; 3]; 4];
                 let (mut ue, mut de, mut ude) = ([0.0; 8], [0.0; 8], [0.0; 8]);
                 for (a, &n) in nodes.iter().enumerate() {
                     x[a] = mesh.coords[n];
@@ -361,7 +361,7 @@ impl NodalLaws {
                     }
                 }
                 if kind == ElementKind::Bar2 {
-                    let eps = element::bar_strain(&x[..2], &ue[..4]);
+                    let eps = element::bar_strain(&x[..2], 2, &ue[..4]);
                     store.set_committed(e, [eps, 0.0, 0.0], [mat.e * eps, 0.0, 0.0], f64::NAN, &[]);
                     continue;
                 }
@@ -428,14 +428,14 @@ fn group_matrix(
     asm.assemble(mesh, |bi, _e, x, ke| {
         let block = &mesh.blocks[bi];
         let kind = block.elements.kind;
-        let nd = 2 * kind.nodes();
+        let nd = mesh.dim * kind.nodes();
         if !in_group(bi) {
             ke[..nd * nd].fill(0.0);
             return;
         }
         let mat = &model.materials[block.material];
         match kind {
-            ElementKind::Bar2 => element::bar_stiffness(x, mat.e * block.section, ke),
+            ElementKind::Bar2 => element::bar_stiffness(x, mesh.dim, mat.e * block.section, ke),
             kind => element::continuum_stiffness(kind, x, &ds[block.material], block.section, ke),
         }
     })

@@ -52,7 +52,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
 /// Holds component `comp` of `nodes` at `value(x)` (constant in time).
 pub fn prescribe(model: &mut Model, nodes: &[usize], comp: usize, value: impl Fn([f64; 2]) -> f64) {
     for &n in nodes {
-        let v = value(model.mesh.coords[n]);
+        let v = value(model.mesh.xy(n));
         model.constraints.push(Constraint {
             dof: 2 * n + comp,
             value: v,

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use super::checks::{check_function, finite};
 use crate::assembly::loads;
-use crate::config::{Component, LoadSpec, Scenario};
+use crate::config::{LoadSpec, Scenario};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::model::{Body, Constraint, Load, Probe, TimeFunction};
@@ -47,7 +47,7 @@ pub(super) fn constraints(s: &Scenario, mesh: &Mesh) -> Result<Vec<Constraint>> 
     let mut claim = |dof: usize, new: Claim| -> Result<()> {
         if let Some(old) = by_dof.get(&dof) {
             if !(old.support && new.support) {
-                let (n, c) = (dof / 2, if dof % 2 == 0 { "x" } else { "y" });
+                let (n, c) = (dof / mesh.dim, ["x", "y", "z"][dof % mesh.dim]);
                 return Err(Error::config(
                     &new.field,
                     format!(
@@ -69,9 +69,15 @@ pub(super) fn constraints(s: &Scenario, mesh: &Mesh) -> Result<Vec<Constraint>> 
                 "name at least one component (\"x\", \"y\")",
             ));
         }
+        if let Some(c) = sup.fix.iter().find(|c| c.index() >= mesh.dim) {
+            return Err(Error::config(
+                format!("{field}.fix"),
+                format!("component {c:?} in a plane model (only x and y)"),
+            ));
+        }
         for &n in node_set(mesh, &format!("{field}.set"), &sup.set)? {
             for c in &sup.fix {
-                let dof = 2 * n + (*c == Component::Y) as usize;
+                let dof = mesh.dim * n + c.index();
                 claim(
                     dof,
                     Claim {
@@ -91,8 +97,14 @@ pub(super) fn constraints(s: &Scenario, mesh: &Mesh) -> Result<Vec<Constraint>> 
         let field = format!("prescribed[{i}]");
         finite(&format!("{field}.value"), &[p.value])?;
         check_function(&format!("{field}.function"), &p.function)?;
+        if p.component.index() >= mesh.dim {
+            return Err(Error::config(
+                format!("{field}.component"),
+                "component z in a plane model (only x and y)",
+            ));
+        }
         for &n in node_set(mesh, &format!("{field}.set"), &p.set)? {
-            let dof = 2 * n + (p.component == Component::Y) as usize;
+            let dof = mesh.dim * n + p.component.index();
             claim(
                 dof,
                 Claim {
@@ -110,6 +122,41 @@ pub(super) fn constraints(s: &Scenario, mesh: &Mesh) -> Result<Vec<Constraint>> 
     Ok(by_dof.into_values().map(|c| c.constraint).collect())
 }
 
+/// Refuses a z component in a plane model.
+fn plane_vector(mesh: &Mesh, field: &str, v: &[f64; 3]) -> Result<()> {
+    if mesh.dim == 2 && v[2] != 0.0 {
+        return Err(Error::config(
+            field,
+            format!("a plane model has no z component (got {v:?}): give two"),
+        ));
+    }
+    Ok(())
+}
+
+/// The non-empty named set `set` of `sets` (`what`: "edge" or "face"), or an error
+/// that lists the known ones.
+fn named_set<'m, T>(
+    field: &str,
+    what: &str,
+    sets: &'m BTreeMap<String, Vec<T>>,
+    set: &str,
+) -> Result<&'m [T]> {
+    match sets.get(set) {
+        Some(e) if !e.is_empty() => Ok(e),
+        Some(_) => Err(Error::config(
+            format!("{field}.set"),
+            format!("{what} set `{set}` is empty"),
+        )),
+        None => Err(Error::config(
+            format!("{field}.set"),
+            format!(
+                "unknown {what} set `{set}` (known: {})",
+                sets.keys().cloned().collect::<Vec<_>>().join(", ")
+            ),
+        )),
+    }
+}
+
 /// The loads as force patterns scaled by their time functions.
 pub(super) fn loads(s: &Scenario, mesh: &Mesh, bodies: &[Body]) -> Result<Vec<Load>> {
     let mut out = Vec::new();
@@ -123,31 +170,23 @@ pub(super) fn loads(s: &Scenario, mesh: &Mesh, bodies: &[Body]) -> Result<Vec<Lo
                 function,
             } => {
                 finite(&format!("{field}.value"), value)?;
-                let edges = match mesh.edge_sets.get(set) {
-                    Some(e) if !e.is_empty() => e,
-                    Some(_) => {
-                        return Err(Error::config(
-                            format!("{field}.set"),
-                            format!("edge set `{set}` is empty"),
-                        ))
-                    }
-                    None => {
-                        return Err(Error::config(
-                            format!("{field}.set"),
-                            format!(
-                                "unknown edge set `{set}` (known: {})",
-                                mesh.edge_sets
-                                    .keys()
-                                    .cloned()
-                                    .collect::<Vec<_>>()
-                                    .join(", ")
-                            ),
-                        ))
-                    }
-                };
-                let body = mesh.node_body[edges[0][0]];
-                loads::add_edge_traction(mesh, edges, *value, bodies[body].thickness, &mut f);
-                (function, format!("traction on {set}"))
+                plane_vector(mesh, &format!("{field}.value"), value)?;
+                if mesh.dim == 3 {
+                    let faces = named_set(&field, "face", &mesh.face_sets, set)?;
+                    loads::add_face_traction(mesh, faces, *value, &mut f);
+                    (function, format!("traction on {set}"))
+                } else {
+                    let edges = named_set(&field, "edge", &mesh.edge_sets, set)?;
+                    let body = mesh.node_body[edges[0][0]];
+                    loads::add_edge_traction(
+                        mesh,
+                        edges,
+                        [value[0], value[1]],
+                        bodies[body].thickness,
+                        &mut f,
+                    );
+                    (function, format!("traction on {set}"))
+                }
             }
             LoadSpec::Nodal {
                 set,
@@ -155,7 +194,9 @@ pub(super) fn loads(s: &Scenario, mesh: &Mesh, bodies: &[Body]) -> Result<Vec<Lo
                 function,
             } => {
                 finite(&format!("{field}.value"), value)?;
+                plane_vector(mesh, &format!("{field}.value"), value)?;
                 loads::add_nodal(
+                    mesh.dim,
                     node_set(mesh, &format!("{field}.set"), set)?,
                     *value,
                     &mut f,
@@ -201,7 +242,7 @@ pub(super) fn probes(s: &Scenario, mesh: &Mesh) -> Result<Vec<Probe>> {
             (Some(x), None) => {
                 finite(&format!("{field}.at"), x)?;
                 let n = mesh
-                    .nearest_node(*x)
+                    .nearest_node([x[0], x[1], 0.0])
                     .ok_or_else(|| Error::config(&field, "the mesh has no nodes"))?;
                 let c = mesh.coords[n];
                 let d = ((c[0] - x[0]).powi(2) + (c[1] - x[1]).powi(2)).sqrt();

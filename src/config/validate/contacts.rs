@@ -91,7 +91,7 @@ fn mortar_reach(
         slave_segments,
         master,
         radius,
-        &|n| mesh.coords[n],
+        &|n| mesh.xy(n),
         &mut rows,
     );
     if needed > crate::contact::rows::ROW_NODES {
@@ -220,7 +220,7 @@ pub(super) fn contacts(
                     }
                 }
                 for e in &edges {
-                    let l = dist(mesh.coords[e[0]], mesh.coords[e[1]]);
+                    let l = dist(mesh.xy(e[0]), mesh.xy(e[1]));
                     radius = radius.max(l);
                     shortest = shortest.min(l);
                 }
@@ -277,7 +277,7 @@ pub(super) fn contacts(
                     nodes.sort_unstable();
                     nodes.dedup();
                     for e in &back {
-                        let l = dist(mesh.coords[e[0]], mesh.coords[e[1]]);
+                        let l = dist(mesh.xy(e[0]), mesh.xy(e[1]));
                         radius = radius.max(l);
                         shortest = shortest.min(l);
                     }

@@ -9,7 +9,7 @@ use crate::config::{LoadOptions, MeshSpec, MeshingSpec, Scenario};
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::memory::{factor_nnz_estimate, Estimate};
-use crate::mesh::{gmsh, structured, Block, ElementKind, Elements, Mesh, Part};
+use crate::mesh::{gmsh, solid, structured, Block, ElementKind, Elements, Mesh, Part};
 use crate::model::Body;
 
 /// The nodes and elements of a rectangle of `nx x ny` cells, or `None` if the counts
@@ -39,6 +39,10 @@ pub fn meshing_size_is_taken(s: &Scenario) -> Result<()> {
                 divisions: None,
                 element_size: None,
                 ..
+            } | MeshSpec::Box {
+                divisions: None,
+                element_size: None,
+                ..
             }
         )
     });
@@ -53,7 +57,10 @@ pub fn meshing_size_is_taken(s: &Scenario) -> Result<()> {
                 MeshSpec::Rectangle {
                     divisions: Some(_), ..
                 } => "divisions",
-                MeshSpec::Rectangle { .. } => "its own element_size",
+                MeshSpec::Box {
+                    divisions: Some(_), ..
+                } => "divisions",
+                MeshSpec::Rectangle { .. } | MeshSpec::Box { .. } => "its own element_size",
                 MeshSpec::Gmsh { .. } => "a Gmsh file",
             };
             format!("`{}` gives {given}", b.name)
@@ -69,23 +76,36 @@ pub fn meshing_size_is_taken(s: &Scenario) -> Result<()> {
     ))
 }
 
-/// How one rectangle is cut, resolved from its spec and `[meshing]`.
-enum Cuts<'a> {
+/// How one rectangle (`N = 2`) or box (`N = 3`) is cut, resolved from its spec and
+/// `[meshing]`.
+enum Cuts<'a, const N: usize> {
     /// `divisions`: equal cells.
-    Equal([usize; 2]),
+    Equal([usize; N]),
     /// `element_size` with optional grid lines.
-    Sized { size: f64, lines: [&'a [f64]; 2] },
+    Sized { size: f64, lines: [&'a [f64]; N] },
 }
 
-/// Resolves and checks a rectangle's cuts (before anything is allocated).
-fn rectangle_cuts<'a>(
+impl<const N: usize> Cuts<'_, N> {
+    /// The cell boundaries along each axis.
+    fn lines(&self, size: [f64; N]) -> [Vec<f64>; N] {
+        std::array::from_fn(|a| match self {
+            Cuts::Equal(d) => (0..=d[a])
+                .map(|i| size[a] * i as f64 / d[a] as f64)
+                .collect(),
+            Cuts::Sized { size: h, lines } => structured::graded_lines(size[a], *h, lines[a]),
+        })
+    }
+}
+
+/// Resolves and checks a rectangle's or a box's cuts (before anything is allocated).
+fn rectangle_cuts<'a, const N: usize>(
     field: &str,
-    size: [f64; 2],
-    divisions: Option<[usize; 2]>,
+    size: [f64; N],
+    divisions: Option<[usize; N]>,
     element_size: Option<f64>,
-    lines: [&'a [f64]; 2],
+    lines: [&'a [f64]; N],
     meshing: &MeshingSpec,
-) -> Result<Cuts<'a>> {
+) -> Result<Cuts<'a, N>> {
     if let Some(d) = divisions {
         if element_size.is_some() {
             return Err(Error::config(
@@ -93,13 +113,13 @@ fn rectangle_cuts<'a>(
                 "give `divisions` or `element_size`, not both",
             ));
         }
-        if !lines[0].is_empty() || !lines[1].is_empty() {
+        if lines.iter().any(|l| !l.is_empty()) {
             return Err(Error::config(
                 format!("{field}.x_lines"),
                 "grid lines need `element_size` (here or in [meshing]), not `divisions`",
             ));
         }
-        if d[0] == 0 || d[1] == 0 {
+        if d.contains(&0) {
             return Err(Error::config(
                 format!("{field}.divisions"),
                 format!("must be at least 1 each way, got {d:?}"),
@@ -118,7 +138,11 @@ fn rectangle_cuts<'a>(
         }
     };
     positive(&h_field, h)?;
-    for (axis, name) in [(0, "x_lines"), (1, "y_lines")] {
+    for (axis, name) in ["x_lines", "y_lines", "z_lines"]
+        .into_iter()
+        .enumerate()
+        .take(N)
+    {
         let f = format!("{field}.{name}");
         finite(&f, lines[axis])?;
         let mut prev = 0.0;
@@ -157,7 +181,7 @@ fn cells_along(length: f64, size: f64, lines: &[f64]) -> f64 {
         .sum()
 }
 
-impl Cuts<'_> {
+impl Cuts<'_, 2> {
     /// Cells along x and y.
     fn counts(&self, size: [f64; 2]) -> (u64, u64) {
         match self {
@@ -319,6 +343,44 @@ pub(super) fn body_part(
                 ),
             })
         }
+        MeshSpec::Box {
+            origin,
+            size,
+            divisions,
+            element_size,
+            x_lines,
+            y_lines,
+            z_lines,
+            element,
+        } => {
+            finite(&format!("{field}.origin"), origin)?;
+            for (i, &l) in size.iter().enumerate() {
+                positive(&format!("{field}.size[{i}]"), l)?;
+            }
+            if !matches!(element, ElementKind::Hex8 | ElementKind::Tet4) {
+                return Err(Error::config(
+                    format!("{field}.element"),
+                    "a box is meshed with hex8 or tet4",
+                ));
+            }
+            let cuts = rectangle_cuts(
+                field,
+                *size,
+                *divisions,
+                *element_size,
+                [x_lines, y_lines, z_lines],
+                meshing,
+            )?;
+            let [xs, ys, zs] = cuts.lines(*size);
+            let cells = (xs.len() - 1) as f64 * (ys.len() - 1) as f64 * (zs.len() - 1) as f64;
+            if cells > 2e8 {
+                return Err(Error::config(
+                    format!("{field}.divisions"),
+                    format!("{cells:.3e} cells: far too many"),
+                ));
+            }
+            Ok(solid::block(*origin, &xs, &ys, &zs, *element))
+        }
         MeshSpec::Gmsh { file } => {
             if file.trim().is_empty() {
                 return Err(Error::config(
@@ -391,7 +453,12 @@ pub(super) fn add_bars(
                 ),
             ));
         }
-        let nodes = mesh.nodes_on_segment(body, bar.from, bar.to, 1e-9 * len.max(1.0));
+        let nodes = mesh.nodes_on_segment(
+            body,
+            [bar.from[0], bar.from[1], 0.0],
+            [bar.to[0], bar.to[1], 0.0],
+            1e-9 * len.max(1.0),
+        );
         if nodes.len() < 2 {
             return Err(Error::config(
                 field,

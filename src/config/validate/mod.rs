@@ -22,6 +22,7 @@ pub use meshes::estimate;
 
 use super::{LoadOptions, Scenario};
 use crate::error::{Error, Result};
+use crate::fe::Plane;
 use crate::mesh::Mesh;
 use crate::model::{Analysis, AnalysisKind, Body, Model, TimeScheme};
 
@@ -81,7 +82,9 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 format!("duplicate body name `{}`", b.name),
             ));
         }
-        positive(&format!("{field}.thickness"), b.thickness)?;
+        if let Some(t) = b.thickness {
+            positive(&format!("{field}.thickness"), t)?;
+        }
         finite(&format!("{field}.velocity"), &b.velocity)?;
         let mat = find_material(format!("{field}.material"), &b.material)?;
         let part =
@@ -94,17 +97,55 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                     e => e,
                 }
             })?;
-        products_are_finite(&field, b, &materials[mat], a.plane, &part)?;
-        mesh.add_part(&part, bi, &b.name, mat, b.thickness);
+        let thickness = match (part.dim, b.thickness) {
+            (2, Some(t)) => t,
+            (2, None) => {
+                return Err(Error::config(
+                    format!("{field}.thickness"),
+                    format!(
+                        "body `{}` is plane: give its thickness (m), the length its \
+                         elements stand for",
+                        b.name
+                    ),
+                ))
+            }
+            (_, None) => 1.0,
+            (_, Some(_)) => {
+                return Err(Error::config(
+                    format!("{field}.thickness"),
+                    format!(
+                        "body `{}` is a solid (its mesh is three-dimensional): it has no \
+                         thickness; remove the key",
+                        b.name
+                    ),
+                ))
+            }
+        };
+        if bi > 0 && part.dim != mesh.dim {
+            return Err(Error::config(
+                format!("{field}.mesh"),
+                format!(
+                    "body `{}` is {}D but `{}` is {}D: one model has one dimension",
+                    b.name, part.dim, s.bodies[0].name, mesh.dim
+                ),
+            ));
+        }
+        let plane = if part.dim == 3 { Plane::Solid } else { a.plane };
+        products_are_finite(&field, thickness, &materials[mat], plane, &part)?;
+        mesh.add_part(&part, bi, &b.name, mat, thickness);
         bodies.push(Body {
             name: b.name.clone(),
             velocity: b.velocity,
-            thickness: b.thickness,
+            thickness,
         });
     }
     meshes::add_bars(s, &mut mesh, &bodies, &materials, &find_material)?;
     let names: Vec<String> = bodies.iter().map(|b| b.name.clone()).collect();
     mesh.check_elements(&names)?;
+    let dim = mesh.dim;
+    if dim == 3 {
+        solid_scope(s, &mesh, &materials)?;
+    }
     materials::check_crack_band(&mesh, &materials)?;
     meshes::check_memory(&mesh, &materials, opts)?;
 
@@ -137,7 +178,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let mut model = Model {
         mesh,
         materials,
-        plane: a.plane,
+        plane: if dim == 3 { Plane::Solid } else { a.plane },
         bodies,
         constraints,
         loads,
@@ -187,7 +228,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
 fn initial_overlap(model: &Model) -> Result<()> {
     let mut cands = Vec::new();
     let coords = &model.mesh.coords;
-    crate::contact::detect::detect(&model.contacts, |n| coords[n], &mut cands);
+    crate::contact::detect::detect(&model.contacts, |n| crate::mesh::xy(coords[n]), &mut cands);
     let tol = model.analysis.contact_tolerance;
     let deepest = cands
         .iter()
@@ -222,41 +263,80 @@ fn initial_overlap(model: &Model) -> Result<()> {
 /// A body's thickness times its material's stiffness and density (and times its
 /// area) must stay finite: a thickness of 1e300 overflows the element matrices,
 /// which would otherwise surface as a singular stiffness far from its cause.
+/// What a solid model can hold so far: linear elastic materials, supports, loads,
+/// gravity and probes; no contact (three-dimensional contact is its own work) and
+/// no bars. Each refusal names the field.
+fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material]) -> Result<()> {
+    for block in &mesh.blocks {
+        let m = &materials[block.material];
+        if !m.is_linear_elastic() {
+            return Err(Error::config(
+                format!("materials.{}.model", m.name),
+                format!(
+                    "`{}` in a solid: solids take linear elastic materials so far (the \
+                     other models run in plane stress or strain)",
+                    m.model_name()
+                ),
+            ));
+        }
+    }
+    if !s.contact.is_empty() {
+        return Err(Error::config(
+            "contact[0]",
+            "contact between solids is not available yet: three-dimensional models run \
+             without contact",
+        ));
+    }
+    if !s.bars.is_empty() {
+        return Err(Error::config(
+            "bars[0]",
+            "bars in a solid are not available yet",
+        ));
+    }
+    Ok(())
+}
+
 fn products_are_finite(
     field: &str,
-    b: &super::BodySpec,
+    thickness: f64,
     m: &crate::material::Material,
     plane: crate::fe::Plane,
     part: &crate::mesh::Part,
 ) -> Result<()> {
-    let stiffness = m
-        .c(plane)
-        .iter()
-        .flatten()
-        .fold(0.0f64, |a, c| a.max(c.abs()));
+    let stiffness = if plane == Plane::Solid {
+        m.c_solid()
+            .iter()
+            .flatten()
+            .fold(0.0f64, |a, c| a.max(c.abs()))
+    } else {
+        m.c(plane)
+            .iter()
+            .flatten()
+            .fold(0.0f64, |a, c| a.max(c.abs()))
+    };
     let area: f64 = part
         .blocks
         .iter()
         .flat_map(|bl| (0..bl.len()).map(move |e| (bl, e)))
         .map(|(bl, e)| {
-            let x: Vec<[f64; 2]> = bl.element(e).iter().map(|&n| part.coords[n]).collect();
-            crate::mesh::polygon_area(&x).abs()
+            let x: Vec<[f64; 3]> = bl.element(e).iter().map(|&n| part.coords[n]).collect();
+            if bl.kind.dim() == 3 {
+                crate::fe::element::measure(bl.kind, &x).abs()
+            } else {
+                crate::mesh::polygon_area(&x).abs()
+            }
         })
         .sum();
     for (what, product) in [
-        ("its material's stiffness", b.thickness * stiffness),
-        (
-            "its density and area (the mass)",
-            b.thickness * m.rho * area,
-        ),
+        ("its material's stiffness", thickness * stiffness),
+        ("its density and area (the mass)", thickness * m.rho * area),
     ] {
         if !product.is_finite() {
             return Err(Error::config(
                 format!("{field}.thickness"),
                 format!(
-                    "{:e} m times {what} overflows ({product}): the element matrices would \
-                     not be finite",
-                    b.thickness
+                    "{thickness:e} m times {what} overflows ({product}): the element \
+                     matrices would not be finite"
                 ),
             ));
         }
