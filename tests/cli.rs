@@ -390,3 +390,59 @@ fn a_frictional_run_reports_friction_in_every_output() {
         "{report}"
     );
 }
+
+#[test]
+fn a_solid_runs_end_to_end_and_what_it_cannot_hold_is_refused() {
+    // examples/solid/cantilever.toml for 40 steps: hexahedra in the VTK files with
+    // six stress components, the ledger closing to round-off (a linear model, so
+    // the balance is exact); then the same box with a standard linear solid, a thickness,
+    // and a z support on a plane body are refused, each naming its field.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let (ok, _, err) = rothe(&[
+        "run",
+        "examples/solid/cantilever.toml",
+        "--set",
+        "analysis.t_end=4e-4",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(v["dofs"], 17 * 5 * 5 * 3);
+    let rel = v["energy"]["balance_residual_rel"].as_f64().unwrap();
+    assert!(rel.abs() < 1e-12, "balance {rel}");
+    assert!(v["energy"]["external_work"].as_f64().unwrap() > 0.0);
+    let vtu = std::fs::read_to_string(out.join("vtk/step_0000020.vtu")).unwrap();
+    assert!(
+        vtu.contains("NumberOfComponents=\"6\""),
+        "six stress components"
+    );
+    let base = std::fs::read_to_string("examples/solid/cantilever.toml").unwrap();
+    for (from, to, field) in [
+        (
+            "model = \"elastic\"",
+            "model = \"sls\"\nalpha = 0.5\nbeta = 1.0e-3",
+            "materials.steel.model",
+        ),
+        (
+            "material = \"steel\"",
+            "material = \"steel\"\nthickness = 0.5",
+            "bodies[0].thickness",
+        ),
+    ] {
+        let sc = dir.path().join("bad.toml");
+        std::fs::write(&sc, base.replace(from, to)).unwrap();
+        let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+        assert!(!ok && err.contains(field), "{field}: {err}");
+    }
+    let plane = std::fs::read_to_string("tests/regression/elastic_cantilever.toml")
+        .unwrap()
+        .replace("fix = [\"x\", \"y\"]", "fix = [\"x\", \"z\"]");
+    let sc = dir.path().join("plane.toml");
+    std::fs::write(&sc, plane).unwrap();
+    let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(!ok && err.contains("supports[0].fix"), "{err}");
+}
