@@ -73,8 +73,18 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
     let mut seen: HashMap<(usize, Vec<i64>), f64> = HashMap::new();
     for (bi, b) in mesh.blocks.iter().enumerate() {
         let m = &model.materials[b.material];
-        let d = m.instantaneous_stiffness(model.plane);
-        let eta = m.viscosity(model.plane);
+        // Solids hold elastic materials only so far (their `C` is taken below).
+        let plane = mesh.dim == 2;
+        let d = if plane {
+            m.instantaneous_stiffness(model.plane)
+        } else {
+            [[0.0; 3]; 3]
+        };
+        let eta = if plane {
+            m.viscosity(model.plane)
+        } else {
+            None
+        };
         let a_k = model.analysis.rayleigh[1];
         for e in 0..b.elements.len() {
             let nodes = b.elements.element(e);

@@ -264,8 +264,9 @@ fn initial_overlap(model: &Model) -> Result<()> {
 /// area) must stay finite: a thickness of 1e300 overflows the element matrices,
 /// which would otherwise surface as a singular stiffness far from its cause.
 /// What a solid model can hold so far: linear elastic materials, supports, loads,
-/// gravity and probes; no contact (three-dimensional contact is its own work) and
-/// no bars. Each refusal names the field.
+/// gravity and probes under statics or backward Euler; no contact
+/// (three-dimensional contact is its own work), no bars, no explicit path. Each
+/// refusal names the field.
 fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material]) -> Result<()> {
     for block in &mesh.blocks {
         let m = &materials[block.material];
@@ -291,6 +292,13 @@ fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material
         return Err(Error::config(
             "bars[0]",
             "bars in a solid are not available yet",
+        ));
+    }
+    if s.analysis.scheme == TimeScheme::CentralDifference {
+        return Err(Error::config(
+            "analysis.scheme",
+            "the explicit path in a solid is not available yet: use backward Euler \
+             (the default) or statics",
         ));
     }
     Ok(())
