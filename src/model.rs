@@ -414,10 +414,14 @@ impl Model {
                 .find(|&e| b.elements.element(e).contains(&n))
                 .map(|e| format!("block {bi} element {e}"))
         });
+        let c = mesh.coords[n];
+        let at = if mesh.dim == 3 {
+            format!("({:.4}, {:.4}, {:.4})", c[0], c[1], c[2])
+        } else {
+            format!("({:.4}, {:.4})", c[0], c[1])
+        };
         format!(
-            "node {n} at ({:.4}, {:.4}) of body `{body}`, {}",
-            mesh.coords[n][0],
-            mesh.coords[n][1],
+            "node {n} at {at} of body `{body}`, {}",
             element.unwrap_or_else(|| "no element".into()),
         )
     }

@@ -195,9 +195,14 @@ impl Default for Part {
 
 impl Part {
     fn node_name(&self, n: usize) -> String {
+        let at = if self.dim == 2 {
+            format!("{:?}", xy(self.coords[n]))
+        } else {
+            format!("{:?}", self.coords[n])
+        };
         match &self.node_tags {
-            Some(t) => format!("node with Gmsh tag {} at {:?}", t[n], self.coords[n]),
-            None => format!("node {n} at {:?}", self.coords[n]),
+            Some(t) => format!("node with Gmsh tag {} at {at}", t[n]),
+            None => format!("node {n} at {at}"),
         }
     }
 
@@ -300,6 +305,15 @@ impl Mesh {
     /// Number of degrees of freedom (`dim` per node).
     pub fn n_dofs(&self) -> usize {
         self.dim * self.coords.len()
+    }
+
+    /// Where node `n` is, for messages: `[x, y]` in the plane, `[x, y, z]` in a solid.
+    pub fn position(&self, n: usize) -> String {
+        if self.dim == 2 {
+            format!("{:?}", self.xy(n))
+        } else {
+            format!("{:?}", self.coords[n])
+        }
     }
 
     /// The in-plane coordinates of node `n`.

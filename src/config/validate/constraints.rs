@@ -51,8 +51,9 @@ pub(super) fn constraints(s: &Scenario, mesh: &Mesh) -> Result<Vec<Constraint>> 
                 return Err(Error::config(
                     &new.field,
                     format!(
-                        "claims component {c} of node {n} at {:?}, which `{}` already holds",
-                        mesh.coords[n], old.field
+                        "claims component {c} of node {n} at {}, which `{}` already holds",
+                        mesh.position(n),
+                        old.field
                     ),
                 ));
             }
