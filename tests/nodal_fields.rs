@@ -109,11 +109,11 @@ fn compare<I: Integrator>(mut nodal: I, mut points: I, every: usize, what: &str)
                 let (mut eps, mut sig, mut hist) = (vec![], vec![], vec![]);
                 let (mut eps_b, mut sig_b, mut hist_b) = (vec![], vec![], vec![]);
                 for g in 0..x.n_points() {
-                    eps.extend(x.eps(g));
-                    sig.extend(x.sigma(g));
+                    eps.extend(x.eps::<3>(g));
+                    sig.extend(x.sigma::<3>(g));
                     hist.extend(x.history(g));
-                    eps_b.extend(y.eps(g));
-                    sig_b.extend(y.sigma(g));
+                    eps_b.extend(y.eps::<3>(g));
+                    sig_b.extend(y.sigma::<3>(g));
                     hist_b.extend(y.history(g));
                     assert!(
                         x.dissipated(g).is_nan(),

@@ -8,7 +8,10 @@
 use super::nonlocal::DRIVERS;
 use super::{Assembler, SharedValues};
 use crate::energy::Dissipation;
-use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind, Plane};
+use crate::fe::{
+    element, kinematics, stiffness_rule, strain, strain_solid, ElementKind, Plane, PointKinematics,
+    MAX_ELEMENT_DOFS, MAX_NODES,
+};
 use crate::halves::in_halves;
 use crate::material::store::{Committed, Layout, StateStore};
 use crate::material::{Material, PointResponse, PointStatus, StrainStep, MAX_STATE};
@@ -57,22 +60,30 @@ const ELEMENT_LEAF: usize = 128;
 
 /// Number of material points of an element kind (bars: one).
 pub fn points_per_element(kind: ElementKind) -> usize {
-    match kind {
-        ElementKind::Bar2 => 1,
-        k => stiffness_rule(k).len(),
+    kind.points()
+}
+
+/// The Voigt size of a mesh's points: 3 in the plane, 6 in a solid.
+pub fn voigt_of(mesh: &Mesh) -> usize {
+    if mesh.dim == 3 {
+        6
+    } else {
+        3
     }
 }
 
 /// One store per block, sized for its points and its material's history, in the
 /// material's initial state.
 pub fn new_stores(mesh: &Mesh, materials: &[Material]) -> Vec<StateStore> {
+    let v = voigt_of(mesh);
     mesh.blocks
         .iter()
         .map(|b| {
             let mat = &materials[b.material];
             let n = b.elements.len() * points_per_element(b.elements.kind);
-            let mut s = StateStore::new(n, mat.n_state());
-            if mat.n_state() > 0 {
+            let ns = mat.n_state_for(v);
+            let mut s = StateStore::with_voigt(n, ns, v);
+            if ns > 0 {
                 for g in 0..n {
                     mat.init_state(s.history_mut(g));
                 }
@@ -98,8 +109,8 @@ impl Shared {
     }
 }
 
-/// What one element evaluation needs besides its index.
-struct Ctx<'a> {
+/// What one element evaluation needs besides its index (`V` the Voigt size).
+struct Ctx<'a, const V: usize> {
     mesh: &'a Mesh,
     mat: &'a Material,
     plane: Plane,
@@ -113,14 +124,14 @@ struct Ctx<'a> {
     at_rest: bool,
     /// Keep every history at its committed value (`Material::update_frozen`).
     frozen: bool,
-    /// The material's elasticity matrix in this plane idealisation.
-    c: [[f64; 3]; 3],
+    /// The material's elasticity matrix in this idealisation.
+    c: [[f64; V]; V],
     /// The averaged drivers of the block's points (`nonlocal::DRIVERS` per point)
     /// when its material is nonlocal.
     drivers: Option<&'a [f64]>,
 }
 
-impl<'a> Ctx<'a> {
+impl<'a, const V: usize> Ctx<'a, V> {
     fn new(
         mesh: &'a Mesh,
         mat: &'a Material,
@@ -141,7 +152,7 @@ impl<'a> Ctx<'a> {
             dt,
             predict,
             at_rest,
-            c: mat.c(plane),
+            c: mat.c_voigt(plane),
         }
     }
 
@@ -165,13 +176,14 @@ struct TrialOut {
     layout: Layout,
 }
 
-/// Evaluates element `e` at displacements `u`: calls `point(w, &resp, &kin, x,
-/// σ_pred)` for each of its points, where `σ_pred` (when `cx.predict`) is the stress
-/// of the next step of the same size at an unchanged strain, from the trial history:
-/// for constant-tangent materials `f_int` of the next step is then `f_pred + K_t Δu`
-/// exactly. With `trial`, the points' trial states are written.
-fn element_points<F>(
-    cx: &Ctx,
+/// Evaluates element `e` at displacements `u` in a mesh of dimension `D` with `V`
+/// Voigt components: calls `point(w, &resp, &kin, x, σ_pred)` for each of its
+/// points, where `σ_pred` (when `cx.predict`) is the stress of the next step of the
+/// same size at an unchanged strain, from the trial history: for constant-tangent
+/// materials `f_int` of the next step is then `f_pred + K_t Δu` exactly. With
+/// `trial`, the points' trial states are written.
+fn element_points<const D: usize, const V: usize, F>(
+    cx: &Ctx<V>,
     committed: Committed,
     nodes: &[usize],
     u: &[f64],
@@ -179,18 +191,23 @@ fn element_points<F>(
     trial: Option<TrialOut>,
     mut point: F,
 ) where
-    F: FnMut(f64, &PointResponse, Option<&crate::fe::PointKinematics>, &[[f64; 3]], [f64; 3]),
+    F: FnMut(f64, &PointResponse<V>, Option<&PointKinematics>, &[[f64; 3]], [f64; V]),
 {
-    let (x, ue, nn) = gather(cx.mesh, nodes, u);
+    let (x, ue, nn) = gather::<D>(cx.mesh, nodes, u);
     if cx.kind == ElementKind::Bar2 {
         let g = e;
-        let eps = element::bar_strain(&x[..2], 2, &ue[..4]);
-        let eps_n = if cx.at_rest { eps } else { committed.eps(g)[0] };
+        let eps = element::bar_strain(&x[..2], D, &ue[..2 * D]);
+        let eps_n = if cx.at_rest {
+            eps
+        } else {
+            committed.eps::<V>(g)[0]
+        };
         let de = eps - eps_n;
         let (_, l) = element::bar_axis(&x[..2]);
+        let first = |v: f64| -> [f64; V] { std::array::from_fn(|i| if i == 0 { v } else { 0.0 }) };
         let resp = PointResponse {
-            sigma: [cx.mat.e * eps, 0.0, 0.0],
-            tangent: [[cx.mat.e, 0.0, 0.0], [0.0; 3], [0.0; 3]],
+            sigma: first(cx.mat.e * eps),
+            tangent: std::array::from_fn(|i| if i == 0 { first(cx.mat.e) } else { [0.0; V] }),
             psi: 0.5 * cx.mat.e * eps * eps,
             dissipation: Dissipation {
                 numerical: 0.5 * cx.mat.e * de * de,
@@ -201,8 +218,8 @@ fn element_points<F>(
         if let Some(t) = trial {
             // SAFETY: point g belongs to element e only.
             unsafe {
-                write3(t.base.slice(t.layout.eps() + 3 * g, 3), &[eps, 0.0, 0.0]);
-                write3(t.base.slice(t.layout.sigma() + 3 * g, 3), &resp.sigma);
+                write_v(t.base.slice(t.layout.eps() + V * g, V), &first(eps));
+                write_v(t.base.slice(t.layout.sigma() + V * g, V), &resp.sigma);
                 t.base.slice(t.layout.dissipated() + g, 1)[0] = committed.dissipated(g);
             }
         }
@@ -210,19 +227,24 @@ fn element_points<F>(
         return;
     }
     let rule = stiffness_rule(cx.kind);
-    // Element size for crack-band regularisation: the square root of its area.
-    let length = crate::mesh::polygon_area(&x[..nn]).abs().sqrt();
-    let ns = cx.mat.n_state();
+    // Element size for crack-band regularisation: the square root of its area (the
+    // cube root of its volume).
+    let length = if D == 3 {
+        element::measure(cx.kind, &x[..nn]).abs().cbrt()
+    } else {
+        crate::mesh::polygon_area(&x[..nn]).abs().sqrt()
+    };
+    let ns = cx.mat.n_state_for(V);
     let mut scratch = [0.0; MAX_STATE];
     for (q, &(xi, wq)) in rule.iter().enumerate() {
         let g = e * rule.len() + q;
         let k = kinematics(cx.kind, &x[..nn], xi);
-        let eps = strain(&k, nn, &ue);
+        let eps = strain_v::<V>(&k, nn, &ue);
         let (eps_n, dt) = if cx.at_rest {
             // A vanishing step: rates are zero and history does not evolve.
             (eps, f64::MIN_POSITIVE)
         } else {
-            (committed.eps(g), cx.dt)
+            (committed.eps::<V>(g), cx.dt)
         };
         let step = StrainStep {
             eps_n,
@@ -232,7 +254,7 @@ fn element_points<F>(
         };
         let history_n = committed.history(g);
         let averaged = cx.drivers.map(|d| [d[DRIVERS * g], d[DRIVERS * g + 1]]);
-        let mut pred = [0.0; 3];
+        let mut pred = [0.0; V];
         let resp = match trial {
             Some(t) => {
                 // SAFETY: point g belongs to element e only; the slots are disjoint
@@ -246,8 +268,8 @@ fn element_points<F>(
                         .update_driven(&cx.c, cx.plane, &step, averaged, history_n, hist)
                 };
                 unsafe {
-                    write3(t.base.slice(t.layout.eps() + 3 * g, 3), &eps);
-                    write3(t.base.slice(t.layout.sigma() + 3 * g, 3), &r.sigma);
+                    write_v(t.base.slice(t.layout.eps() + V * g, V), &eps);
+                    write_v(t.base.slice(t.layout.sigma() + V * g, V), &r.sigma);
                     t.base.slice(t.layout.dissipated() + g, 1)[0] =
                         committed.dissipated(g) + r.dissipation.material();
                 }
@@ -271,57 +293,91 @@ fn element_points<F>(
     }
 }
 
-/// The coordinates and displacements of an element's nodes, and their number (plane
-/// elements: the Gauss-point pass is the plane's; solids of constant tangent take
-/// the nodal path, `time::nodal`).
+/// The strain of `V` Voigt components at a point (`V = 3`: the plane's, `6`: a
+/// solid's) from the element displacements `ue`.
 #[inline(always)]
-pub(crate) fn gather(mesh: &Mesh, nodes: &[usize], u: &[f64]) -> ([[f64; 3]; 4], [f64; 8], usize) {
-    let mut x = [[0.0; 3]; 4];
-    let mut ue = [0.0; 8];
+pub(crate) fn strain_v<const V: usize>(k: &PointKinematics, nn: usize, ue: &[f64]) -> [f64; V] {
+    if V == 6 {
+        let e = strain_solid(k, nn, ue);
+        std::array::from_fn(|i| e[i])
+    } else {
+        let e = strain(k, nn, ue);
+        std::array::from_fn(|i| e[i])
+    }
+}
+
+/// The coordinates and displacements (`D` per node) of an element's nodes, and
+/// their number.
+#[inline(always)]
+pub(crate) fn gather<const D: usize>(
+    mesh: &Mesh,
+    nodes: &[usize],
+    u: &[f64],
+) -> ([[f64; 3]; MAX_NODES], [f64; MAX_ELEMENT_DOFS], usize) {
+    let mut x = [[0.0; 3]; MAX_NODES];
+    let mut ue = [0.0; MAX_ELEMENT_DOFS];
     for (a, &n) in nodes.iter().enumerate() {
         x[a] = mesh.coords[n];
-        ue[2 * a] = u[2 * n];
-        ue[2 * a + 1] = u[2 * n + 1];
+        for i in 0..D {
+            ue[D * a + i] = u[D * n + i];
+        }
     }
     (x, ue, nodes.len())
 }
 
-/// Writes a Voigt triple (element by element: no call to `memcpy` on the hot path).
+/// Writes a Voigt vector (element by element: no call to `memcpy` on the hot path).
 #[inline(always)]
-fn write3(out: &mut [f64], v: &[f64; 3]) {
-    out[0] = v[0];
-    out[1] = v[1];
-    out[2] = v[2];
-}
-
-/// Adds one point's `w Bᵀ D B` (continuum) or sets the bar stiffness `E A / L`
-/// (bars have one point) in the element matrix `ke`.
-#[inline]
-fn add_point_tangent(
-    k: Option<&crate::fe::PointKinematics>,
-    x: &[[f64; 3]],
-    nn: usize,
-    w: f64,
-    d: &[[f64; 3]; 3],
-    ke: &mut [f64],
-) {
-    match k {
-        Some(k) => element::add_btdb(k, nn, d, w, ke),
-        None => element::bar_stiffness(x, 2, d[0][0] * w / element::bar_axis(x).1, ke),
+fn write_v<const V: usize>(out: &mut [f64], v: &[f64; V]) {
+    for i in 0..V {
+        out[i] = v[i];
     }
 }
 
-/// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`.
+/// Adds one point's `w Bᵀ D B` (continuum) or sets the bar stiffness `E A / L`
+/// (bars have one point) in the element matrix `ke` (mesh dimension `dim`).
 #[inline]
-fn add_bt_sigma(
-    k: Option<&crate::fe::PointKinematics>,
+fn add_point_tangent<const V: usize>(
+    k: Option<&PointKinematics>,
+    x: &[[f64; 3]],
+    nn: usize,
+    dim: usize,
+    w: f64,
+    d: &[[f64; V]; V],
+    ke: &mut [f64],
+) {
+    match k {
+        Some(k) if V == 6 => {
+            let d6: [[f64; 6]; 6] = std::array::from_fn(|i| std::array::from_fn(|j| d[i][j]));
+            element::add_btdb_solid(k, nn, &d6, w, ke)
+        }
+        Some(k) => {
+            let d3: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| d[i][j]));
+            element::add_btdb(k, nn, &d3, w, ke)
+        }
+        None => element::bar_stiffness(x, dim, d[0][0] * w / element::bar_axis(x).1, ke),
+    }
+}
+
+/// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`, in
+/// a mesh of dimension `D`.
+#[inline]
+fn add_bt_sigma<const D: usize, const V: usize>(
+    k: Option<&PointKinematics>,
     x: &[[f64; 3]],
     nn: usize,
     w: f64,
-    sigma: &[f64; 3],
-    fe: &mut [f64; 8],
+    sigma: &[f64; V],
+    fe: &mut [f64; MAX_ELEMENT_DOFS],
 ) {
     match k {
+        Some(k) if D == 3 => {
+            for a in 0..nn {
+                let [dx, dy, dz] = k.dndx[a];
+                fe[3 * a] += w * (dx * sigma[0] + dy * sigma[2] + dz * sigma[5]);
+                fe[3 * a + 1] += w * (dy * sigma[1] + dx * sigma[2] + dz * sigma[4]);
+                fe[3 * a + 2] += w * (dz * sigma[3] + dy * sigma[4] + dx * sigma[5]);
+            }
+        }
         Some(k) => {
             for a in 0..nn {
                 let (dx, dy) = (k.dndx[a][0], k.dndx[a][1]);
@@ -332,10 +388,10 @@ fn add_bt_sigma(
         None => {
             let (ax, l) = element::bar_axis(x);
             let n = sigma[0] * w / l;
-            fe[0] -= n * ax[0];
-            fe[1] -= n * ax[1];
-            fe[2] += n * ax[0];
-            fe[3] += n * ax[1];
+            for i in 0..D {
+                fe[i] -= n * ax[i];
+                fe[D + i] += n * ax[i];
+            }
         }
     }
 }
@@ -380,6 +436,47 @@ impl Assembler {
         pass: PointPass,
         stores: &mut [StateStore],
         f: &mut [f64],
+        f_pred: Option<&mut [f64]>,
+        tangent: Option<&mut [f64]>,
+        tangent_base: Option<&[f64]>,
+    ) -> PointTotals {
+        if mesh.dim == 3 {
+            self.internal_force_d::<3, 6>(
+                mesh,
+                materials,
+                plane,
+                pass,
+                stores,
+                f,
+                f_pred,
+                tangent,
+                tangent_base,
+            )
+        } else {
+            self.internal_force_d::<2, 3>(
+                mesh,
+                materials,
+                plane,
+                pass,
+                stores,
+                f,
+                f_pred,
+                tangent,
+                tangent_base,
+            )
+        }
+    }
+
+    /// [`Assembler::internal_force`] in dimension `D` with `V` Voigt components.
+    #[allow(clippy::too_many_arguments)]
+    fn internal_force_d<const D: usize, const V: usize>(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        pass: PointPass,
+        stores: &mut [StateStore],
+        f: &mut [f64],
         mut f_pred: Option<&mut [f64]>,
         mut tangent: Option<&mut [f64]>,
         tangent_base: Option<&[f64]>,
@@ -411,7 +508,7 @@ impl Assembler {
                 base: Shared(trial_buf.as_mut_ptr()),
                 layout,
             };
-            let cx = Ctx::new(
+            let cx = Ctx::<V>::new(
                 mesh,
                 &materials[block.material],
                 plane,
@@ -437,14 +534,16 @@ impl Assembler {
                 // every run.
                 let leaf = |chunk: &[usize]| {
                     let mut acc = PointTotals::default();
+                    let mut ke = [0.0; MAX_ELEMENT_DOFS * MAX_ELEMENT_DOFS];
                     for &e in chunk {
                         let nodes = block.elements.element(e);
-                        let mut fe = [0.0; 8];
-                        let mut fe_pred = [0.0; 8];
-                        let mut ke = [0.0; 64];
+                        let mut fe = [0.0; MAX_ELEMENT_DOFS];
+                        let mut fe_pred = [0.0; MAX_ELEMENT_DOFS];
+                        let nd = D * nodes.len();
+                        ke[..nd * nd].fill(0.0);
                         let mut changed = !by_delta;
                         let mut q = 0;
-                        element_points(
+                        element_points::<D, V, _>(
                             &cx,
                             committed,
                             nodes,
@@ -462,9 +561,9 @@ impl Assembler {
                                     });
                                 }
                                 q += 1;
-                                add_bt_sigma(k, x, nodes.len(), w, &r.sigma, &mut fe);
+                                add_bt_sigma::<D, V>(k, x, nodes.len(), w, &r.sigma, &mut fe);
                                 if predict {
-                                    add_bt_sigma(k, x, nodes.len(), w, &sp, &mut fe_pred);
+                                    add_bt_sigma::<D, V>(k, x, nodes.len(), w, &sp, &mut fe_pred);
                                 }
                                 if block_tangent {
                                     if !by_delta {
@@ -472,6 +571,7 @@ impl Assembler {
                                             k,
                                             x,
                                             nodes.len(),
+                                            D,
                                             w,
                                             &r.tangent,
                                             &mut ke,
@@ -483,25 +583,27 @@ impl Assembler {
                                                 *a -= b;
                                             }
                                         }
-                                        add_point_tangent(k, x, nodes.len(), w, &d, &mut ke);
+                                        add_point_tangent(k, x, nodes.len(), D, w, &d, &mut ke);
                                         changed = true;
                                     }
                                 }
                             },
                         );
                         if let Some(kp) = kp.filter(|_| block_tangent && changed) {
-                            self.scatter(nodes, &ke, kp);
+                            self.scatter(nodes, &ke[..nd * nd], kp);
                         }
                         for (a, &n) in nodes.iter().enumerate() {
                             // SAFETY: no two elements of this colour share node n.
-                            let fn_ = unsafe { fp.slice(2 * n, 2) };
-                            fn_[0] += fe[2 * a];
-                            fn_[1] += fe[2 * a + 1];
+                            let fn_ = unsafe { fp.slice(D * n, D) };
+                            for i in 0..D {
+                                fn_[i] += fe[D * a + i];
+                            }
                             if let Some(pp) = pp {
                                 // SAFETY: as above, for the predicted force.
-                                let pn = unsafe { pp.slice(2 * n, 2) };
-                                pn[0] += fe_pred[2 * a];
-                                pn[1] += fe_pred[2 * a + 1];
+                                let pn = unsafe { pp.slice(D * n, D) };
+                                for i in 0..D {
+                                    pn[i] += fe_pred[D * a + i];
+                                }
                             }
                         }
                     }
@@ -533,10 +635,27 @@ impl Assembler {
         dt: f64,
         stores: &[StateStore],
     ) -> Vec<f64> {
+        if mesh.dim == 3 {
+            self.tangent_d::<3, 6>(mesh, materials, plane, u, dt, stores)
+        } else {
+            self.tangent_d::<2, 3>(mesh, materials, plane, u, dt, stores)
+        }
+    }
+
+    /// [`Assembler::tangent`] in dimension `D` with `V` Voigt components.
+    fn tangent_d<const D: usize, const V: usize>(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        u: &[f64],
+        dt: f64,
+        stores: &[StateStore],
+    ) -> Vec<f64> {
         let nonlocal = self.nonlocal_at(mesh, materials, plane, u, stores);
         self.assemble(mesh, |bi, e, _x, ke| {
             let block = &mesh.blocks[bi];
-            let cx = Ctx::new(
+            let cx = Ctx::<V>::new(
                 mesh,
                 &materials[block.material],
                 plane,
@@ -547,16 +666,16 @@ impl Assembler {
             )
             .with_drivers(nonlocal.as_ref().and_then(|n| n.block(mesh, bi)));
             let nodes = block.elements.element(e);
-            let nd = 2 * nodes.len();
+            let nd = D * nodes.len();
             ke[..nd * nd].fill(0.0);
-            element_points(
+            element_points::<D, V, _>(
                 &cx,
                 stores[bi].committed(),
                 nodes,
                 u,
                 e,
                 None,
-                |w, r, k, x, _| add_point_tangent(k, x, nodes.len(), w, &r.tangent, ke),
+                |w, r, k, x, _| add_point_tangent(k, x, nodes.len(), D, w, &r.tangent, ke),
             );
         })
     }

@@ -356,7 +356,8 @@ impl NonlocalTable {
                     let per = (POINT_LEAF / ng).max(1);
                     for (k, el) in chunk.chunks_exact_mut(DRIVERS * ng).enumerate() {
                         let e = c * per + k;
-                        let (x, ue, nn) = super::internal::gather(mesh, b.elements.element(e), u);
+                        let (x, ue, nn) =
+                            super::internal::gather::<2>(mesh, b.elements.element(e), u);
                         for (q, &(xi, _)) in stiffness_rule(kind).iter().enumerate() {
                             let kin = kinematics(kind, &x[..nn], xi);
                             let eps = strain(&kin, nn, &ue);

@@ -6,14 +6,10 @@
 
 use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 
-/// Elastic update at one point.
-pub fn update(c: &[[f64; 3]; 3], step: &StrainStep) -> PointResponse {
+/// Elastic update at one point (`V` Voigt components).
+pub fn update<const V: usize>(c: &[[f64; V]; V], step: &StrainStep<V>) -> PointResponse<V> {
     let sigma = mul3(c, &step.eps);
-    let de = [
-        step.eps[0] - step.eps_n[0],
-        step.eps[1] - step.eps_n[1],
-        step.eps[2] - step.eps_n[2],
-    ];
+    let de: [f64; V] = std::array::from_fn(|i| step.eps[i] - step.eps_n[i]);
     PointResponse {
         sigma,
         tangent: *c,

@@ -131,25 +131,38 @@ pub fn damage_law(kappa: f64, kappa0: f64, a: f64, b: f64) -> f64 {
     }
 }
 
-/// Three principal strains, the third being the out-of-plane one.
-fn principal3(eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
+/// Three principal strains: in a solid (`V = 6`) the eigenvalues of the strain
+/// tensor; in the plane (`V = 3`) the two in-plane ones and the out-of-plane one.
+fn principal3<const V: usize>(eps: &[f64; V], nu: f64, plane: Plane) -> [f64; 3] {
+    if V == 6 {
+        return super::principal::principal_voigt6(eps, 0.5);
+    }
     let (e1, e2) = super::principal::principal_values(eps[0], eps[1], 0.5 * eps[2]);
     let ezz = match plane {
         Plane::Stress => -nu / (1.0 - nu) * (eps[0] + eps[1]),
         Plane::Strain => 0.0,
-        Plane::Solid => unreachable!("validation keeps Mazars to the plane"),
+        Plane::Solid => unreachable!("a solid's Voigt vector has six components"),
     };
     [e1, e2, ezz]
 }
 
-/// Three principal effective stresses `C ε` (the third out of plane).
-fn principal_stress3(c: &[[f64; 3]; 3], eps: &[f64; 3], nu: f64, plane: Plane) -> [f64; 3] {
+/// Three principal effective stresses `C ε` (in the plane the third is the
+/// out-of-plane one).
+fn principal_stress3<const V: usize>(
+    c: &[[f64; V]; V],
+    eps: &[f64; V],
+    nu: f64,
+    plane: Plane,
+) -> [f64; 3] {
     let s = mul3(c, eps);
+    if V == 6 {
+        return super::principal::principal_voigt6(&s, 1.0);
+    }
     let (s1, s2) = super::principal::principal_values(s[0], s[1], s[2]);
     let szz = match plane {
         Plane::Stress => 0.0,
         Plane::Strain => nu * (s[0] + s[1]),
-        Plane::Solid => unreachable!("validation keeps Mazars to the plane"),
+        Plane::Solid => unreachable!("a solid's Voigt vector has six components"),
     };
     [s1, s2, szz]
 }
@@ -158,7 +171,12 @@ fn principal_stress3(c: &[[f64; 3]; 3], eps: &[f64; 3], nu: f64, plane: Plane) -
 /// nonlocal material averages: `[ε_t, ε_c]` of eq. (11) (paper) or `[ε̃, 0]`,
 /// `ε̃ = √Σ⟨ε_i⟩₊²` (classic).
 #[inline]
-pub fn drivers(p: &MazarsParams, nu: f64, plane: Plane, eps: &[f64; 3]) -> [f64; 2] {
+pub fn drivers<const V: usize>(
+    p: &MazarsParams,
+    nu: f64,
+    plane: Plane,
+    eps: &[f64; V],
+) -> [f64; 2] {
     drivers_of(p, nu, &principal3(eps, nu, plane))
 }
 
@@ -188,12 +206,12 @@ fn drivers_of(p: &MazarsParams, nu: f64, e: &[f64; 3]) -> [f64; 2] {
 /// by the triaxiality `r` (paper) and the weights `α_t, α_c` (classic) are the
 /// point's own.
 #[allow(clippy::too_many_arguments)]
-fn damage(
+fn damage<const V: usize>(
     p: &MazarsParams,
-    c: &[[f64; 3]; 3],
+    c: &[[f64; V]; V],
     nu: f64,
     plane: Plane,
-    eps: &[f64; 3],
+    eps: &[f64; V],
     e: &[f64; 3],
     drv: [f64; 2],
     (a_t, b_t): (f64, f64),
@@ -246,8 +264,9 @@ fn damage(
     }
 }
 
-/// Young's modulus back from the plane `C` (for the classic split and the crack band).
-pub fn e_modulus(c: &[[f64; 3]; 3], nu: f64, plane: Plane) -> f64 {
+/// Young's modulus back from `C` (for the classic split and the crack band): a
+/// solid's `C_xx = λ + 2μ` is the plane strain one.
+pub fn e_modulus<const V: usize>(c: &[[f64; V]; V], nu: f64, plane: Plane) -> f64 {
     match plane {
         Plane::Stress => c[0][0] * (1.0 - nu * nu),
         Plane::Strain | Plane::Solid => c[0][0] * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu),
@@ -258,16 +277,16 @@ pub fn e_modulus(c: &[[f64; 3]; 3], nu: f64, plane: Plane) -> f64 {
 /// `averaged` holds the nonlocal average of the [`drivers`] at this point (`None`:
 /// the point's own).
 #[allow(clippy::too_many_arguments)]
-pub fn update(
+pub fn update<const V: usize>(
     p: &MazarsParams,
-    c: &[[f64; 3]; 3],
+    c: &[[f64; V]; V],
     nu: f64,
     plane: Plane,
-    step: &StrainStep,
+    step: &StrainStep<V>,
     averaged: Option<[f64; 2]>,
     state_n: &[f64],
     state: &mut [f64],
-) -> PointResponse {
+) -> PointResponse<V> {
     let (k1n, k2n, dn) = (state_n[0], state_n[1], state_n[2]);
     let e = principal3(&step.eps, nu, plane);
     let drv = averaged.unwrap_or_else(|| drivers_of(p, nu, &e));
@@ -296,31 +315,32 @@ pub fn update(
 
 /// The Mazars point with its history frozen at the committed state: `D = D⁰`,
 /// `σ = (1 − D⁰)Cε` (the paper's first estimate of a step, `D(u_{s−1})`).
-pub fn frozen(
-    c: &[[f64; 3]; 3],
-    step: &StrainStep,
+pub fn frozen<const V: usize>(
+    c: &[[f64; V]; V],
+    step: &StrainStep<V>,
     state_n: &[f64],
     state: &mut [f64],
-) -> PointResponse {
+) -> PointResponse<V> {
     state.copy_from_slice(&state_n[..state.len()]);
     secant_response(c, step, state_n[2], state_n[2])
 }
 
 /// Stress, secant, stored energy and the step's dissipation of a point whose damage
 /// goes from `dn` to `d` (theory/damage.md, (M4)–(M6)).
-fn secant_response(c: &[[f64; 3]; 3], step: &StrainStep, dn: f64, d: f64) -> PointResponse {
+fn secant_response<const V: usize>(
+    c: &[[f64; V]; V],
+    step: &StrainStep<V>,
+    dn: f64,
+    d: f64,
+) -> PointResponse<V> {
     let ce = mul3(c, &step.eps);
     let y1 = 0.5 * dot3(&step.eps, &ce);
     let y0 = 0.5 * dot3(&step.eps_n, &mul3(c, &step.eps_n));
-    let de = [
-        step.eps[0] - step.eps_n[0],
-        step.eps[1] - step.eps_n[1],
-        step.eps[2] - step.eps_n[2],
-    ];
+    let de: [f64; V] = std::array::from_fn(|i| step.eps[i] - step.eps_n[i]);
     let dd = d - dn;
     let w = 1.0 - d;
     PointResponse {
-        sigma: [w * ce[0], w * ce[1], w * ce[2]],
+        sigma: ce.map(|x| w * x),
         tangent: c.map(|row| row.map(|x| w * x)),
         psi: w * y1,
         dissipation: Dissipation {

@@ -41,13 +41,14 @@ pub enum PointStatus {
     ReturnFailed,
 }
 
-/// What one material update returns.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PointResponse {
-    /// Stress `[σ_xx, σ_yy, σ_xy]` at the new step.
-    pub sigma: [f64; 3],
+/// What one material update returns: `V = 3` Voigt components in the plane, 6 in a
+/// solid (the order of `fe`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointResponse<const V: usize = 3> {
+    /// Stress `[σ_xx, σ_yy, σ_xy(, σ_zz, σ_yz, σ_zx)]` at the new step.
+    pub sigma: [f64; V],
     /// Consistent tangent `∂σ_{n+1}/∂ε_{n+1}`.
-    pub tangent: [[f64; 3]; 3],
+    pub tangent: [[f64; V]; V],
     /// Stored (free) energy density at the new step.
     pub psi: f64,
     /// Dissipation increments of the step.
@@ -56,13 +57,25 @@ pub struct PointResponse {
     pub status: PointStatus,
 }
 
-/// The strain step a material point is asked to take.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct StrainStep {
+impl<const V: usize> Default for PointResponse<V> {
+    fn default() -> Self {
+        PointResponse {
+            sigma: [0.0; V],
+            tangent: [[0.0; V]; V],
+            psi: 0.0,
+            dissipation: Dissipation::default(),
+            status: PointStatus::Ok,
+        }
+    }
+}
+
+/// The strain step a material point is asked to take (`V` Voigt components).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StrainStep<const V: usize = 3> {
     /// Strain at the last committed step.
-    pub eps_n: [f64; 3],
+    pub eps_n: [f64; V],
     /// Strain at the new step.
-    pub eps: [f64; 3],
+    pub eps: [f64; V],
     /// Time step size.
     pub dt: f64,
     /// Characteristic size of the element the point belongs to (m): the crack-band
@@ -103,8 +116,20 @@ pub enum Model {
     RankineHill(RankineHillParams),
 }
 
-/// The largest number of history values a model keeps per point.
-pub const MAX_STATE: usize = 5;
+impl<const V: usize> Default for StrainStep<V> {
+    fn default() -> Self {
+        StrainStep {
+            eps_n: [0.0; V],
+            eps: [0.0; V],
+            dt: 0.0,
+            length: 0.0,
+        }
+    }
+}
+
+/// The largest number of history values a model keeps per point (a solid's
+/// standard linear solid: six dashpot strains).
+pub const MAX_STATE: usize = 6;
 
 /// A material: elastic constants, density and constitutive model.
 #[derive(Clone, Debug, PartialEq)]
@@ -228,11 +253,23 @@ impl Material {
         crate::fe::elasticity_solid(self.e, self.nu)
     }
 
+    /// Elasticity matrix with `V` Voigt components: the plane's `C` for `V = 3`, the
+    /// solid's for `V = 6`.
+    pub fn c_voigt<const V: usize>(&self, plane: Plane) -> [[f64; V]; V] {
+        if V == 6 {
+            let c = self.c_solid();
+            std::array::from_fn(|i| std::array::from_fn(|j| c[i][j]))
+        } else {
+            let c = self.c(plane);
+            std::array::from_fn(|i| std::array::from_fn(|j| c[i][j]))
+        }
+    }
+
     /// The stiffness the material shows to a sudden strain (what an explicit step
     /// sees): `C`, and `(1 + α) C` for the standard linear solid (`α C` without the
     /// parallel spring), whose Maxwell branch answers at once.
-    pub fn instantaneous_stiffness(&self, plane: Plane) -> [[f64; 3]; 3] {
-        let c = self.c(plane);
+    pub fn instantaneous_stiffness<const V: usize>(&self, plane: Plane) -> [[f64; V]; V] {
+        let c = self.c_voigt::<V>(plane);
         match self.model {
             Model::Sls {
                 alpha, parallel, ..
@@ -247,9 +284,14 @@ impl Material {
     /// The viscosity `η` of a Kelvin-Voigt material (`σ_v = η ε̇`, Voigt form on
     /// engineering strain), `None` for the others.
     pub fn viscosity(&self, plane: Plane) -> Option<[[f64; 3]; 3]> {
+        self.viscosity_voigt(plane)
+    }
+
+    /// [`Material::viscosity`] with `V` Voigt components (a solid's for `V = 6`).
+    pub fn viscosity_voigt<const V: usize>(&self, plane: Plane) -> Option<[[f64; V]; V]> {
         match self.model {
             Model::KelvinVoigt(Viscosity::Proportional(alpha)) => {
-                Some(self.c(plane).map(|row| row.map(|x| alpha * x)))
+                Some(self.c_voigt::<V>(plane).map(|row| row.map(|x| alpha * x)))
             }
             Model::KelvinVoigt(Viscosity::Identity(beta)) => {
                 Some(viscoelastic::identity_viscosity(beta))
@@ -277,9 +319,16 @@ impl Material {
 
     /// Number of history values stored per Gauss point (at most [`MAX_STATE`]).
     pub fn n_state(&self) -> usize {
+        self.n_state_for(3)
+    }
+
+    /// Number of history values per point with `voigt` strain components (a
+    /// standard linear solid keeps one dashpot strain per component).
+    pub fn n_state_for(&self, voigt: usize) -> usize {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) => 0,
-            Model::Sls { .. } | Model::Mazars(_) => 3,
+            Model::Sls { .. } => voigt,
+            Model::Mazars(_) => 3,
             Model::RankineHill(_) => 5,
         }
     }
@@ -325,26 +374,26 @@ impl Material {
     /// `state` (the trial state of the step just taken): what `update` would return
     /// with `eps_n = eps`, computed without the energy terms. For constant-tangent
     /// models the next step's stress is this plus `tangent · Δε`.
-    pub fn predicted_stress(
+    pub fn predicted_stress<const V: usize>(
         &self,
         plane: Plane,
-        eps: &[f64; 3],
+        eps: &[f64; V],
         state: &[f64],
         dt: f64,
-    ) -> [f64; 3] {
-        self.predicted_stress_with(&self.c(plane), plane, eps, state, dt)
+    ) -> [f64; V] {
+        self.predicted_stress_with(&self.c_voigt(plane), plane, eps, state, dt)
     }
 
     /// [`Material::predicted_stress`] with the elasticity matrix `c = self.c(plane)`
     /// computed by the caller (once per element block in the Gauss-point loop).
-    pub fn predicted_stress_with(
+    pub fn predicted_stress_with<const V: usize>(
         &self,
-        c: &[[f64; 3]; 3],
+        c: &[[f64; V]; V],
         plane: Plane,
-        eps: &[f64; 3],
+        eps: &[f64; V],
         state: &[f64],
         dt: f64,
-    ) -> [f64; 3] {
+    ) -> [f64; V] {
         match self.model {
             // The stress at the trial damage: with the strain unchanged neither the
             // history maxima nor the damage grow (the local law at the committed
@@ -353,7 +402,7 @@ impl Material {
             Model::Mazars(_) => {
                 let w = 1.0 - state[2];
                 let s = mul3(c, eps);
-                [w * s[0], w * s[1], w * s[2]]
+                s.map(|x| w * x)
             }
             Model::Elastic | Model::KelvinVoigt(_) | Model::RankineHill(_) => {
                 let mut st = [0.0; MAX_STATE];
@@ -367,7 +416,7 @@ impl Material {
                         length: 1.0,
                     },
                     state,
-                    &mut st[..self.n_state()],
+                    &mut st[..self.n_state_for(V)],
                 )
                 .sigma
             }
@@ -378,53 +427,49 @@ impl Material {
             } => {
                 let k = dt * alpha / beta;
                 let p = if parallel { 1.0 } else { 0.0 };
-                let ee = [eps[0] - state[0], eps[1] - state[1], eps[2] - state[2]];
+                let ee: [f64; V] = std::array::from_fn(|i| eps[i] - state[i]);
                 let (ce, cee) = (mul3(c, eps), mul3(c, &ee));
                 let a = alpha / (1.0 + k);
-                [
-                    p * ce[0] + a * cee[0],
-                    p * ce[1] + a * cee[1],
-                    p * ce[2] + a * cee[2],
-                ]
+                std::array::from_fn(|i| p * ce[i] + a * cee[i])
             }
         }
     }
 
     /// The material update (see the module docs).
-    pub fn update(
+    pub fn update<const V: usize>(
         &self,
         plane: Plane,
-        step: &StrainStep,
+        step: &StrainStep<V>,
         state_n: &[f64],
         state: &mut [f64],
-    ) -> PointResponse {
-        self.update_with(&self.c(plane), plane, step, state_n, state)
+    ) -> PointResponse<V> {
+        self.update_with(&self.c_voigt(plane), plane, step, state_n, state)
     }
 
     /// [`Material::update`] with the elasticity matrix `c = self.c(plane)` computed by
     /// the caller (once per element block in the Gauss-point loop).
-    pub fn update_with(
+    pub fn update_with<const V: usize>(
         &self,
-        c: &[[f64; 3]; 3],
+        c: &[[f64; V]; V],
         plane: Plane,
-        step: &StrainStep,
+        step: &StrainStep<V>,
         state_n: &[f64],
         state: &mut [f64],
-    ) -> PointResponse {
+    ) -> PointResponse<V> {
         self.update_driven(c, plane, step, None, state_n, state)
     }
 
     /// [`Material::update_with`] with every history frozen at its committed value
     /// where the model has such a form (Mazars: `D = D⁰`, the secant of the last
     /// step, the paper's first estimate); the ordinary update for the others.
-    pub fn update_frozen(
+    pub fn update_frozen<const V: usize>(
         &self,
-        c: &[[f64; 3]; 3],
+        c: &[[f64; V]; V],
         plane: Plane,
-        step: &StrainStep,
+        step: &StrainStep<V>,
         state_n: &[f64],
         state: &mut [f64],
-    ) -> PointResponse {
+    ) -> PointResponse<V> {
         match self.model {
             Model::Mazars(_) => mazars::frozen(c, step, state_n, state),
             _ => self.update_with(c, plane, step, state_n, state),
@@ -440,15 +485,17 @@ impl Material {
     /// [`Material::update_with`] where the damage of a nonlocal material is driven by
     /// `averaged`, the nonlocal average of its equivalent strains at this point
     /// ([`mazars::drivers`]); `None` (and every other model) takes the point's own.
-    pub fn update_driven(
+    /// `V = 3` in the plane, `6` in a solid; Rankine-Hill is the plane's (validation
+    /// keeps it there).
+    pub fn update_driven<const V: usize>(
         &self,
-        c: &[[f64; 3]; 3],
+        c: &[[f64; V]; V],
         plane: Plane,
-        step: &StrainStep,
+        step: &StrainStep<V>,
         averaged: Option<[f64; 2]>,
         state_n: &[f64],
         state: &mut [f64],
-    ) -> PointResponse {
+    ) -> PointResponse<V> {
         let c = *c;
         match self.model {
             Model::Elastic => elastic::update(&c, step),
@@ -476,7 +523,32 @@ impl Material {
                 mazars::update(&p, &c, self.nu, plane, step, averaged, state_n, state)
             }
             Model::RankineHill(p) => {
-                rankine_hill::update(&p, &c, self.e, self.nu, step, state_n, state)
+                assert_eq!(V, 3, "validation keeps Rankine-Hill to the plane");
+                let narrow = |v: &[f64; V]| -> [f64; 3] { std::array::from_fn(|i| v[i]) };
+                let c3: [[f64; 3]; 3] = std::array::from_fn(|i| narrow(&c[i]));
+                let step3 = StrainStep {
+                    eps_n: narrow(&step.eps_n),
+                    eps: narrow(&step.eps),
+                    dt: step.dt,
+                    length: step.length,
+                };
+                let r = rankine_hill::update(&p, &c3, self.e, self.nu, &step3, state_n, state);
+                let widen = |v: &[f64; 3]| -> [f64; V] {
+                    std::array::from_fn(|i| if i < 3 { v[i] } else { 0.0 })
+                };
+                PointResponse {
+                    sigma: widen(&r.sigma),
+                    tangent: std::array::from_fn(|i| {
+                        if i < 3 {
+                            widen(&r.tangent[i])
+                        } else {
+                            [0.0; V]
+                        }
+                    }),
+                    psi: r.psi,
+                    dissipation: r.dissipation,
+                    status: r.status,
+                }
             }
         }
     }
@@ -500,18 +572,18 @@ pub fn sig(x: f64) -> String {
     }
 }
 
-/// `a · b` for Voigt vectors.
+/// `a · b` for Voigt vectors (summed from the first component on).
 #[inline]
-pub fn dot3(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+pub fn dot3<const V: usize>(a: &[f64; V], b: &[f64; V]) -> f64 {
+    let mut s = a[0] * b[0];
+    for i in 1..V {
+        s += a[i] * b[i];
+    }
+    s
 }
 
-/// `C x` for a 3x3 matrix.
+/// `C x` for a Voigt matrix (each row summed from its first column on).
 #[inline]
-pub fn mul3(c: &[[f64; 3]; 3], x: &[f64; 3]) -> [f64; 3] {
-    [
-        c[0][0] * x[0] + c[0][1] * x[1] + c[0][2] * x[2],
-        c[1][0] * x[0] + c[1][1] * x[1] + c[1][2] * x[2],
-        c[2][0] * x[0] + c[2][1] * x[1] + c[2][2] * x[2],
-    ]
+pub fn mul3<const V: usize>(c: &[[f64; V]; V], x: &[f64; V]) -> [f64; V] {
+    std::array::from_fn(|i| dot3(&c[i], x))
 }

@@ -21,6 +21,47 @@ pub fn principal_values(xx: f64, yy: f64, xy: f64) -> (f64, f64) {
     (c + r, c - r)
 }
 
+/// The three eigenvalues, in decreasing order, of the symmetric tensor with
+/// diagonal `d = [xx, yy, zz]` and off-diagonal `o = [xy, yz, zx]` (tensor
+/// components): the trigonometric solution of the characteristic cubic about the
+/// mean, exact to round-off for any symmetric tensor (a diagonal one returns its
+/// diagonal sorted).
+pub fn eigenvalues_sym3(d: [f64; 3], o: [f64; 3]) -> [f64; 3] {
+    let p1 = o[0] * o[0] + o[1] * o[1] + o[2] * o[2];
+    let mut e = if p1 == 0.0 {
+        d
+    } else {
+        let q = (d[0] + d[1] + d[2]) / 3.0;
+        let (a, b, c) = (d[0] - q, d[1] - q, d[2] - q);
+        let p2 = a * a + b * b + c * c + 2.0 * p1;
+        let p = (p2 / 6.0).sqrt();
+        if p == 0.0 {
+            [q; 3]
+        } else {
+            // B = (A − q I)/p; r = det(B)/2 ∈ [−1, 1].
+            let det = a * (b * c - o[1] * o[1]) - o[0] * (o[0] * c - o[1] * o[2])
+                + o[2] * (o[0] * o[1] - b * o[2]);
+            let r = (det / (2.0 * p * p * p)).clamp(-1.0, 1.0);
+            let phi = r.acos() / 3.0;
+            let e1 = q + 2.0 * p * phi.cos();
+            let e3 = q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos();
+            [e1, 3.0 * q - e1 - e3, e3]
+        }
+    };
+    e.sort_by(|x, y| y.total_cmp(x));
+    e
+}
+
+/// Principal values of a solid's Voigt vector `[xx, yy, s_xy, zz, s_yz, s_zx]`
+/// whose shears are `shear_scale` times the tensor's (1/2 for engineering strains,
+/// 1 for stresses).
+pub fn principal_voigt6(v: &[f64], shear_scale: f64) -> [f64; 3] {
+    eigenvalues_sym3(
+        [v[0], v[1], v[3]],
+        [shear_scale * v[2], shear_scale * v[4], shear_scale * v[5]],
+    )
+}
+
 /// Principal stresses of a Voigt stress `[σ_xx, σ_yy, σ_xy]`.
 #[inline]
 pub fn principal_stress(s: &[f64; 3]) -> (f64, f64, f64) {

@@ -1,7 +1,8 @@
 //! Gauss-point storage of one element block: committed and trial states.
 //!
-//! Each state is one buffer laid out as `[ε (3 per point) | σ (3 per point) |
-//! cumulative dissipation density (1 per point) | history (n_state per point)]`. The
+//! Each state is one buffer laid out as `[ε (v per point) | σ (v per point) |
+//! cumulative dissipation density (1 per point) | history (n_state per point)]`,
+//! `v` the Voigt size (3 in the plane, 6 in a solid). The
 //! Gauss-point loop writes a whole trial state through one base pointer (see
 //! `assembly::internal`); accepting a step swaps the two buffers, so a commit copies
 //! nothing and no pass allocates. Every evaluation rewrites all trial entries before
@@ -12,6 +13,7 @@
 pub struct StateStore {
     n_points: usize,
     n_state: usize,
+    voigt: usize,
     committed: Vec<f64>,
     trial: Vec<f64>,
 }
@@ -23,6 +25,8 @@ pub struct Layout {
     pub n_points: usize,
     /// History values per point.
     pub n_state: usize,
+    /// Strain and stress components per point.
+    pub voigt: usize,
 }
 
 impl Layout {
@@ -32,19 +36,19 @@ impl Layout {
     }
     /// Start of the stresses.
     pub fn sigma(&self) -> usize {
-        3 * self.n_points
+        self.voigt * self.n_points
     }
     /// Start of the cumulative dissipation densities.
     pub fn dissipated(&self) -> usize {
-        6 * self.n_points
+        2 * self.voigt * self.n_points
     }
     /// Start of the history values.
     pub fn history(&self) -> usize {
-        7 * self.n_points
+        (2 * self.voigt + 1) * self.n_points
     }
     /// Length of a state buffer.
     pub fn len(&self) -> usize {
-        (7 + self.n_state) * self.n_points
+        (2 * self.voigt + 1 + self.n_state) * self.n_points
     }
     /// True for a block without points.
     pub fn is_empty(&self) -> bool {
@@ -53,12 +57,25 @@ impl Layout {
 }
 
 impl StateStore {
-    /// Storage for `n_points` points with `n_state` history values each, all zero.
+    /// Storage for `n_points` plane points with `n_state` history values each, all
+    /// zero.
     pub fn new(n_points: usize, n_state: usize) -> Self {
-        let len = Layout { n_points, n_state }.len();
+        Self::with_voigt(n_points, n_state, 3)
+    }
+
+    /// Storage for `n_points` points of `voigt` strain components with `n_state`
+    /// history values each, all zero.
+    pub fn with_voigt(n_points: usize, n_state: usize, voigt: usize) -> Self {
+        let len = Layout {
+            n_points,
+            n_state,
+            voigt,
+        }
+        .len();
         StateStore {
             n_points,
             n_state,
+            voigt,
             committed: crate::memory::zeroed(len),
             trial: crate::memory::zeroed(len),
         }
@@ -69,6 +86,7 @@ impl StateStore {
         Layout {
             n_points: self.n_points,
             n_state: self.n_state,
+            voigt: self.voigt,
         }
     }
 
@@ -110,10 +128,7 @@ impl StateStore {
     pub fn split(&mut self) -> (Committed<'_>, &mut [f64]) {
         (
             Committed {
-                layout: Layout {
-                    n_points: self.n_points,
-                    n_state: self.n_state,
-                },
+                layout: self.layout(),
                 data: &self.committed,
             },
             &mut self.trial,
@@ -130,14 +145,15 @@ impl StateStore {
     pub fn set_committed(
         &mut self,
         g: usize,
-        eps: [f64; 3],
-        sigma: [f64; 3],
+        eps: &[f64],
+        sigma: &[f64],
         dissipated: f64,
         history: &[f64],
     ) {
         let l = self.layout();
-        self.committed[l.eps() + 3 * g..l.eps() + 3 * g + 3].copy_from_slice(&eps);
-        self.committed[l.sigma() + 3 * g..l.sigma() + 3 * g + 3].copy_from_slice(&sigma);
+        let v = l.voigt;
+        self.committed[l.eps() + v * g..l.eps() + v * g + v].copy_from_slice(&eps[..v]);
+        self.committed[l.sigma() + v * g..l.sigma() + v * g + v].copy_from_slice(&sigma[..v]);
         self.committed[l.dissipated() + g] = dissipated;
         let o = l.history() + g * self.n_state;
         self.committed[o..o + history.len()].copy_from_slice(history);
@@ -158,18 +174,25 @@ pub struct Committed<'a> {
 }
 
 impl Committed<'_> {
-    /// Strain of point `g`.
+    /// Strain of point `g` (`V` the store's Voigt size).
     #[inline]
-    pub fn eps(&self, g: usize) -> [f64; 3] {
-        let o = 3 * g;
-        [self.data[o], self.data[o + 1], self.data[o + 2]]
+    pub fn eps<const V: usize>(&self, g: usize) -> [f64; V] {
+        let o = V * g;
+        std::array::from_fn(|i| self.data[o + i])
     }
 
-    /// Stress of point `g`.
+    /// Stress of point `g` (`V` the store's Voigt size).
     #[inline]
-    pub fn sigma(&self, g: usize) -> [f64; 3] {
-        let o = self.layout.sigma() + 3 * g;
-        [self.data[o], self.data[o + 1], self.data[o + 2]]
+    pub fn sigma<const V: usize>(&self, g: usize) -> [f64; V] {
+        let o = self.layout.sigma() + V * g;
+        std::array::from_fn(|i| self.data[o + i])
+    }
+
+    /// Stress of point `g` in the Voigt order of `fe`, padded to six components.
+    pub fn sigma6(&self, g: usize) -> [f64; 6] {
+        let v = self.layout.voigt;
+        let o = self.layout.sigma() + v * g;
+        std::array::from_fn(|i| if i < v { self.data[o + i] } else { 0.0 })
     }
 
     /// Cumulative dissipation density (viscous + damage + plastic, J/m³) of point `g`.

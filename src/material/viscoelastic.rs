@@ -4,39 +4,51 @@
 
 use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
 
+/// Whether Voigt component `i` is a shear (engineering `γ`): the plane's third, a
+/// solid's third, fifth and sixth (order of `fe`).
+#[inline]
+fn is_shear(i: usize) -> bool {
+    matches!(i, 2 | 4 | 5)
+}
+
 /// Voigt matrix of the identity viscosity `η = β I` acting on engineering strain
-/// rates: `σ = β ε̇` componentwise, so `σ_xy = β γ̇_xy / 2`.
-pub fn identity_viscosity(beta: f64) -> [[f64; 3]; 3] {
-    [[beta, 0.0, 0.0], [0.0, beta, 0.0], [0.0, 0.0, 0.5 * beta]]
+/// rates: `σ = β ε̇` componentwise, so `σ_xy = β γ̇_xy / 2` (each shear).
+pub fn identity_viscosity<const V: usize>(beta: f64) -> [[f64; V]; V] {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| match (i == j, is_shear(i)) {
+            (true, true) => 0.5 * beta,
+            (true, false) => beta,
+            _ => 0.0,
+        })
+    })
 }
 
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+fn sub<const V: usize>(a: &[f64; V], b: &[f64; V]) -> [f64; V] {
+    std::array::from_fn(|i| a[i] - b[i])
 }
 
-fn add_scaled(m: &[[f64; 3]; 3], a: f64, n: &[[f64; 3]; 3], b: f64) -> [[f64; 3]; 3] {
-    let mut out = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            out[i][j] = a * m[i][j] + b * n[i][j];
-        }
-    }
-    out
+fn add_scaled<const V: usize>(
+    m: &[[f64; V]; V],
+    a: f64,
+    n: &[[f64; V]; V],
+    b: f64,
+) -> [[f64; V]; V] {
+    std::array::from_fn(|i| std::array::from_fn(|j| a * m[i][j] + b * n[i][j]))
 }
 
 /// Kelvin-Voigt `σ = C ε + η ε̇`, `ε̇ ≈ (ε − ε_n)/h`. History-free (the committed
 /// strain is the store's). Tangent `C + η/h`; `ΔD_viscous = Δε:η:Δε/h`;
 /// `ΔD_num = ½ Δε:C:Δε`.
-pub fn kelvin_voigt(c: &[[f64; 3]; 3], eta: &[[f64; 3]; 3], step: &StrainStep) -> PointResponse {
+pub fn kelvin_voigt<const V: usize>(
+    c: &[[f64; V]; V],
+    eta: &[[f64; V]; V],
+    step: &StrainStep<V>,
+) -> PointResponse<V> {
     let de = sub(&step.eps, &step.eps_n);
     let ce = mul3(c, &step.eps);
     let eta_de = mul3(eta, &de);
     let h = step.dt;
-    let sigma = [
-        ce[0] + eta_de[0] / h,
-        ce[1] + eta_de[1] / h,
-        ce[2] + eta_de[2] / h,
-    ];
+    let sigma: [f64; V] = std::array::from_fn(|i| ce[i] + eta_de[i] / h);
     PointResponse {
         sigma,
         tangent: add_scaled(c, 1.0, eta, 1.0 / h),
@@ -54,25 +66,21 @@ pub fn kelvin_voigt(c: &[[f64; 3]; 3], eta: &[[f64; 3]; 3], step: &StrainStep) -
 /// dashpot `β C` (`β` in seconds), `p = 1` (SLS) or `p = 0` (Maxwell). State: the
 /// dashpot strain `ε_d`; backward Euler `ε_d¹ = (ε_d⁰ + k ε)/(1 + k)`, `k = h α/β`,
 /// so `τ = α C (ε − ε_d⁰)/(1 + k)`, the paper's eq. (10) second line.
-pub fn standard_linear_solid(
-    c: &[[f64; 3]; 3],
+pub fn standard_linear_solid<const V: usize>(
+    c: &[[f64; V]; V],
     parallel: f64,
     alpha: f64,
     beta: f64,
-    step: &StrainStep,
+    step: &StrainStep<V>,
     eps_d_n: &[f64],
     eps_d: &mut [f64],
-) -> PointResponse {
+) -> PointResponse<V> {
     let h = step.dt;
     let k = h * alpha / beta;
     let inv = 1.0 / (1.0 + k);
-    let ed_n = [eps_d_n[0], eps_d_n[1], eps_d_n[2]];
-    let ed = [
-        (ed_n[0] + k * step.eps[0]) * inv,
-        (ed_n[1] + k * step.eps[1]) * inv,
-        (ed_n[2] + k * step.eps[2]) * inv,
-    ];
-    eps_d[..3].copy_from_slice(&ed);
+    let ed_n: [f64; V] = std::array::from_fn(|i| eps_d_n[i]);
+    let ed: [f64; V] = std::array::from_fn(|i| (ed_n[i] + k * step.eps[i]) * inv);
+    eps_d[..V].copy_from_slice(&ed);
     // Four products with C; every other one follows by linearity.
     let ce = mul_iso(c, &step.eps);
     let ce_n = mul_iso(c, &step.eps_n);
@@ -86,11 +94,7 @@ pub fn standard_linear_solid(
     let c_ded = sub(&ced, &ced_n);
     let dee = sub(&de, &ded);
     let c_dee = sub(&c_de, &c_ded);
-    let sigma = [
-        parallel * ce[0] + alpha * c_ee[0],
-        parallel * ce[1] + alpha * c_ee[1],
-        parallel * ce[2] + alpha * c_ee[2],
-    ];
+    let sigma: [f64; V] = std::array::from_fn(|i| parallel * ce[i] + alpha * c_ee[i]);
     PointResponse {
         sigma,
         tangent: add_scaled(c, parallel, c, alpha * inv),
@@ -104,12 +108,20 @@ pub fn standard_linear_solid(
     }
 }
 
-/// `C x` for an isotropic plane elasticity matrix (no normal-shear coupling).
+/// `C x` for an isotropic elasticity matrix: no normal-shear coupling, the shears
+/// on the diagonal (the normal rows summed over the normal columns in order).
 #[inline]
-fn mul_iso(c: &[[f64; 3]; 3], x: &[f64; 3]) -> [f64; 3] {
-    [
-        c[0][0] * x[0] + c[0][1] * x[1],
-        c[1][0] * x[0] + c[1][1] * x[1],
-        c[2][2] * x[2],
-    ]
+fn mul_iso<const V: usize>(c: &[[f64; V]; V], x: &[f64; V]) -> [f64; V] {
+    std::array::from_fn(|i| {
+        if is_shear(i) {
+            return c[i][i] * x[i];
+        }
+        let mut s = c[i][0] * x[0];
+        for j in 1..V {
+            if !is_shear(j) {
+                s += c[i][j] * x[j];
+            }
+        }
+        s
+    })
 }

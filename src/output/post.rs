@@ -74,7 +74,7 @@ pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64;
         if let Some(store) = points.get(bi) {
             let c = store.committed();
             for e in 0..block.elements.len() {
-                out.push(pad(element_mean(mesh, bi, e, ng, |g| c.sigma(g))));
+                out.push(element_mean(mesh, bi, e, ng, |g| c.sigma6(g)));
             }
             continue;
         }

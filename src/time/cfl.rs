@@ -3,6 +3,7 @@
 //! `c = sqrt(E(1−ν) / (ρ(1+ν)(1−2ν)))` of the paper's formula (ω = 1 here), and
 //! `c = sqrt(E/ρ)` for bars.
 
+use crate::fe::element::Voigt;
 use crate::fe::MAX_ELEMENT_DOFS;
 
 /// The size of the largest element matrix.
@@ -73,18 +74,6 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
     let mut seen: HashMap<(usize, Vec<i64>), f64> = HashMap::new();
     for (bi, b) in mesh.blocks.iter().enumerate() {
         let m = &model.materials[b.material];
-        // Solids hold elastic materials only so far (their `C` is taken below).
-        let plane = mesh.dim == 2;
-        let d = if plane {
-            m.instantaneous_stiffness(model.plane)
-        } else {
-            [[0.0; 3]; 3]
-        };
-        let eta = if plane {
-            m.viscosity(model.plane)
-        } else {
-            None
-        };
         let a_k = model.analysis.rayleigh[1];
         for e in 0..b.elements.len() {
             let nodes = b.elements.element(e);
@@ -97,60 +86,25 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
                 .map(|c| (c / size * 1e12).round() as i64)
                 .collect();
             let dt = *seen.entry((bi, key)).or_insert_with(|| {
-                let dim = mesh.dim;
-                let nd = dim * nodes.len();
-                let mut ke = [0.0; ELEMENT_MATRIX];
-                let mut me = [0.0; ELEMENT_MATRIX];
-                match b.elements.kind {
-                    ElementKind::Bar2 => {
-                        crate::fe::element::bar_stiffness(&x, dim, m.e * b.section, &mut ke);
-                        crate::fe::element::bar_mass(&x, dim, m.rho * b.section, &mut me);
-                    }
-                    kind if dim == 3 => {
-                        let d = m.c_solid();
-                        crate::fe::element::continuum_stiffness(kind, &x, &d, b.section, &mut ke);
-                        crate::fe::element::continuum_mass(kind, &x, m.rho * b.section, &mut me);
-                    }
-                    kind => {
-                        crate::fe::element::continuum_stiffness(kind, &x, &d, b.section, &mut ke);
-                        crate::fe::element::continuum_mass(kind, &x, m.rho * b.section, &mut me);
-                    }
-                }
-                // Lumped: row sums. Symmetric form D^{-1/2} K D^{-1/2}.
-                let mut s = [0.0; MAX_ELEMENT_DOFS];
-                for i in 0..nd {
-                    let row: f64 = (0..nd).map(|j| me[i * nd + j]).sum();
-                    s[i] = if row > 0.0 { 1.0 / row.sqrt() } else { 0.0 };
-                }
-                let scaled = |k: &[f64; ELEMENT_MATRIX]| {
-                    let mut a = [0.0; ELEMENT_MATRIX];
-                    for i in 0..nd {
-                        for j in 0..nd {
-                            a[i * nd + j] = s[i] * k[i * nd + j] * s[j];
-                        }
-                    }
-                    largest_eigenvalue(&mut a, nd)
+                let el = ElementStep {
+                    kind: b.elements.kind,
+                    x: &x,
+                    dim: mesh.dim,
+                    material: m,
+                    section: b.section,
+                    a_k,
                 };
-                let omega2 = scaled(&ke);
-                if omega2 <= 0.0 {
-                    return f64::INFINITY;
+                if mesh.dim == 3 {
+                    el.limit(
+                        &m.instantaneous_stiffness::<6>(model.plane),
+                        m.viscosity_voigt::<6>(model.plane),
+                    )
+                } else {
+                    el.limit(
+                        &m.instantaneous_stiffness::<3>(model.plane),
+                        m.viscosity(model.plane),
+                    )
                 }
-                let omega = omega2.sqrt();
-                // The largest damping rate 2ξω the half-step velocity carries.
-                let mut c_max = a_k * omega2;
-                if let (Some(eta), ElementKind::Quad4 | ElementKind::Tri3) = (eta, b.elements.kind)
-                {
-                    let mut ce = [0.0; ELEMENT_MATRIX];
-                    crate::fe::element::continuum_stiffness(
-                        b.elements.kind,
-                        &x,
-                        &eta,
-                        b.section,
-                        &mut ce,
-                    );
-                    c_max += scaled(&ce);
-                }
-                damped_limit(omega, c_max)
             });
             if dt.is_finite() && best.is_none_or(|s| dt < s.dt) {
                 {
@@ -164,6 +118,66 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
         }
     }
     best
+}
+
+/// One element's share of the stable step: its geometry, material and section.
+struct ElementStep<'a> {
+    kind: ElementKind,
+    x: &'a [[f64; 3]],
+    dim: usize,
+    material: &'a crate::material::Material,
+    section: f64,
+    /// Rayleigh's stiffness coefficient.
+    a_k: f64,
+}
+
+impl ElementStep<'_> {
+    /// The damped limit `2/ω` of the element with instantaneous stiffness `d` and
+    /// viscosity `eta` (either Voigt size), lumped mass.
+    fn limit<M: Voigt>(&self, d: &M, eta: Option<M>) -> f64 {
+        let (m, x, dim) = (self.material, self.x, self.dim);
+        let nd = dim * x.len();
+        let mut ke = [0.0; ELEMENT_MATRIX];
+        let mut me = [0.0; ELEMENT_MATRIX];
+        match self.kind {
+            ElementKind::Bar2 => {
+                crate::fe::element::bar_stiffness(x, dim, m.e * self.section, &mut ke);
+                crate::fe::element::bar_mass(x, dim, m.rho * self.section, &mut me);
+            }
+            kind => {
+                crate::fe::element::continuum_stiffness(kind, x, d, self.section, &mut ke);
+                crate::fe::element::continuum_mass(kind, x, m.rho * self.section, &mut me);
+            }
+        }
+        // Lumped: row sums. Symmetric form D^{-1/2} K D^{-1/2}.
+        let mut s = [0.0; MAX_ELEMENT_DOFS];
+        for i in 0..nd {
+            let row: f64 = (0..nd).map(|j| me[i * nd + j]).sum();
+            s[i] = if row > 0.0 { 1.0 / row.sqrt() } else { 0.0 };
+        }
+        let scaled = |k: &[f64; ELEMENT_MATRIX]| {
+            let mut a = [0.0; ELEMENT_MATRIX];
+            for i in 0..nd {
+                for j in 0..nd {
+                    a[i * nd + j] = s[i] * k[i * nd + j] * s[j];
+                }
+            }
+            largest_eigenvalue(&mut a, nd)
+        };
+        let omega2 = scaled(&ke);
+        if omega2 <= 0.0 {
+            return f64::INFINITY;
+        }
+        let omega = omega2.sqrt();
+        // The largest damping rate 2ξω the half-step velocity carries.
+        let mut c_max = self.a_k * omega2;
+        if let (Some(eta), true) = (eta, self.kind != ElementKind::Bar2) {
+            let mut ce = [0.0; ELEMENT_MATRIX];
+            crate::fe::element::continuum_stiffness(self.kind, x, &eta, self.section, &mut ce);
+            c_max += scaled(&ce);
+        }
+        damped_limit(omega, c_max)
+    }
 }
 
 /// The stable step `2/ω_max` of the mesh itself (not element by element): `ω_max²`

@@ -20,10 +20,10 @@
 
 use rayon::prelude::*;
 
-use crate::assembly::internal::{new_stores, points_per_element};
+use crate::assembly::internal::{new_stores, points_per_element, strain_v};
 use crate::assembly::{Assembler, Mass, Pattern};
 use crate::energy::Dissipation;
-use crate::fe::{element, kinematics, stiffness_rule, strain, ElementKind};
+use crate::fe::{element, kinematics, stiffness_rule, ElementKind, MAX_ELEMENT_DOFS, MAX_NODES};
 use crate::halves::{add, in_halves, split_slices, Slices, VECTOR_LEAF};
 use crate::material::store::StateStore;
 use crate::material::{mul3, Model as Law, Viscosity};
@@ -163,18 +163,24 @@ impl NodalLaws {
             .iter()
             .enumerate()
             .map(|(g, &(law, material))| {
+                let in_group = |bi: usize| block_group[bi] == g;
+                let plane = model.plane;
+                let solid = model.mesh.dim == 3;
                 let k = (!single).then(|| {
-                    group_matrix(model, asm, |bi| block_group[bi] == g, |m| m.c(model.plane))
+                    if solid {
+                        group_matrix(model, asm, in_group, |m| m.c_voigt::<6>(plane))
+                    } else {
+                        group_matrix(model, asm, in_group, |m| m.c(plane))
+                    }
                 });
-                let v = if law == GroupLaw::MatrixVoigt {
-                    group_matrix(
-                        model,
-                        asm,
-                        |bi| block_group[bi] == g,
-                        |m| m.viscosity(model.plane).unwrap_or_default(),
-                    )
-                } else {
-                    Vec::new()
+                let v = match law {
+                    GroupLaw::MatrixVoigt if solid => group_matrix(model, asm, in_group, |m| {
+                        m.viscosity_voigt::<6>(plane).unwrap_or_default()
+                    }),
+                    GroupLaw::MatrixVoigt => group_matrix(model, asm, in_group, |m| {
+                        m.viscosity(plane).unwrap_or_default()
+                    }),
+                    _ => Vec::new(),
                 };
                 Group {
                     law,
@@ -334,6 +340,20 @@ impl NodalLaws {
     /// cumulative dissipation density, a sum over every step, is not a function of
     /// the fields: it is NaN (the ledger holds the totals).
     pub fn materialise(&self, model: &Model, u: &[f64], s: &NodalState) -> Vec<StateStore> {
+        if model.mesh.dim == 3 {
+            self.materialise_d::<3, 6>(model, u, s)
+        } else {
+            self.materialise_d::<2, 3>(model, u, s)
+        }
+    }
+
+    /// [`NodalLaws::materialise`] in dimension `D` with `V` Voigt components.
+    fn materialise_d<const D: usize, const V: usize>(
+        &self,
+        model: &Model,
+        u: &[f64],
+        s: &NodalState,
+    ) -> Vec<StateStore> {
         let mesh = &model.mesh;
         let mut stores = new_stores(mesh, &model.materials);
         for (bi, (block, store)) in mesh.blocks.iter().zip(stores.iter_mut()).enumerate() {
@@ -341,50 +361,62 @@ impl NodalLaws {
             let kind = block.elements.kind;
             let nn = kind.nodes();
             let ng = points_per_element(kind);
-            let c = mat.c(model.plane);
+            let c: [[f64; V]; V] = mat.c_voigt(model.plane);
             let (law, fields) = self.law_of_block(model, bi, s);
             let rule = stiffness_rule(kind);
-            for e in 0..block.elements.len() {
-                let nodes = block.elements.element(e);
-                let mut x = [[0.0; 3]; 4];
-                let (mut ue, mut de, mut ude) = ([0.0; 8], [0.0; 8], [0.0; 8]);
-                for (a, &n) in nodes.iter().enumerate() {
-                    x[a] = mesh.coords[n];
-                    for j in 0..2 {
-                        ue[2 * a + j] = u[2 * n + j];
-                        if !s.du.is_empty() {
-                            de[2 * a + j] = s.du[2 * n + j];
-                        }
-                        if let Some(f) = fields.filter(|f| !f.ud.is_empty()) {
-                            ude[2 * a + j] = f.ud[2 * n + j];
+            let gather = |field: &[f64], nodes: &[usize]| -> [f64; MAX_ELEMENT_DOFS] {
+                let mut out = [0.0; MAX_ELEMENT_DOFS];
+                if !field.is_empty() {
+                    for (a, &n) in nodes.iter().enumerate() {
+                        for j in 0..D {
+                            out[D * a + j] = field[D * n + j];
                         }
                     }
                 }
+                out
+            };
+            for e in 0..block.elements.len() {
+                let nodes = block.elements.element(e);
+                let mut x = [[0.0; 3]; MAX_NODES];
+                for (a, &n) in nodes.iter().enumerate() {
+                    x[a] = mesh.coords[n];
+                }
+                let ue = gather(u, nodes);
+                let de = gather(&s.du, nodes);
+                let ude = gather(fields.map_or(&[][..], |f| &f.ud[..]), nodes);
                 if kind == ElementKind::Bar2 {
-                    let eps = element::bar_strain(&x[..2], 2, &ue[..4]);
-                    store.set_committed(e, [eps, 0.0, 0.0], [mat.e * eps, 0.0, 0.0], f64::NAN, &[]);
+                    let eps = element::bar_strain(&x[..2], D, &ue[..2 * D]);
+                    store.set_committed(
+                        e,
+                        &[eps, 0.0, 0.0],
+                        &[mat.e * eps, 0.0, 0.0],
+                        f64::NAN,
+                        &[],
+                    );
                     continue;
                 }
                 for (q, &(xi, _)) in rule.iter().enumerate() {
                     let kin = kinematics(kind, &x[..nn], xi);
-                    let eps = strain(&kin, nn, &ue);
+                    let eps = strain_v::<V>(&kin, nn, &ue);
                     let ce = mul3(&c, &eps);
                     let g = e * ng + q;
                     match law {
-                        GroupLaw::Elastic => store.set_committed(g, eps, ce, f64::NAN, &[]),
+                        GroupLaw::Elastic => store.set_committed(g, &eps, &ce, f64::NAN, &[]),
                         GroupLaw::ProportionalVoigt { .. } | GroupLaw::MatrixVoigt => {
-                            let eta = mat.viscosity(model.plane).expect("a Kelvin-Voigt material");
-                            let rate = strain(&kin, nn, &de).map(|x| x / s.h);
+                            let eta: [[f64; V]; V] = mat
+                                .viscosity_voigt(model.plane)
+                                .expect("a Kelvin-Voigt material");
+                            let rate = strain_v::<V>(&kin, nn, &de).map(|x| x / s.h);
                             let sv = mul3(&eta, &rate);
-                            let sigma = [ce[0] + sv[0], ce[1] + sv[1], ce[2] + sv[2]];
-                            store.set_committed(g, eps, sigma, f64::NAN, &[]);
+                            let sigma: [f64; V] = std::array::from_fn(|i| ce[i] + sv[i]);
+                            store.set_committed(g, &eps, &sigma, f64::NAN, &[]);
                         }
                         GroupLaw::Sls { alpha, p, .. } => {
-                            let ed = strain(&kin, nn, &ude);
+                            let ed = strain_v::<V>(&kin, nn, &ude);
                             let ced = mul3(&c, &ed);
-                            let sigma: [f64; 3] =
+                            let sigma: [f64; V] =
                                 std::array::from_fn(|i| p * ce[i] + alpha * (ce[i] - ced[i]));
-                            store.set_committed(g, eps, sigma, f64::NAN, &ed);
+                            store.set_committed(g, &eps, &sigma, f64::NAN, &ed);
                         }
                     }
                 }
@@ -417,14 +449,14 @@ impl NodalLaws {
 
 /// `∫ Bᵀ D B` over the blocks `in_group` holds, with `D = d(material)` (bars in the
 /// group: `E A / L`).
-fn group_matrix(
+fn group_matrix<M: crate::fe::element::Voigt>(
     model: &Model,
     asm: &Assembler,
     in_group: impl Fn(usize) -> bool + Sync,
-    d: impl Fn(&crate::material::Material) -> [[f64; 3]; 3],
+    d: impl Fn(&crate::material::Material) -> M,
 ) -> Vec<f64> {
     let mesh = &model.mesh;
-    let ds: Vec<[[f64; 3]; 3]> = model.materials.iter().map(d).collect();
+    let ds: Vec<M> = model.materials.iter().map(d).collect();
     asm.assemble(mesh, |bi, _e, x, ke| {
         let block = &mesh.blocks[bi];
         let kind = block.elements.kind;

@@ -263,19 +263,29 @@ fn initial_overlap(model: &Model) -> Result<()> {
 /// A body's thickness times its material's stiffness and density (and times its
 /// area) must stay finite: a thickness of 1e300 overflows the element matrices,
 /// which would otherwise surface as a singular stiffness far from its cause.
-/// What a solid model can hold so far: linear elastic materials, supports, loads,
-/// gravity and probes under statics or backward Euler; no contact
-/// (three-dimensional contact is its own work), no bars, no explicit path. Each
-/// refusal names the field.
+/// What a solid model can hold so far: every material model but Rankine-Hill
+/// (whose returns are written for plane stress) and nonlocal averaging (its
+/// neighbour search is the plane's), supports, loads, gravity and probes under
+/// statics, backward Euler and central differences; no contact (three-dimensional
+/// contact is its own work) and no bars. Each refusal names the field.
 fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material]) -> Result<()> {
     for block in &mesh.blocks {
         let m = &materials[block.material];
-        if !m.is_linear_elastic() {
+        let why = match m.model {
+            crate::material::Model::RankineHill(_) => {
+                Some("Rankine-Hill plasticity is written for plane stress")
+            }
+            _ if m.nonlocal_radius().is_some() => {
+                Some("nonlocal averaging searches its neighbours in the plane")
+            }
+            _ => None,
+        };
+        if let Some(why) = why {
             return Err(Error::config(
                 format!("materials.{}.model", m.name),
                 format!(
-                    "`{}` in a solid: solids take linear elastic materials so far (the \
-                     other models run in plane stress or strain)",
+                    "`{}` in a solid is not available yet: {why} (use it in plane stress or \
+                     strain, or a local model in the solid)",
                     m.model_name()
                 ),
             ));
@@ -292,13 +302,6 @@ fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material
         return Err(Error::config(
             "bars[0]",
             "bars in a solid are not available yet",
-        ));
-    }
-    if s.analysis.scheme == TimeScheme::CentralDifference {
-        return Err(Error::config(
-            "analysis.scheme",
-            "the explicit path in a solid is not available yet: use backward Euler \
-             (the default) or statics",
         ));
     }
     Ok(())
