@@ -557,3 +557,35 @@ fn a_wave_in_a_solid_bar_moves_its_end_as_one_dimensional_theory_says() {
         }
     }
 }
+
+#[test]
+fn a_gmsh_solid_is_read_oriented_and_carries_uniaxial_stress_exactly() {
+    // Reference: tests/data/bar_hex.msh, two unit hexahedra along x, one numbered
+    // left-handed and the left face listed inwards. The reader must give both
+    // positive volumes and outward face sets; pulled by 1 MPa on its right face and
+    // held on its left, the bar is in uniaxial stress: σ_xx = 1 MPa in both cells,
+    // every other component zero, u_x(x = 2) = 2 σ/E.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let part = rothe::mesh::gmsh::read(&dir.join("bar_hex.msh")).unwrap();
+    assert_eq!(part.dim, 3);
+    part.check().unwrap();
+    for (name, sign) in [("left", -1.0), ("right", 1.0)] {
+        for f in &part.face_sets[name] {
+            let x = |s: usize| part.coords[f[s]];
+            let n = rothe::mesh::cross(rothe::mesh::sub(x(1), x(0)), rothe::mesh::sub(x(2), x(0)));
+            assert!(sign * n[0] > 0.0, "{name}: the face points inwards");
+        }
+    }
+    let model = rothe::config::load(&dir.join("bar_hex.toml")).unwrap();
+    let sol = &statics::solve(&model, Backend::Faer, &[1.0]).unwrap()[0];
+    for s in rothe::output::post::cell_stress(&model, &sol.u, &[]) {
+        assert!((s[0] - 1e6).abs() < 1e-6, "σ_xx {}", s[0]);
+        for i in 1..6 {
+            assert!(s[i].abs() < 1e-6, "σ[{i}] {}", s[i]);
+        }
+    }
+    let right = &model.mesh.node_sets["bar.right"];
+    for &n in right {
+        assert!((sol.u[3 * n] - 2.0 * 1e6 / 210e9).abs() < 1e-15);
+    }
+}

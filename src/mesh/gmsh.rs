@@ -38,7 +38,14 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     if !msh.has_elements {
         return Err("the file has no $Elements section".into());
     }
-    let (coords, node_tags, tag_to_index) = nodes(&msh)?;
+    if msh
+        .element_blocks
+        .iter()
+        .any(|b| matches!(b.element_type, 4 | 5))
+    {
+        return parse_solid(&msh);
+    }
+    let (coords, node_tags, tag_to_index) = nodes(&msh, false)?;
     let index = |tag: u64, element: u64| -> std::result::Result<usize, String> {
         tag_to_index.get(&tag).copied().ok_or_else(|| {
             format!("element with Gmsh tag {element} refers to node tag {tag}, which no node block defines")
@@ -165,6 +172,168 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     })
 }
 
+/// A file with volume elements: a solid part of 4-node tetrahedra and 8-node
+/// hexahedra (each renumbered to positive volume if the file lists it the other way
+/// round), its 3- and 4-node surface elements as face sets of their physical groups
+/// (oriented outwards from the volume element they bound), and every physical
+/// group's nodes as a node set. Other element types are refused by name.
+fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
+    let (coords, node_tags, tag_to_index) = nodes(msh, true)?;
+    let index = |tag: u64, element: u64| -> std::result::Result<usize, String> {
+        tag_to_index.get(&tag).copied().ok_or_else(|| {
+            format!("element with Gmsh tag {element} refers to node tag {tag}, which no node block defines")
+        })
+    };
+    let set_names = group_names(msh)?;
+    let set_name = |dim: i32, tag: i32| -> String {
+        set_names
+            .get(&(dim, tag))
+            .cloned()
+            .unwrap_or_else(|| format!("physical_{dim}_{tag}"))
+    };
+    let mut volumes: [(Vec<usize>, Vec<u64>); 2] = Default::default();
+    let mut faces: Vec<(String, [usize; 4])> = Vec::new();
+    let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    let mut seen: HashMap<u64, ()> = HashMap::new();
+    for block in &msh.element_blocks {
+        let dim = block.entity_dim;
+        let groups = msh
+            .entity_groups
+            .get(&(dim, block.entity_tag))
+            .cloned()
+            .unwrap_or_default();
+        let per = block.nodes_per_element;
+        for (e, &tag) in block.tags.iter().enumerate() {
+            if seen.insert(tag, ()).is_some() {
+                return Err(format!("element tag {tag} is used by two elements"));
+            }
+            let mut ns = Vec::with_capacity(per);
+            for &t in &block.nodes[e * per..(e + 1) * per] {
+                ns.push(index(t, tag)?);
+            }
+            match block.element_type {
+                4 | 5 => {
+                    let (kind, slot) = if per == 4 {
+                        (ElementKind::Tet4, 0)
+                    } else {
+                        (ElementKind::Hex8, 1)
+                    };
+                    let x: Vec<[f64; 3]> = ns.iter().map(|&n| coords[n]).collect();
+                    if crate::fe::element::measure(kind, &x) < 0.0 {
+                        // The mirror numbering: swap within each face's cycle.
+                        if per == 4 {
+                            ns.swap(1, 2);
+                        } else {
+                            ns.swap(1, 3);
+                            ns.swap(5, 7);
+                        }
+                    }
+                    volumes[slot].0.extend_from_slice(&ns);
+                    volumes[slot].1.push(tag);
+                }
+                2 | 3 => {
+                    let mut f = [usize::MAX; 4];
+                    f[..per].copy_from_slice(&ns);
+                    for &g in &groups {
+                        faces.push((set_name(2, g), f));
+                    }
+                }
+                1 | 15 => {}
+                other => {
+                    return Err(format!(
+                        "element with Gmsh tag {tag} has type {other} ({}), which a solid \
+                         model does not take (use 4-node tetrahedra, 8-node hexahedra, \
+                         3-node triangles and 4-node quadrilaterals)",
+                        type_name(other)
+                    ))
+                }
+            }
+            for &g in &groups {
+                node_sets
+                    .entry(set_name(dim, g))
+                    .or_default()
+                    .extend_from_slice(&ns);
+            }
+        }
+    }
+    for nodes in node_sets.values_mut() {
+        nodes.sort_unstable();
+        nodes.dedup();
+    }
+    for (_, _, name) in &msh.physical_names {
+        node_sets.entry(name.clone()).or_default();
+    }
+    let mut blocks = Vec::new();
+    for (kind, (conn, tags)) in [ElementKind::Tet4, ElementKind::Hex8]
+        .into_iter()
+        .zip(volumes)
+    {
+        if !conn.is_empty() {
+            blocks.push(Elements {
+                kind,
+                conn,
+                tags: Some(tags),
+            });
+        }
+    }
+    let face_sets = oriented_faces(&blocks, &coords, faces);
+    Ok(Part {
+        dim: 3,
+        coords,
+        blocks,
+        node_sets,
+        edge_sets: BTreeMap::new(),
+        face_sets,
+        node_tags: Some(node_tags),
+    })
+}
+
+/// The face sets with every face turned to point away from the volume element it
+/// bounds (a face of no element keeps the file's order).
+fn oriented_faces(
+    blocks: &[Elements],
+    coords: &[[f64; 3]],
+    faces: Vec<(String, [usize; 4])>,
+) -> BTreeMap<String, Vec<[usize; 4]>> {
+    use crate::mesh::{cross, sub};
+    // The element (block, index) holding each sorted face.
+    let mut owner: HashMap<Vec<usize>, (usize, usize)> = HashMap::new();
+    for (bi, b) in blocks.iter().enumerate() {
+        for e in 0..b.len() {
+            let el = b.element(e);
+            for f in b.kind.faces() {
+                let mut key: Vec<usize> = f.iter().map(|&a| el[a]).collect();
+                key.sort_unstable();
+                owner.insert(key, (bi, e));
+            }
+        }
+    }
+    let mut out: BTreeMap<String, Vec<[usize; 4]>> = BTreeMap::new();
+    for (name, mut f) in faces {
+        let n = if f[3] == usize::MAX { 3 } else { 4 };
+        let mut key = f[..n].to_vec();
+        key.sort_unstable();
+        if let Some(&(bi, e)) = owner.get(&key) {
+            let el = blocks[bi].element(e);
+            let centre = el.iter().fold([0.0; 3], |c, &k| {
+                let x = coords[k];
+                [c[0] + x[0], c[1] + x[1], c[2] + x[2]]
+            });
+            let centre = centre.map(|c| c / el.len() as f64);
+            let normal = cross(
+                sub(coords[f[1]], coords[f[0]]),
+                sub(coords[f[2]], coords[f[0]]),
+            );
+            let out_dir = sub(coords[f[0]], centre);
+            if normal[0] * out_dir[0] + normal[1] * out_dir[1] + normal[2] * out_dir[2] < 0.0 {
+                f[1..n].reverse();
+            }
+        }
+        out.entry(name).or_default().push(f);
+    }
+    out
+}
+
 /// Orients every edge of the edge sets with its element on the left (the element's
 /// counter-clockwise order), as the rectangle meshes give them: contact takes a
 /// segment's outward normal from its direction. Gmsh lists a curve's lines in the
@@ -194,6 +363,7 @@ fn orient_edges(blocks: &[Elements], edge_sets: &mut BTreeMap<String, Vec<[usize
 #[allow(clippy::type_complexity)]
 fn nodes(
     msh: &MshFile,
+    solid: bool,
 ) -> std::result::Result<(Vec<[f64; 3]>, Vec<u64>, HashMap<u64, usize>), String> {
     let n: usize = msh.node_blocks.iter().map(|b| b.tags.len()).sum();
     let mut coords = Vec::with_capacity(n);
@@ -212,13 +382,13 @@ fn nodes(
             if index.insert(tag, coords.len()).is_some() {
                 return Err(format!("node tag {tag} is defined twice"));
             }
-            if p[2].abs() > z_tolerance {
+            if !solid && p[2].abs() > z_tolerance {
                 return Err(format!(
                     "node with Gmsh tag {tag} at {p:?} lies off the plane z = 0 \
                      (a 2D model takes x and y only)"
                 ));
             }
-            coords.push([p[0], p[1], 0.0]);
+            coords.push([p[0], p[1], if solid { p[2] } else { 0.0 }]);
             tags.push(tag);
         }
     }
