@@ -63,5 +63,50 @@ fn updates(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, updates);
+/// The Gauss-point pass of a solid (W3 at `n = 8`: 2048 hexahedra, 8 points each)
+/// for the elastic and Mazars models: internal force, trial states and energies at a
+/// bending field that cracks the clamped end (Mazars). Throughput in elements; the
+/// pass runs on every core, so per core is the figure over the core count.
+fn solid_pass(c: &mut Criterion) {
+    use rothe::assembly::internal::{new_stores, PointPass};
+    let mut g = c.benchmark_group("solid_gauss_point_pass");
+    for (name, text) in [MODELS[0], MODELS[3]] {
+        let scenario = rothe::workload::w3_scenario(8).replace("model = \"elastic\"", text);
+        let model = rothe::config::from_str(&scenario, std::path::Path::new(".")).unwrap();
+        let asm = rothe::assembly::Assembler::new(&model.mesh);
+        let mut stores = new_stores(&model.mesh, &model.materials);
+        // u_y = -c x²: curvature 2c, strain 2c·|y - 0.25| at most 0.25 * 2c = 4e-4.
+        let u: Vec<f64> = model
+            .mesh
+            .coords
+            .iter()
+            .flat_map(|x| [-8e-4 * x[0] * (x[1] - 0.25), -4e-4 * x[0] * x[0], 0.0])
+            .collect();
+        let mut f = vec![0.0; u.len()];
+        g.throughput(Throughput::Elements(model.mesh.n_elements() as u64));
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                asm.internal_force(
+                    &model.mesh,
+                    &model.materials,
+                    model.plane,
+                    PointPass {
+                        u: &u,
+                        dt: 1e-5,
+                        at_rest: false,
+                        frozen: false,
+                    },
+                    &mut stores,
+                    &mut f,
+                    None,
+                    None,
+                    None,
+                )
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, updates, solid_pass);
 criterion_main!(benches);

@@ -107,6 +107,48 @@ at = [2.0, 0.25]
     )
 }
 
+/// Workload W3, the solid counterpart of W1: a box 2.0 m x 0.5 m x 0.5 m of
+/// `4n x n x n` hexahedra, W1's concrete, consistent mass, clamped at `x = 0`, a
+/// step traction of 1 MPa down on the top face, backward Euler `h = 1e-5`, 100
+/// steps from rest; probe `tip` at the top right front corner.
+pub fn w3_scenario(n: usize) -> String {
+    format!(
+        r#"
+[analysis]
+t_end = 1.0e-3
+dt = 1.0e-5
+mass = "consistent"
+vtk_every = 0
+[materials.concrete]
+model = "elastic"
+E = 30e9
+nu = 0.2
+rho = 2400.0
+[[bodies]]
+name = "beam"
+material = "concrete"
+mesh = {{ kind = "box", size = [2.0, 0.5, 0.5], divisions = [{nx}, {n}, {n}] }}
+[[supports]]
+set = "beam.left"
+fix = ["x", "y", "z"]
+[[loads]]
+kind = "traction"
+set = "beam.top"
+value = [0.0, -1.0e6, 0.0]
+function = {{ kind = "step", at = 0.0 }}
+[[probes]]
+name = "tip"
+set = "beam.top_right_front"
+"#,
+        nx = 4 * n
+    )
+}
+
+/// The W3 model for `n` cells across the height.
+pub fn w3(n: usize) -> Result<Model> {
+    crate::config::from_str(&w3_scenario(n), std::path::Path::new("."))
+}
+
 /// The W1 model for `ny` cells across the height.
 pub fn w1(ny: usize) -> Result<Model> {
     crate::config::from_str(&w1_scenario(ny), std::path::Path::new("."))

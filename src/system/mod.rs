@@ -125,7 +125,8 @@ impl EffectiveSystem {
         let reduced = ReducedMatrix::new(pattern, &dofs);
         let t = Instant::now();
         let mut solver = backend.solver()?;
-        let nested_dissection = ordering.nested_dissection(dofs.n_free());
+        let dim = pattern.dim;
+        let nested_dissection = ordering.nested_dissection(dofs.n_free(), dim);
         if nested_dissection {
             solver.set_ordering(reduced.nested_dissection(&dofs, coords));
         }
