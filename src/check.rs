@@ -369,15 +369,16 @@ pub fn write_matrices(model: &Model, dir: &std::path::Path) -> Result<Vec<std::p
     let n = p.n_dofs();
     let on_pattern = |values: &[f64]| {
         let mut coo = CooMatrix::new(n, n);
+        let d = p.dim;
         for node in 0..p.n_nodes {
             let nbrs = &p.adj[p.adj_ptr[node]..p.adj_ptr[node + 1]];
-            for j in 0..2 {
+            for j in 0..d {
                 let c0 = p.col_start(node, j);
                 for (kk, &m) in nbrs.iter().enumerate() {
-                    for i in 0..2 {
-                        let v = values[c0 + 2 * kk + i];
+                    for i in 0..d {
+                        let v = values[c0 + d * kk + i];
                         if v != 0.0 {
-                            coo.push(2 * m as usize + i, 2 * node + j, v);
+                            coo.push(d * m as usize + i, d * node + j, v);
                         }
                     }
                 }

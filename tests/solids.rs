@@ -213,10 +213,11 @@ const MAZARS: &str = "eps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 
 /// Drives a solid point and a plane-stress point through the uniaxial-stress strain
 /// paths `ε_xx(t)` (lateral strains `−ν ε_xx`) and returns, per step, the solid's and
 /// the plane's `(σ_xx, history)`.
-fn uniaxial_both(
-    m: &rothe::material::Material,
-    path: &[f64],
-) -> Vec<([f64; 6], [f64; 3], Vec<f64>, Vec<f64>)> {
+/// Per step: the solid's stress, the plane's stress, the solid's and the plane's
+/// history.
+type Both = ([f64; 6], [f64; 3], Vec<f64>, Vec<f64>);
+
+fn uniaxial_both(m: &rothe::material::Material, path: &[f64]) -> Vec<Both> {
     use rothe::material::StrainStep;
     let nu = m.nu;
     let ns = m.n_state();

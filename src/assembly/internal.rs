@@ -327,6 +327,7 @@ pub(crate) fn gather<const D: usize>(
 
 /// Writes a Voigt vector (element by element: no call to `memcpy` on the hot path).
 #[inline(always)]
+#[allow(clippy::manual_memcpy)]
 fn write_v<const V: usize>(out: &mut [f64], v: &[f64; V]) {
     for i in 0..V {
         out[i] = v[i];

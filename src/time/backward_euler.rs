@@ -13,7 +13,8 @@
 //! confirms it and gives the new state. See `theory/scheme.md` and
 //! `theory/energy.md`.
 
-use super::implicit::{Core, Scheme};
+use super::implicit::Core;
+use super::operators::Scheme;
 use super::{Integrator, SolverFacts, State, StepOutcome, Timing};
 use crate::assembly::{Assembler, Mass};
 use crate::error::Result;

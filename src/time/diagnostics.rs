@@ -3,7 +3,7 @@
 //! fault, and the likely cause of an effective matrix that is not positive
 //! definite at the start.
 
-use super::implicit::{Operators, Scheme};
+use super::operators::{Operators, Scheme};
 use crate::linsolve::LowerCsc;
 use crate::model::Model;
 use crate::nonlinear::Outcome;

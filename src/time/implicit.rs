@@ -15,351 +15,23 @@
 use std::time::Instant;
 
 use super::diagnostics::{describe, likely_cause};
-use super::forces::{external_force, gravity_force};
-use super::nodal::{MassProduct, NodalLaws, NodalState};
+use super::forces::external_force;
+use super::nodal::{MassProduct, NodalState};
+use super::operators::{Operators, Response, Scheme};
+use super::residual::{residual_chunk, PassCoefficients, PassInputs, PassOutputs, PassSums};
 use super::{Rejection, State, StepOutcome, StepReport};
 use crate::assembly::internal::{new_stores, PointPass, PointTotals};
 use crate::assembly::{Assembler, Mass};
 use crate::contact::ContactCorrection;
-use crate::energy::{work_integrands, Dissipation, Ledger, StepIncrements, StepWork};
+use crate::energy::{Dissipation, StepIncrements, StepWork};
 use crate::error::{Error, Result};
 use crate::halves;
 use crate::linsolve::Backend;
-use crate::material::store::StateStore;
-use crate::model::{IterationMethod, Model, ViscoelasticState};
+use crate::model::{IterationMethod, Model};
 use crate::nonlinear::{
     self, Convergence, Correction, Evaluation, LinearCorrection, Outcome, StepProblem,
 };
 use crate::system::{DofMap, EffectiveSystem, Factored};
-
-/// How the materials respond, which decides how the effective matrix is kept.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Response {
-    /// Every material is linear elastic: `f_int = K u`, no Gauss-point state.
-    Elastic,
-    /// Materials with history whose tangent is constant for a fixed step (linear
-    /// viscoelasticity), their state at the Gauss points: factorised once per step
-    /// size, affine step, a Gauss-point pass per evaluation.
-    Constant,
-    /// The same materials with their state in nodal fields ([`super::nodal`]): a
-    /// step of matrix-vector products.
-    Nodal,
-    /// A state-dependent tangent (damage, plasticity), followed as `iteration` says.
-    StateDependent(IterationMethod),
-}
-
-/// The time discretisation of the step.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Scheme {
-    /// Backward Euler with step `h` and damping `C = damp_m M + damp_k K`.
-    BackwardEuler {
-        /// Step size.
-        h: f64,
-        /// Mass-proportional damping `zeta + a_m` (1/s).
-        damp_m: f64,
-        /// Stiffness-proportional damping `a_k` (s).
-        damp_k: f64,
-    },
-    /// Static equilibrium at load steps of size `dt` (the material rates use it).
-    Static {
-        /// Load step size.
-        dt: f64,
-    },
-}
-
-/// Matrices and settings of an implicit scheme: built once, read by every step.
-pub(crate) struct Operators {
-    pub asm: Assembler,
-    /// Elastic stiffness on the shared pattern.
-    pub k: Vec<f64>,
-    pub mass: Mass,
-    pub gravity: Option<Vec<f64>>,
-    pub response: Response,
-    /// The tangent at rest for the current step size: the constant tangent of
-    /// `Response::Constant` and `Response::Nodal`, the base of the state-dependent
-    /// tangent of `Response::StateDependent` (empty for elastic models).
-    pub kt: Vec<f64>,
-    /// The nodal-field laws of `Response::Nodal`.
-    pub nodal: Option<NodalLaws>,
-    pub scheme: Scheme,
-    /// 1 on free dofs, 0 on constrained ones (sums over the free dofs without a
-    /// branch).
-    pub free_mask: Vec<f64>,
-    pub test: Convergence,
-    /// Every material is rate-independent ([`crate::material::Material::is_rate_independent`]).
-    pub rate_independent: bool,
-    /// Statics: the multiple of `M` added to the matrix (never to the residual) while
-    /// a body in contact has rigid motions no support holds
-    /// ([`super::statics::STATIC_SEAT`]).
-    pub seat: f64,
-}
-
-impl Operators {
-    /// Assembles `K`, `M` (statics: only for gravity), gravity, the constant tangent,
-    /// and decides the response of the model's materials.
-    pub fn new(model: &Model, scheme: Scheme) -> Self {
-        let a = &model.analysis;
-        let asm = Assembler::new(&model.mesh);
-        let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
-        let mass = asm.mass(&model.mesh, &model.materials, a.lumped_mass);
-        let gravity = gravity_force(model, &mass, &asm.pattern);
-        let response = if model.materials.iter().all(|m| m.is_linear_elastic()) {
-            Response::Elastic
-        } else if model.materials.iter().all(|m| m.has_constant_tangent()) {
-            match a.viscoelastic_state {
-                ViscoelasticState::Nodal => Response::Nodal,
-                ViscoelasticState::Points => Response::Constant,
-            }
-        } else {
-            Response::StateDependent(a.iteration)
-        };
-        let mut free_mask = vec![1.0; model.mesh.n_dofs()];
-        for c in &model.constraints {
-            free_mask[c.dof] = 0.0;
-        }
-        let mut ops = Operators {
-            asm,
-            k,
-            mass,
-            gravity,
-            response,
-            kt: Vec::new(),
-            nodal: None,
-            scheme,
-            free_mask,
-            rate_independent: model.materials.iter().all(|m| m.is_rate_independent()),
-            seat: 0.0,
-            test: Convergence {
-                tolerance: a.tolerance,
-                displacement_tolerance: a.displacement_tolerance,
-                max_iterations: a.max_iterations,
-                penetration_tolerance: a.contact_tolerance,
-                complementarity_tolerance: a.contact_tolerance,
-                refactor_rate: a.refactor_rate,
-            },
-        };
-        if response == Response::Nodal {
-            ops.nodal = NodalLaws::new(model, &ops.asm);
-            if ops.nodal.is_none() {
-                // A constant-tangent material without a nodal-field form: its state
-                // stays at the Gauss points.
-                ops.response = Response::Constant;
-            }
-        }
-        ops.update_constant_tangent(model);
-        if matches!(scheme, Scheme::Static { .. }) {
-            ops.seat = super::statics::seat(model, &ops.asm.pattern, &ops.k, &ops.mass);
-        }
-        ops
-    }
-
-    /// The step size (statics: the load step).
-    pub fn h(&self) -> f64 {
-        match self.scheme {
-            Scheme::BackwardEuler { h, .. } => h,
-            Scheme::Static { dt } => dt,
-        }
-    }
-
-    /// Sets the step size.
-    pub fn set_h(&mut self, model: &Model, h_new: f64) {
-        match &mut self.scheme {
-            Scheme::BackwardEuler { h, .. } => *h = h_new,
-            Scheme::Static { dt } => *dt = h_new,
-        }
-        self.update_constant_tangent(model);
-    }
-
-    /// The tangent at rest at the current step size, from fresh stores: the whole
-    /// tangent of constant-tangent materials (it does not depend on the state), and
-    /// for state-dependent ones the base their tangent is assembled on (every point
-    /// elastic; `Assembler::internal_force` adds what departs from it).
-    fn update_constant_tangent(&mut self, model: &Model) {
-        if self.response != Response::Elastic {
-            let stores = new_stores(&model.mesh, &model.materials);
-            let u0 = vec![0.0; model.mesh.n_dofs()];
-            self.kt = self.asm.tangent(
-                &model.mesh,
-                &model.materials,
-                model.plane,
-                &u0,
-                self.h(),
-                &stores,
-            );
-        }
-    }
-
-    /// `(c_m, c_k, c_t)` of `K_eff = c_m M + c_k K + c_t K_t`.
-    pub fn coefficients(&self) -> (f64, f64, f64) {
-        let c_t = if self.response == Response::Elastic {
-            0.0
-        } else {
-            1.0
-        };
-        match self.scheme {
-            Scheme::BackwardEuler { h, damp_m, damp_k } => {
-                let c_m = 1.0 / (h * h) + damp_m / h;
-                let c_k = if c_t == 0.0 {
-                    1.0 + damp_k / h
-                } else {
-                    damp_k / h
-                };
-                (c_m, c_k, c_t)
-            }
-            Scheme::Static { .. } => (self.seat, 1.0 - c_t, c_t),
-        }
-    }
-
-    /// Refills the effective matrix with the tangent `kt` (ignored for elastic
-    /// models).
-    pub fn refill(&self, sys: &mut EffectiveSystem, kt: &[f64]) {
-        let (c_m, c_k, c_t) = self.coefficients();
-        if c_t == 0.0 {
-            sys.refill(c_m, &self.mass, &[(c_k, &self.k)]);
-        } else if c_k == 0.0 {
-            sys.refill(c_m, &self.mass, &[(c_t, kt)]);
-        } else {
-            sys.refill(c_m, &self.mass, &[(c_k, &self.k), (c_t, kt)]);
-        }
-    }
-
-    /// Refills the effective matrix with the tangent `kt` and refactorises it.
-    pub fn refactor(&self, sys: &mut EffectiveSystem, kt: &[f64]) -> Result<Factored> {
-        self.refill(sys, kt);
-        sys.factorize()
-    }
-
-    /// The initial effective matrix: the elastic or constant one, or for
-    /// state-dependent materials the tangent at rest.
-    pub fn initial_system(
-        &self,
-        model: &Model,
-        backend: Backend,
-        memory_limit: Option<u64>,
-    ) -> Result<(EffectiveSystem, Factored, Option<Vec<f64>>)> {
-        let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-        let mut sys = EffectiveSystem::new(
-            &self.asm.pattern,
-            dofs,
-            backend,
-            model.analysis.ordering,
-            &model.mesh.coords,
-        )?;
-        // The analysis knows the factor's size: refuse before it is allocated.
-        crate::config::memory_estimate(model, sys.factor_nnz())
-            .check(memory_limit, "the factorisation")?;
-        let factored = match self.response {
-            Response::StateDependent(_) => {
-                let f = self.refactor(&mut sys, &self.kt)?;
-                return Ok((sys, f, Some(self.kt.clone())));
-            }
-            _ => self.refactor(&mut sys, &self.kt)?,
-        };
-        Ok((sys, factored, None))
-    }
-
-    /// Whether the scheme has inertia (backward Euler) or not (statics).
-    fn dynamic(&self) -> Option<(f64, f64, f64)> {
-        match self.scheme {
-            Scheme::BackwardEuler { h, damp_m, damp_k } => Some((h, damp_m, damp_k)),
-            Scheme::Static { .. } => None,
-        }
-    }
-
-    fn internal(
-        &self,
-        model: &Model,
-        pass: PointPass,
-        points: &mut [crate::material::store::StateStore],
-        f: &mut [f64],
-        f_pred: Option<&mut [f64]>,
-        tangent: Option<&mut [f64]>,
-    ) -> PointTotals {
-        self.asm.internal_force(
-            &model.mesh,
-            &model.materials,
-            model.plane,
-            pass,
-            points,
-            f,
-            f_pred,
-            tangent,
-            matches!(self.response, Response::StateDependent(_)).then_some(&self.kt[..]),
-        )
-    }
-
-    /// The state at `t = 0`: prescribed displacements, the bodies' initial velocities
-    /// (statics: at rest), history materials at rest.
-    pub fn initial_state(&self, model: &Model) -> State {
-        let n = model.mesh.n_dofs();
-        let mut u = vec![0.0; n];
-        for c in &model.constraints {
-            u[c.dof] = c.at(0.0);
-        }
-        let v = match self.scheme {
-            Scheme::BackwardEuler { .. } => model.initial_velocity(),
-            Scheme::Static { .. } => vec![0.0; n],
-        };
-        let mut mv = vec![0.0; n];
-        self.mass.matvec(&self.asm.pattern, &v, &mut mv);
-        let mut f_ext = vec![0.0; n];
-        external_force(model, self.gravity.as_deref(), 0.0, &mut f_ext);
-        let mut f_int = vec![0.0; n];
-        let mut f_pred = if self.response == Response::Constant {
-            vec![0.0; n]
-        } else {
-            Vec::new()
-        };
-        let mut nodal = NodalState::default();
-        let (e_el0, points) = if self.response == Response::Elastic {
-            self.asm.pattern.matvec(&self.k, &u, &mut f_int);
-            (0.5 * super::dot(&u, &f_int), Vec::new())
-        } else if let Some(laws) = &self.nodal {
-            let (state, psi) = laws.initial(&self.asm.pattern, &self.k, &u, &mut f_int);
-            nodal = state;
-            (psi, Vec::new())
-        } else {
-            let mut points = new_stores(&model.mesh, &model.materials);
-            let pred = (!f_pred.is_empty()).then_some(&mut f_pred[..]);
-            let pass = PointPass {
-                u: &u,
-                dt: self.h(),
-                at_rest: true,
-                frozen: false,
-            };
-            let totals = self.internal(model, pass, &mut points, &mut f_int, pred, None);
-            points.iter_mut().for_each(|p| p.commit());
-            (totals.psi, points)
-        };
-        let e_kin0 = 0.5 * super::dot(&v, &mv);
-        let contact = crate::contact::ContactState::initial(model, &u);
-        State {
-            t: 0.0,
-            step: 0,
-            u,
-            v,
-            mv,
-            a: Vec::new(),
-            f_int,
-            f_ext,
-            ledger: Ledger::new(e_kin0, e_el0),
-            points,
-            f_pred,
-            f_pred_h: self.h(),
-            contact,
-            nodal,
-        }
-    }
-
-    /// The Gauss-point stores of `s` for output: built from the nodal fields on the
-    /// nodal path (see [`NodalLaws::materialise`]), `None` where `s.points` holds
-    /// them already.
-    pub fn output_points(&self, model: &Model, s: &State) -> Option<Vec<StateStore>> {
-        self.nodal
-            .as_ref()
-            .map(|laws| laws.materialise(model, &s.u, &s.nodal))
-    }
-}
 
 /// The vectors of the step being solved (reused from step to step).
 #[derive(Default)]
@@ -415,7 +87,7 @@ pub(crate) struct Scratch {
     /// The ledger sums of the last evaluation: the four work integrands (applied
     /// loads), kinetic energy, the scheme's loss, and for elastic models the stored
     /// energy and `½ Δu·K Δu`.
-    ledger_sums: [f64; 8],
+    ledger_sums: PassSums,
     nl: nonlinear::Scratch,
 }
 
@@ -457,7 +129,7 @@ impl Scratch {
             factor_valid: true,
             corrections: 0,
             totals: PointTotals::default(),
-            ledger_sums: [0.0; 8],
+            ledger_sums: PassSums::default(),
             nl: nonlinear::Scratch::new(n_free, ops.test.max_iterations),
         }
     }
@@ -677,13 +349,13 @@ impl StepProblem for ImplicitStep<'_> {
             halves::VECTOR_LEAF,
             &halves::split_slices,
             &leaf,
-            &halves::add,
+            &PassSums::merge,
         );
-        w.ledger_sums.copy_from_slice(&sums[3..]);
+        w.ledger_sums = sums;
         Evaluation {
-            force_scale2: sums[0],
-            magnitude2: sums[2],
-            increment2: sums[1],
+            force_scale2: sums.force_scale2,
+            magnitude2: sums.magnitude2,
+            increment2: sums.increment2,
             tangent,
             failure,
             provisional,
@@ -722,109 +394,6 @@ impl StepProblem for ImplicitStep<'_> {
         self.w.corrections += 1;
         nonlinear::add_on_free(free, delta, u, Some(&mut self.w.du))
     }
-}
-
-/// Coefficients of the residual pass.
-struct PassCoefficients {
-    inv_h: f64,
-    damp_m: f64,
-    damp_k: f64,
-}
-
-/// What the residual pass reads (whole vectors, or one chunk of each).
-#[derive(Clone, Copy)]
-struct PassInputs<'a> {
-    u: &'a [f64],
-    du: &'a [f64],
-    kdu: &'a [f64],
-    f_ext: &'a [f64],
-    mv_n: &'a [f64],
-    v_n: &'a [f64],
-    f_int_n: &'a [f64],
-    f_ext_n: &'a [f64],
-    /// 1 on free dofs, 0 on constrained ones.
-    free: &'a [f64],
-}
-
-impl<'a> PassInputs<'a> {
-    fn range(&self, lo: usize, hi: usize) -> PassInputs<'a> {
-        PassInputs {
-            u: &self.u[lo..hi],
-            du: &self.du[lo..hi],
-            kdu: &self.kdu[lo..hi],
-            f_ext: &self.f_ext[lo..hi],
-            mv_n: &self.mv_n[lo..hi],
-            v_n: &self.v_n[lo..hi],
-            f_int_n: &self.f_int_n[lo..hi],
-            f_ext_n: &self.f_ext_n[lo..hi],
-            free: &self.free[lo..hi],
-        }
-    }
-}
-
-/// What the residual pass writes (one piece of each vector).
-struct PassOutputs<'a> {
-    r: &'a mut [f64],
-    f_int: &'a mut [f64],
-    /// `M Δu` on entry, `M v` on exit (dynamic).
-    mv: &'a mut [f64],
-    v: &'a mut [f64],
-}
-
-/// The residual pass over one chunk of dofs, specialised for inertia (`DYN`) and
-/// for elastic models (`ELASTIC`, where `f_int = f_int,n + K Δu` is formed here).
-/// Returns `[Σ_free (f_ext² + f_int² + inertia²), Σ_free Δu², Σ magnitude², the
-/// four work integrands, E_kin, the scheme's loss, E_el, ½Δu·KΔu]`.
-#[inline]
-fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
-    inp: &PassInputs,
-    out: PassOutputs,
-    c: &PassCoefficients,
-) -> [f64; 11] {
-    let n = out.r.len();
-    let PassOutputs { r, f_int, mv, v } = out;
-    let (f_int, mv, v) = (&mut f_int[..n], &mut mv[..n], &mut v[..n]);
-    let (u, du, kdu, f_ext) = (&inp.u[..n], &inp.du[..n], &inp.kdu[..n], &inp.f_ext[..n]);
-    let (mv_n, v_n, f_int_n) = (&inp.mv_n[..n], &inp.v_n[..n], &inp.f_int_n[..n]);
-    let (f_ext_n, free) = (&inp.f_ext_n[..n], &inp.free[..n]);
-    let mut acc = [0.0f64; 11];
-    for i in 0..n {
-        if ELASTIC {
-            f_int[i] = f_int_n[i] + kdu[i];
-        }
-        let (inertia, damping, momenta) = if DYN {
-            mv[i] *= c.inv_h;
-            v[i] = du[i] * c.inv_h;
-            (
-                (mv[i] - mv_n[i]) * c.inv_h,
-                c.damp_m * mv[i] + c.damp_k * kdu[i] * c.inv_h,
-                (mv[i].abs() + mv_n[i].abs()) * c.inv_h,
-            )
-        } else {
-            (0.0, 0.0, 0.0)
-        };
-        let fi = f_int[i];
-        r[i] = inertia + damping + fi - f_ext[i];
-        acc[0] += free[i] * (f_ext[i] * f_ext[i] + fi * fi + inertia * inertia);
-        acc[1] += free[i] * du[i] * du[i];
-        // Over every dof: the reactions size the forces of a model whose free dofs
-        // carry no load.
-        let m = f_ext[i].abs() + fi.abs() + momenta + damping.abs();
-        acc[2] += m * m;
-        let work = work_integrands(du[i], f_int_n[i], fi, f_ext_n[i], f_ext[i], damping);
-        for k in 0..4 {
-            acc[3 + k] += work[k];
-        }
-        if DYN {
-            acc[7] += 0.5 * v[i] * mv[i];
-            acc[8] += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);
-        }
-        if ELASTIC {
-            acc[9] += 0.5 * u[i] * fi;
-            acc[10] += 0.5 * du[i] * kdu[i];
-        }
-    }
-    acc
 }
 
 /// How an implicit step corrects its iterates: one solve, or the contact QP.
@@ -1048,15 +617,15 @@ fn finish(
         let reaction = w.r[d];
         w.f_ext_np1[d] += reaction;
         // External work and load jump are linear in f_ext,n+1.
-        sums[1] += w.du[d] * reaction;
-        sums[2] += w.du[d] * reaction;
+        sums.work[1] += w.du[d] * reaction;
+        sums.work[2] += w.du[d] * reaction;
     }
-    let work = StepWork::from_sums([sums[0], sums[1], sums[2], sums[3]]);
+    let work = StepWork::from_sums(sums.work);
     let (elastic_energy, material) = if ops.response == Response::Elastic {
         (
-            sums[6],
+            sums.elastic,
             Dissipation {
-                numerical: sums[7],
+                numerical: sums.elastic_loss,
                 ..Default::default()
             },
         )
@@ -1064,11 +633,11 @@ fn finish(
         (w.totals.psi, w.totals.dissipation)
     };
     s.ledger.record(&StepIncrements {
-        kinetic: sums[4],
+        kinetic: sums.kinetic,
         elastic: elastic_energy,
         work,
         material,
-        scheme_loss: sums[5],
+        scheme_loss: sums.scheme_loss,
         contact,
         friction,
     });

@@ -16,6 +16,8 @@ pub mod forces;
 mod implicit;
 pub mod march;
 pub mod nodal;
+mod operators;
+mod residual;
 pub use implicit::first_matrices;
 pub mod statics;
 

@@ -4,7 +4,8 @@
 //! load steps (rates use `dt`), so a static run is quasi-static: linear elasticity
 //! takes one solve per step, damage and plasticity iterate.
 
-use super::implicit::{Core, Scheme};
+use super::implicit::Core;
+use super::operators::Scheme;
 use super::{Integrator, SolverFacts, State, StepOutcome, Timing};
 use crate::error::{Error, Result};
 use crate::linsolve::Backend;

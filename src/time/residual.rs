@@ -1,0 +1,161 @@
+//! The fused residual pass of an implicit step: one sweep over the dofs that forms
+//! the residual, finishes `M v`, `v` and (elastic models) `f_int = f_int,n + K Δu`,
+//! and sums the scales of the convergence test and the step's ledger terms, by name
+//! ([`PassSums`]). Split in chunks by `crate::halves`, so the sums are the same in
+//! every run.
+
+use crate::energy::work_integrands;
+
+/// Coefficients of the residual pass.
+pub(crate) struct PassCoefficients {
+    /// `1/h`.
+    pub inv_h: f64,
+    /// Mass-proportional damping.
+    pub damp_m: f64,
+    /// Stiffness-proportional damping.
+    pub damp_k: f64,
+}
+
+/// What the residual pass reads (whole vectors, or one chunk of each).
+#[derive(Clone, Copy)]
+pub(crate) struct PassInputs<'a> {
+    /// Displacements of the iterate.
+    pub u: &'a [f64],
+    /// Its increment over the step.
+    pub du: &'a [f64],
+    /// `K Δu`.
+    pub kdu: &'a [f64],
+    /// The applied loads at the new time.
+    pub f_ext: &'a [f64],
+    /// `M v` at the step's start.
+    pub mv_n: &'a [f64],
+    /// `v` at the step's start.
+    pub v_n: &'a [f64],
+    /// The internal force at the step's start.
+    pub f_int_n: &'a [f64],
+    /// The applied loads at the step's start.
+    pub f_ext_n: &'a [f64],
+    /// 1 on free dofs, 0 on constrained ones.
+    pub free: &'a [f64],
+}
+
+impl<'a> PassInputs<'a> {
+    /// The same inputs restricted to the dofs `lo..hi`.
+    pub fn range(&self, lo: usize, hi: usize) -> PassInputs<'a> {
+        PassInputs {
+            u: &self.u[lo..hi],
+            du: &self.du[lo..hi],
+            kdu: &self.kdu[lo..hi],
+            f_ext: &self.f_ext[lo..hi],
+            mv_n: &self.mv_n[lo..hi],
+            v_n: &self.v_n[lo..hi],
+            f_int_n: &self.f_int_n[lo..hi],
+            f_ext_n: &self.f_ext_n[lo..hi],
+            free: &self.free[lo..hi],
+        }
+    }
+}
+
+/// What the residual pass writes (one piece of each vector).
+pub(crate) struct PassOutputs<'a> {
+    /// The residual.
+    pub r: &'a mut [f64],
+    /// The internal force (written for elastic models, read otherwise).
+    pub f_int: &'a mut [f64],
+    /// `M Δu` on entry, `M v` on exit (dynamic).
+    pub mv: &'a mut [f64],
+    /// The new velocity (dynamic).
+    pub v: &'a mut [f64],
+}
+
+/// The sums of one residual pass, by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct PassSums {
+    /// `Σ_free (f_ext² + f_int² + inertia²)`: the scale of the residual test.
+    pub force_scale2: f64,
+    /// `Σ_free Δu²`.
+    pub increment2: f64,
+    /// `Σ (|f_ext| + |f_int| + |momenta| + |damping|)²` over every dof.
+    pub magnitude2: f64,
+    /// The four work integrands of `energy::work_integrands`.
+    pub work: [f64; 4],
+    /// `½ v·M v` at the new time (dynamic).
+    pub kinetic: f64,
+    /// `½ Δv·M Δv`, the scheme's loss (dynamic).
+    pub scheme_loss: f64,
+    /// `½ u·f_int` (elastic models).
+    pub elastic: f64,
+    /// `½ Δu·K Δu`, the elastic models' numerical loss.
+    pub elastic_loss: f64,
+}
+
+impl PassSums {
+    /// The sums of two pieces, field by field.
+    pub fn merge(a: PassSums, b: PassSums) -> PassSums {
+        PassSums {
+            force_scale2: a.force_scale2 + b.force_scale2,
+            increment2: a.increment2 + b.increment2,
+            magnitude2: a.magnitude2 + b.magnitude2,
+            work: std::array::from_fn(|k| a.work[k] + b.work[k]),
+            kinetic: a.kinetic + b.kinetic,
+            scheme_loss: a.scheme_loss + b.scheme_loss,
+            elastic: a.elastic + b.elastic,
+            elastic_loss: a.elastic_loss + b.elastic_loss,
+        }
+    }
+}
+
+/// The residual pass over one chunk of dofs, specialised for inertia (`DYN`) and
+/// for elastic models (`ELASTIC`, where `f_int = f_int,n + K Δu` is formed here).
+/// Returns the chunk's [`PassSums`].
+#[inline]
+pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
+    inp: &PassInputs,
+    out: PassOutputs,
+    c: &PassCoefficients,
+) -> PassSums {
+    let n = out.r.len();
+    let PassOutputs { r, f_int, mv, v } = out;
+    let (f_int, mv, v) = (&mut f_int[..n], &mut mv[..n], &mut v[..n]);
+    let (u, du, kdu, f_ext) = (&inp.u[..n], &inp.du[..n], &inp.kdu[..n], &inp.f_ext[..n]);
+    let (mv_n, v_n, f_int_n) = (&inp.mv_n[..n], &inp.v_n[..n], &inp.f_int_n[..n]);
+    let (f_ext_n, free) = (&inp.f_ext_n[..n], &inp.free[..n]);
+    let mut acc = PassSums::default();
+    for i in 0..n {
+        if ELASTIC {
+            f_int[i] = f_int_n[i] + kdu[i];
+        }
+        let (inertia, damping, momenta) = if DYN {
+            mv[i] *= c.inv_h;
+            v[i] = du[i] * c.inv_h;
+            (
+                (mv[i] - mv_n[i]) * c.inv_h,
+                c.damp_m * mv[i] + c.damp_k * kdu[i] * c.inv_h,
+                (mv[i].abs() + mv_n[i].abs()) * c.inv_h,
+            )
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        let fi = f_int[i];
+        r[i] = inertia + damping + fi - f_ext[i];
+        acc.force_scale2 += free[i] * (f_ext[i] * f_ext[i] + fi * fi + inertia * inertia);
+        acc.increment2 += free[i] * du[i] * du[i];
+        // Over every dof: the reactions size the forces of a model whose free dofs
+        // carry no load.
+        let m = f_ext[i].abs() + fi.abs() + momenta + damping.abs();
+        acc.magnitude2 += m * m;
+        let work = work_integrands(du[i], f_int_n[i], fi, f_ext_n[i], f_ext[i], damping);
+        for k in 0..4 {
+            acc.work[k] += work[k];
+        }
+        if DYN {
+            acc.kinetic += 0.5 * v[i] * mv[i];
+            acc.scheme_loss += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);
+        }
+        if ELASTIC {
+            acc.elastic += 0.5 * u[i] * fi;
+            acc.elastic_loss += 0.5 * du[i] * kdu[i];
+        }
+    }
+    acc
+}
