@@ -395,7 +395,7 @@ fn a_frictional_run_reports_friction_in_every_output() {
 fn a_solid_runs_end_to_end_and_what_it_cannot_hold_is_refused() {
     // examples/solid/cantilever.toml for 40 steps: hexahedra in the VTK files with
     // six stress components, the ledger closing to round-off (a linear model, so
-    // the balance is exact); then the same box with a standard linear solid, a thickness,
+    // the balance is exact); then the same box with Rankine-Hill plasticity (plane stress only), a thickness,
     // and a z support on a plane body are refused, each naming its field.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
@@ -424,7 +424,7 @@ fn a_solid_runs_end_to_end_and_what_it_cannot_hold_is_refused() {
     for (from, to, field) in [
         (
             "model = \"elastic\"",
-            "model = \"sls\"\nalpha = 0.5\nbeta = 1.0e-3",
+            "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }",
             "materials.steel.model",
         ),
         (
