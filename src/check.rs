@@ -21,8 +21,9 @@ pub const HUGE_OUTPUT: u64 = 20_000_000_000;
 /// What `rothe check` reports.
 #[derive(Clone, Debug)]
 pub struct Report {
-    /// Body lines: name, elements, thickness, velocity.
-    pub bodies: Vec<(String, usize, f64, [f64; 2])>,
+    /// Body lines: name, elements, thickness (none for a solid), velocity (two
+    /// components in the plane, three in a solid).
+    pub bodies: Vec<(String, usize, Option<f64>, Vec<f64>)>,
     /// Nodes.
     pub nodes: usize,
     /// Elements.
@@ -180,7 +181,12 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
                     .filter(|bl| bl.body == i)
                     .map(|bl| bl.elements.len())
                     .sum();
-                (b.name.clone(), els, b.thickness, b.velocity)
+                (
+                    b.name.clone(),
+                    els,
+                    (mesh.dim == 2).then_some(b.thickness),
+                    b.velocity[..mesh.dim].to_vec(),
+                )
             })
             .collect(),
         nodes: mesh.n_nodes(),
@@ -245,10 +251,13 @@ impl fmt::Display for Report {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         writeln!(f, "bodies      {}", self.bodies.len())?;
         for (name, els, t, v) in &self.bodies {
-            writeln!(
-                f,
-                "  {name:<12} {els} elements, thickness {t} m, velocity {v:?} m/s"
-            )?;
+            match t {
+                Some(t) => writeln!(
+                    f,
+                    "  {name:<12} {els} elements, thickness {t} m, velocity {v:?} m/s"
+                )?,
+                None => writeln!(f, "  {name:<12} {els} elements (solid), velocity {v:?} m/s")?,
+            }
         }
         writeln!(f, "materials   {}", self.materials.len())?;
         for lines in &self.materials {

@@ -132,8 +132,8 @@ pub struct Probe {
 pub struct Body {
     /// Name (prefix of its sets).
     pub name: String,
-    /// Initial velocity of all its nodes.
-    pub velocity: [f64; 2],
+    /// Initial velocity of all its nodes (`z = 0` in the plane).
+    pub velocity: [f64; 3],
     /// Thickness of its continuum elements.
     pub thickness: f64,
 }
@@ -285,7 +285,7 @@ pub struct Model {
     /// Loads.
     pub loads: Vec<Load>,
     /// Gravity acceleration, applied as `M g` (constant in time).
-    pub gravity: Option<[f64; 2]>,
+    pub gravity: Option<[f64; 3]>,
     /// Output probes.
     pub probes: Vec<Probe>,
     /// Contact pairs and unilateral supports.
@@ -391,8 +391,9 @@ impl Model {
         let mut v = vec![0.0; self.mesh.n_dofs()];
         let d = self.mesh.dim;
         for (n, &b) in self.mesh.node_body.iter().enumerate() {
-            v[d * n] = self.bodies[b].velocity[0];
-            v[d * n + 1] = self.bodies[b].velocity[1];
+            for i in 0..d {
+                v[d * n + i] = self.bodies[b].velocity[i];
+            }
         }
         for c in &self.constraints {
             v[c.dof] = 0.0;

@@ -445,4 +445,22 @@ fn a_solid_runs_end_to_end_and_what_it_cannot_hold_is_refused() {
     std::fs::write(&sc, plane).unwrap();
     let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
     assert!(!ok && err.contains("supports[0].fix"), "{err}");
+    // A z velocity or gravity in a plane model.
+    let plane = std::fs::read_to_string("tests/regression/elastic_cantilever.toml").unwrap();
+    for (from, to, field) in [
+        (
+            "thickness = 0.2",
+            "thickness = 0.2\nvelocity = [0.0, 0.0, 1.0]",
+            "bodies[0].velocity",
+        ),
+        (
+            "dt = 2.0e-5",
+            "dt = 2.0e-5\ngravity = [0.0, -9.81, 1.0]",
+            "analysis.gravity",
+        ),
+    ] {
+        std::fs::write(&sc, plane.replace(from, to)).unwrap();
+        let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+        assert!(!ok && err.contains(field), "{field}: {err}");
+    }
 }

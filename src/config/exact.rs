@@ -31,6 +31,14 @@ where
     }
 }
 
+/// Reads an optional [`vector`] (with `#[serde(default)]`).
+pub fn option_vector<'de, D>(d: D) -> Result<Option<[f64; 3]>, D::Error>
+where
+    D: Deserializer<'de>,
+{
+    vector(d).map(Some)
+}
+
 /// Reads an optional `[T; N]` (with `#[serde(default)]`).
 pub fn option_array<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
 where

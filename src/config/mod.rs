@@ -194,9 +194,10 @@ pub struct AnalysisSpec {
     #[serde(default)]
     #[serde(deserialize_with = "exact::array")]
     pub rayleigh: [f64; 2],
-    /// Gravity acceleration vector (m/s²), applied from `t = 0`. Default none.
-    #[serde(default, deserialize_with = "exact::option_array")]
-    pub gravity: Option<[f64; 2]>,
+    /// Gravity acceleration vector (m/s²; two components, three in a solid), applied
+    /// from `t = 0`. Default none.
+    #[serde(default, deserialize_with = "exact::option_vector")]
+    pub gravity: Option<[f64; 3]>,
     /// Write a VTK file every this many steps; 0 for none.
     #[serde(default = "default_vtk_every")]
     pub vtk_every: usize,
@@ -505,10 +506,10 @@ pub struct BodySpec {
     /// Thickness (m) of its elements: required for plane bodies, absent for solids.
     #[serde(default)]
     pub thickness: Option<f64>,
-    /// Initial velocity (m/s). Default at rest.
+    /// Initial velocity (m/s; two components, three in a solid). Default at rest.
     #[serde(default)]
-    #[serde(deserialize_with = "exact::array")]
-    pub velocity: [f64; 2],
+    #[serde(deserialize_with = "exact::vector")]
+    pub velocity: [f64; 3],
     /// Its mesh.
     pub mesh: MeshSpec,
 }
@@ -698,9 +699,9 @@ pub enum LoadSpec {
 pub struct ProbeSpec {
     /// Column prefix.
     pub name: String,
-    /// The node nearest this point.
-    #[serde(default, deserialize_with = "exact::option_array")]
-    pub at: Option<[f64; 2]>,
+    /// The node nearest this point (two coordinates, three in a solid).
+    #[serde(default, deserialize_with = "exact::option_vector")]
+    pub at: Option<[f64; 3]>,
     /// Or the single node of this set.
     #[serde(default)]
     pub set: Option<String>,

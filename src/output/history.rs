@@ -28,19 +28,22 @@ pub const LEDGER_COLUMNS: [&str; 13] = [
 pub struct History {
     path: PathBuf,
     out: BufWriter<File>,
+    /// The mesh's dimension (a solid's probes have a z column).
+    dim: usize,
 }
 
 impl History {
     /// Creates the file and writes the header (ledger columns, solver columns, then
-    /// `<probe>_ux, <probe>_uy` per probe, then `<pair>_force, <pair>_active`,
+    /// `<probe>_ux, <probe>_uy` (and `<probe>_uz` in a solid, `dim = 3`) per probe, then `<pair>_force, <pair>_active`,
     /// `<pair>_tangential_force, <pair>_stick, <pair>_slip` per contact pair: the
     /// normal force, the pressed nodes, the friction force and how many pressed
     /// nodes stick and slip).
-    pub fn create(path: &Path, probes: &[String], pairs: &[String]) -> Result<Self> {
+    pub fn create(path: &Path, probes: &[String], pairs: &[String], dim: usize) -> Result<Self> {
         let file = File::create(path).map_err(|e| Error::io(path, e))?;
         let mut h = History {
             path: path.into(),
             out: BufWriter::new(file),
+            dim,
         };
         let mut cols: Vec<String> = LEDGER_COLUMNS.iter().map(|s| s.to_string()).collect();
         cols.push("iterations".into());
@@ -48,6 +51,9 @@ impl History {
         for p in probes {
             cols.push(format!("{p}_ux"));
             cols.push(format!("{p}_uy"));
+            if dim == 3 {
+                cols.push(format!("{p}_uz"));
+            }
         }
         for p in pairs {
             cols.push(format!("{p}_force"));
@@ -68,7 +74,7 @@ impl History {
         l: &Ledger,
         iterations: usize,
         nl_residual: f64,
-        probes: &[[f64; 2]],
+        probes: &[[f64; 3]],
         pairs: &[crate::contact::PairRecord],
     ) -> Result<()> {
         let d = l.dissipated();
@@ -79,6 +85,9 @@ impl History {
         );
         for p in probes {
             line.push_str(&format!(",{:.12e},{:.12e}", p[0], p[1]));
+            if self.dim == 3 {
+                line.push_str(&format!(",{:.12e}", p[2]));
+            }
         }
         for p in pairs {
             line.push_str(&format!(

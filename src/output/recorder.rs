@@ -45,7 +45,7 @@ pub struct Recorder {
     vtk: Option<VtkSeries>,
     vtk_every: usize,
     probes: BTreeMap<String, ProbeSummary>,
-    samples: Vec<[f64; 2]>,
+    samples: Vec<[f64; 3]>,
     contact: BTreeMap<String, ContactSummary>,
     pair_names: Vec<String>,
     last_t: f64,
@@ -59,7 +59,12 @@ impl Recorder {
         std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
         let names: Vec<String> = model.probes.iter().map(|p| p.name.clone()).collect();
         let pair_names: Vec<String> = model.contacts.iter().map(|p| p.name.clone()).collect();
-        let history = History::create(&out.join("history.csv"), &names, &pair_names)?;
+        let history = History::create(
+            &out.join("history.csv"),
+            &names,
+            &pair_names,
+            model.mesh.dim,
+        )?;
         let vtk = if model.analysis.vtk_every > 0 {
             Some(VtkSeries::new(out, &model.mesh)?)
         } else {
@@ -101,7 +106,11 @@ impl Recorder {
         self.samples.clear();
         let d = model.mesh.dim;
         for p in &model.probes {
-            let x = [s.u[d * p.node], s.u[d * p.node + 1]];
+            let x = [
+                s.u[d * p.node],
+                s.u[d * p.node + 1],
+                if d == 3 { s.u[d * p.node + 2] } else { 0.0 },
+            ];
             if let Some(summary) = self.probes.get_mut(&p.name) {
                 summary.sample(x[1]);
             }

@@ -23,8 +23,7 @@ pub fn external_force(model: &Model, gravity: Option<&[f64]>, t: f64, f: &mut [f
 pub fn gravity_force(model: &Model, mass: &Mass, pattern: &Pattern) -> Option<Vec<f64>> {
     model.gravity.map(|g| {
         let dim = model.mesh.dim;
-        let g3 = [g[0], g[1], 0.0];
-        let field: Vec<f64> = (0..model.mesh.n_dofs()).map(|d| g3[d % dim]).collect();
+        let field: Vec<f64> = (0..model.mesh.n_dofs()).map(|d| g[d % dim]).collect();
         let mut f = vec![0.0; field.len()];
         mass.matvec(pattern, &field, &mut f);
         f

@@ -16,7 +16,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
         plane,
         bodies: vec![Body {
             name: "b".into(),
-            velocity: [0.0, 0.0],
+            velocity: [0.0; 3],
             thickness,
         }],
         constraints: Vec::new(),

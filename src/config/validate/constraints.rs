@@ -124,7 +124,7 @@ pub(super) fn constraints(s: &Scenario, mesh: &Mesh) -> Result<Vec<Constraint>> 
 }
 
 /// Refuses a z component in a plane model.
-fn plane_vector(mesh: &Mesh, field: &str, v: &[f64; 3]) -> Result<()> {
+pub(super) fn plane_vector(mesh: &Mesh, field: &str, v: &[f64; 3]) -> Result<()> {
     if mesh.dim == 2 && v[2] != 0.0 {
         return Err(Error::config(
             field,
@@ -242,18 +242,24 @@ pub(super) fn probes(s: &Scenario, mesh: &Mesh) -> Result<Vec<Probe>> {
         let node = match (&p.at, &p.set) {
             (Some(x), None) => {
                 finite(&format!("{field}.at"), x)?;
+                plane_vector(mesh, &format!("{field}.at"), x)?;
                 let n = mesh
-                    .nearest_node([x[0], x[1], 0.0])
+                    .nearest_node(*x)
                     .ok_or_else(|| Error::config(&field, "the mesh has no nodes"))?;
-                let c = mesh.coords[n];
-                let d = ((c[0] - x[0]).powi(2) + (c[1] - x[1]).powi(2)).sqrt();
+                let d = crate::mesh::distance(mesh.coords[n], *x);
                 let size = mesh.element_size_at(n);
                 if d > size {
+                    let at = if mesh.dim == 2 {
+                        format!("{:?}", [x[0], x[1]])
+                    } else {
+                        format!("{x:?}")
+                    };
                     return Err(Error::config(
                         format!("{field}.at"),
                         format!(
-                            "{x:?} is {d:.4e} m from the nearest node {n} at {c:?}, farther than \
-                             the size of its elements ({size:.4e} m): the point lies on no body"
+                            "{at} is {d:.4e} m from the nearest node {n} at {}, farther than \
+                             the size of its elements ({size:.4e} m): the point lies on no body",
+                            mesh.position(n)
                         ),
                     ));
                 }

@@ -131,6 +131,15 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             ));
         }
         let plane = if part.dim == 3 { Plane::Solid } else { a.plane };
+        if part.dim == 2 && b.velocity[2] != 0.0 {
+            return Err(Error::config(
+                format!("{field}.velocity"),
+                format!(
+                    "a plane body has no z component (got {:?}): give two",
+                    b.velocity
+                ),
+            ));
+        }
         products_are_finite(&field, thickness, &materials[mat], plane, &part)?;
         mesh.add_part(&part, bi, &b.name, mat, thickness);
         bodies.push(Body {
@@ -145,6 +154,9 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let dim = mesh.dim;
     if dim == 3 {
         solid_scope(s, &mesh, &materials)?;
+    }
+    if let Some(g) = &a.gravity {
+        constraints::plane_vector(&mesh, "analysis.gravity", g)?;
     }
     materials::check_crack_band(&mesh, &materials)?;
     meshes::check_memory(&mesh, &materials, opts)?;
