@@ -15,24 +15,40 @@ where
     exactly(v)
 }
 
-/// Reads a vector of two (a plane model's, `z = 0`) or three components into
-/// `[x, y, z]`; any other length is an error naming it.
-pub fn vector<'de, D>(d: D) -> Result<[f64; 3], D::Error>
+/// A vector as a scenario gives it: two components (a plane model's, `z = 0`) or
+/// three (a solid's); validation checks the count against the model's dimension.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Vector {
+    /// `[x, y, z]`.
+    pub xyz: [f64; 3],
+    /// How many components the scenario gave (0: not given, the default).
+    pub len: usize,
+}
+
+/// Reads a [`Vector`] of two or three components; any other length is an error
+/// naming it.
+pub fn vector<'de, D>(d: D) -> Result<Vector, D::Error>
 where
     D: Deserializer<'de>,
 {
     let v = Vec::<f64>::deserialize(d)?;
     match v.len() {
-        2 => Ok([v[0], v[1], 0.0]),
-        3 => Ok([v[0], v[1], v[2]]),
+        2 => Ok(Vector {
+            xyz: [v[0], v[1], 0.0],
+            len: 2,
+        }),
+        3 => Ok(Vector {
+            xyz: [v[0], v[1], v[2]],
+            len: 3,
+        }),
         n => Err(D::Error::custom(format!(
-            "expected a vector of 2 (plane) or 3 (solid) components, found {n}"
+            "has {n} entries, expected 2 (a plane model) or 3 (a solid)"
         ))),
     }
 }
 
 /// Reads an optional [`vector`] (with `#[serde(default)]`).
-pub fn option_vector<'de, D>(d: D) -> Result<Option<[f64; 3]>, D::Error>
+pub fn option_vector<'de, D>(d: D) -> Result<Option<Vector>, D::Error>
 where
     D: Deserializer<'de>,
 {

@@ -4,7 +4,7 @@
 //!
 //! Start with [`load`]; the format is documented in the README and `examples/`.
 
-mod exact;
+pub mod exact;
 mod location;
 pub mod overrides;
 mod validate;
@@ -197,7 +197,7 @@ pub struct AnalysisSpec {
     /// Gravity acceleration vector (m/s²; two components, three in a solid), applied
     /// from `t = 0`. Default none.
     #[serde(default, deserialize_with = "exact::option_vector")]
-    pub gravity: Option<[f64; 3]>,
+    pub gravity: Option<exact::Vector>,
     /// Write a VTK file every this many steps; 0 for none.
     #[serde(default = "default_vtk_every")]
     pub vtk_every: usize,
@@ -509,7 +509,7 @@ pub struct BodySpec {
     /// Initial velocity (m/s; two components, three in a solid). Default at rest.
     #[serde(default)]
     #[serde(deserialize_with = "exact::vector")]
-    pub velocity: [f64; 3],
+    pub velocity: exact::Vector,
     /// Its mesh.
     pub mesh: MeshSpec,
 }
@@ -675,7 +675,7 @@ pub enum LoadSpec {
         set: String,
         /// Traction vector (two components, or three in a solid).
         #[serde(deserialize_with = "exact::vector")]
-        value: [f64; 3],
+        value: exact::Vector,
         /// Time function (default constant).
         #[serde(default = "constant")]
         function: TimeFunction,
@@ -686,7 +686,7 @@ pub enum LoadSpec {
         set: String,
         /// Force vector per node (two components, or three in a solid).
         #[serde(deserialize_with = "exact::vector")]
-        value: [f64; 3],
+        value: exact::Vector,
         /// Time function (default constant).
         #[serde(default = "constant")]
         function: TimeFunction,
@@ -701,7 +701,7 @@ pub struct ProbeSpec {
     pub name: String,
     /// The node nearest this point (two coordinates, three in a solid).
     #[serde(default, deserialize_with = "exact::option_vector")]
-    pub at: Option<[f64; 3]>,
+    pub at: Option<exact::Vector>,
     /// Or the single node of this set.
     #[serde(default)]
     pub set: Option<String>,

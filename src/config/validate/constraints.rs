@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use super::checks::{check_function, finite};
 use crate::assembly::loads;
+use crate::config::exact::Vector;
 use crate::config::{LoadSpec, Scenario};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -123,15 +124,18 @@ pub(super) fn constraints(s: &Scenario, mesh: &Mesh) -> Result<Vec<Constraint>> 
     Ok(by_dof.into_values().map(|c| c.constraint).collect())
 }
 
-/// Refuses a z component in a plane model.
-pub(super) fn plane_vector(mesh: &Mesh, field: &str, v: &[f64; 3]) -> Result<()> {
-    if mesh.dim == 2 && v[2] != 0.0 {
+/// Checks that a vector has as many components as the model has dimensions (two in
+/// the plane, three in a solid), and that they are finite; returns `[x, y, z]`.
+pub(super) fn dimensioned(dim: usize, field: &str, v: &Vector) -> Result<[f64; 3]> {
+    finite(field, &v.xyz)?;
+    if v.len != 0 && v.len != dim {
+        let what = if dim == 2 { "a plane model" } else { "a solid" };
         return Err(Error::config(
             field,
-            format!("a plane model has no z component (got {v:?}): give two"),
+            format!("has {} entries, expected {dim} ({what})", v.len),
         ));
     }
-    Ok(())
+    Ok(v.xyz)
 }
 
 /// The non-empty named set `set` of `sets` (`what`: "edge" or "face"), or an error
@@ -170,11 +174,10 @@ pub(super) fn loads(s: &Scenario, mesh: &Mesh, bodies: &[Body]) -> Result<Vec<Lo
                 value,
                 function,
             } => {
-                finite(&format!("{field}.value"), value)?;
-                plane_vector(mesh, &format!("{field}.value"), value)?;
+                let value = dimensioned(mesh.dim, &format!("{field}.value"), value)?;
                 if mesh.dim == 3 {
                     let faces = named_set(&field, "face", &mesh.face_sets, set)?;
-                    loads::add_face_traction(mesh, faces, *value, &mut f);
+                    loads::add_face_traction(mesh, faces, value, &mut f);
                     (function, format!("traction on {set}"))
                 } else {
                     let edges = named_set(&field, "edge", &mesh.edge_sets, set)?;
@@ -194,12 +197,11 @@ pub(super) fn loads(s: &Scenario, mesh: &Mesh, bodies: &[Body]) -> Result<Vec<Lo
                 value,
                 function,
             } => {
-                finite(&format!("{field}.value"), value)?;
-                plane_vector(mesh, &format!("{field}.value"), value)?;
+                let value = dimensioned(mesh.dim, &format!("{field}.value"), value)?;
                 loads::add_nodal(
                     mesh.dim,
                     node_set(mesh, &format!("{field}.set"), set)?,
-                    *value,
+                    value,
                     &mut f,
                 );
                 (function, format!("nodal force on {set}"))
@@ -241,8 +243,7 @@ pub(super) fn probes(s: &Scenario, mesh: &Mesh) -> Result<Vec<Probe>> {
         }
         let node = match (&p.at, &p.set) {
             (Some(x), None) => {
-                finite(&format!("{field}.at"), x)?;
-                plane_vector(mesh, &format!("{field}.at"), x)?;
+                let x = &dimensioned(mesh.dim, &format!("{field}.at"), x)?;
                 let n = mesh
                     .nearest_node(*x)
                     .ok_or_else(|| Error::config(&field, "the mesh has no nodes"))?;

@@ -85,7 +85,6 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         if let Some(t) = b.thickness {
             positive(&format!("{field}.thickness"), t)?;
         }
-        finite(&format!("{field}.velocity"), &b.velocity)?;
         let mat = find_material(format!("{field}.material"), &b.material)?;
         let part =
             meshes::body_part(&format!("{field}.mesh"), &b.mesh, &s.meshing, dir).map_err(|e| {
@@ -131,20 +130,13 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             ));
         }
         let plane = if part.dim == 3 { Plane::Solid } else { a.plane };
-        if part.dim == 2 && b.velocity[2] != 0.0 {
-            return Err(Error::config(
-                format!("{field}.velocity"),
-                format!(
-                    "a plane body has no z component (got {:?}): give two",
-                    b.velocity
-                ),
-            ));
-        }
+        let velocity =
+            constraints::dimensioned(part.dim, &format!("{field}.velocity"), &b.velocity)?;
         products_are_finite(&field, thickness, &materials[mat], plane, &part)?;
         mesh.add_part(&part, bi, &b.name, mat, thickness);
         bodies.push(Body {
             name: b.name.clone(),
-            velocity: b.velocity,
+            velocity,
             thickness,
         });
     }
@@ -155,9 +147,10 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     if dim == 3 {
         solid_scope(s, &mesh, &materials)?;
     }
-    if let Some(g) = &a.gravity {
-        constraints::plane_vector(&mesh, "analysis.gravity", g)?;
-    }
+    let gravity = match &a.gravity {
+        Some(g) => Some(constraints::dimensioned(mesh.dim, "analysis.gravity", g)?),
+        None => None,
+    };
     materials::check_crack_band(&mesh, &materials)?;
     meshes::check_memory(&mesh, &materials, opts)?;
 
@@ -194,7 +187,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         bodies,
         constraints,
         loads,
-        gravity: a.gravity,
+        gravity,
         probes,
         contacts,
         analysis: Analysis {
@@ -545,9 +538,7 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
     for (i, c) in a.rayleigh.iter().enumerate() {
         checks::non_negative(&format!("analysis.rayleigh[{i}]"), *c)?;
     }
-    if let Some(g) = a.gravity {
-        finite("analysis.gravity", &g)?;
-    }
+
     Ok(())
 }
 
