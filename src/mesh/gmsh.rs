@@ -46,96 +46,53 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
         return parse_solid(&msh);
     }
     let (coords, node_tags, tag_to_index) = nodes(&msh, false)?;
-    let index = |tag: u64, element: u64| -> std::result::Result<usize, String> {
-        tag_to_index.get(&tag).copied().ok_or_else(|| {
-            format!("element with Gmsh tag {element} refers to node tag {tag}, which no node block defines")
-        })
-    };
     let set_names = group_names(&msh)?;
-    let set_name = |dim: i32, tag: i32| -> String {
-        set_names
-            .get(&(dim, tag))
-            .cloned()
-            .unwrap_or_else(|| format!("physical_{dim}_{tag}"))
-    };
-
     let (mut quads, mut quad_tags) = (Vec::new(), Vec::new());
     let (mut tris, mut tri_tags) = (Vec::new(), Vec::new());
-    let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut edge_sets: BTreeMap<String, Vec<[usize; 2]>> = BTreeMap::new();
-    let mut element_tags: HashMap<u64, ()> = HashMap::new();
     let mut surface_elements: HashMap<Vec<usize>, u64> = HashMap::new();
-    let mut ns = Vec::new();
-    for block in &msh.element_blocks {
-        let dim = block.entity_dim;
-        let groups = msh
-            .entity_groups
-            .get(&(dim, block.entity_tag))
-            .cloned()
-            .unwrap_or_default();
-        let per = block.nodes_per_element;
-        for (e, &tag) in block.tags.iter().enumerate() {
-            if element_tags.insert(tag, ()).is_some() {
-                return Err(format!("element tag {tag} is used by two elements"));
-            }
-            ns.clear();
-            for &t in &block.nodes[e * per..(e + 1) * per] {
-                ns.push(index(t, tag)?);
-            }
-            match block.element_type {
-                3 | 2 => {
-                    let mut key = ns.clone();
-                    key.sort_unstable();
-                    if let Some(first) = surface_elements.insert(key, tag) {
-                        return Err(format!(
-                            "elements with Gmsh tags {first} and {tag} have the same nodes \
-                             (an element listed twice)"
-                        ));
-                    }
-                    let (list, tags) = if per == 4 {
-                        (&mut quads, &mut quad_tags)
-                    } else {
-                        (&mut tris, &mut tri_tags)
-                    };
-                    if signed_area(&coords, &ns) < 0.0 {
-                        ns[1..].reverse();
-                    }
-                    list.extend_from_slice(&ns);
-                    tags.push(tag);
-                }
-                1 => {
-                    for &g in &groups {
-                        edge_sets
-                            .entry(set_name(1, g))
-                            .or_default()
-                            .push([ns[0], ns[1]]);
-                    }
-                }
-                15 => {}
-                other => {
+    let node_sets = walk_elements(&msh, &tag_to_index, &set_names, |el| {
+        let (tag, ns) = (el.tag, &mut *el.nodes);
+        match el.element_type {
+            3 | 2 => {
+                let mut key = ns.clone();
+                key.sort_unstable();
+                if let Some(first) = surface_elements.insert(key, tag) {
                     return Err(format!(
-                        "element with Gmsh tag {tag} has type {other} ({}), which a 2D \
-                         model does not take (use 3-node triangles, 4-node quadrilaterals \
-                         and 2-node lines)",
-                        type_name(other)
-                    ))
+                        "elements with Gmsh tags {first} and {tag} have the same nodes \
+                         (an element listed twice)"
+                    ));
+                }
+                let (list, tags) = if ns.len() == 4 {
+                    (&mut quads, &mut quad_tags)
+                } else {
+                    (&mut tris, &mut tri_tags)
+                };
+                if signed_area(&coords, ns) < 0.0 {
+                    ns[1..].reverse();
+                }
+                list.extend_from_slice(ns);
+                tags.push(tag);
+            }
+            1 => {
+                for g in el.groups {
+                    edge_sets.entry(g.clone()).or_default().push([ns[0], ns[1]]);
                 }
             }
-            for &g in &groups {
-                node_sets
-                    .entry(set_name(dim, g))
-                    .or_default()
-                    .extend_from_slice(&ns);
+            15 => {}
+            other => {
+                return Err(format!(
+                    "element with Gmsh tag {tag} has type {other} ({}), which a 2D \
+                     model does not take (use 3-node triangles, 4-node quadrilaterals \
+                     and 2-node lines)",
+                    type_name(other)
+                ))
             }
         }
-    }
-    for nodes in node_sets.values_mut() {
-        nodes.sort_unstable();
-        nodes.dedup();
-    }
-    // A named group without elements is an empty set, not an unknown one.
+        Ok(())
+    })?;
+    // A named group of lines without elements is an empty edge set.
     for (dim, _, name) in &msh.physical_names {
-        node_sets.entry(name.clone()).or_default();
         if *dim == 1 {
             edge_sets.entry(name.clone()).or_default();
         }
@@ -172,85 +129,70 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     })
 }
 
-/// A file with volume elements: a solid part of 4-node tetrahedra and 8-node
-/// hexahedra (each renumbered to positive volume if the file lists it the other way
-/// round), its 3- and 4-node surface elements as face sets of their physical groups
-/// (oriented outwards from the volume element they bound), and every physical
-/// group's nodes as a node set. Other element types are refused by name.
-fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
-    let (coords, node_tags, tag_to_index) = nodes(msh, true)?;
-    let index = |tag: u64, element: u64| -> std::result::Result<usize, String> {
-        tag_to_index.get(&tag).copied().ok_or_else(|| {
-            format!("element with Gmsh tag {element} refers to node tag {tag}, which no node block defines")
-        })
-    };
-    let set_names = group_names(msh)?;
-    let set_name = |dim: i32, tag: i32| -> String {
-        set_names
-            .get(&(dim, tag))
-            .cloned()
-            .unwrap_or_else(|| format!("physical_{dim}_{tag}"))
-    };
-    let mut volumes: [(Vec<usize>, Vec<u64>); 2] = Default::default();
-    let mut faces: Vec<(String, [usize; 4])> = Vec::new();
+/// One element of the file as [`walk_elements`] hands it over.
+struct FileElement<'a> {
+    /// Gmsh element type.
+    element_type: i32,
+    /// Element tag.
+    tag: u64,
+    /// Node indices (the visitor may renumber them).
+    nodes: &'a mut Vec<usize>,
+    /// The set names of the element's physical groups.
+    groups: &'a [String],
+}
+
+/// Walks every element of the file: refuses a tag used twice or a node tag no block
+/// defines, maps the node tags to indices, hands the element to `visit`, and adds
+/// its nodes to the node set of each of its physical groups. Returns the node sets,
+/// sorted, with an empty set for every named group that has no element.
+fn walk_elements(
+    msh: &MshFile,
+    tag_to_index: &HashMap<u64, usize>,
+    set_names: &HashMap<(i32, i32), String>,
+    mut visit: impl FnMut(FileElement) -> std::result::Result<(), String>,
+) -> std::result::Result<BTreeMap<String, Vec<usize>>, String> {
     let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     let mut seen: HashMap<u64, ()> = HashMap::new();
+    let mut ns = Vec::new();
     for block in &msh.element_blocks {
         let dim = block.entity_dim;
-        let groups = msh
+        let groups: Vec<String> = msh
             .entity_groups
             .get(&(dim, block.entity_tag))
-            .cloned()
+            .map(|gs| {
+                gs.iter()
+                    .map(|&g| {
+                        set_names
+                            .get(&(dim, g))
+                            .cloned()
+                            .unwrap_or_else(|| format!("physical_{dim}_{g}"))
+                    })
+                    .collect()
+            })
             .unwrap_or_default();
         let per = block.nodes_per_element;
         for (e, &tag) in block.tags.iter().enumerate() {
             if seen.insert(tag, ()).is_some() {
                 return Err(format!("element tag {tag} is used by two elements"));
             }
-            let mut ns = Vec::with_capacity(per);
+            ns.clear();
             for &t in &block.nodes[e * per..(e + 1) * per] {
-                ns.push(index(t, tag)?);
+                ns.push(tag_to_index.get(&t).copied().ok_or_else(|| {
+                    format!(
+                        "element with Gmsh tag {tag} refers to node tag {t}, which no node \
+                         block defines"
+                    )
+                })?);
             }
-            match block.element_type {
-                4 | 5 => {
-                    let (kind, slot) = if per == 4 {
-                        (ElementKind::Tet4, 0)
-                    } else {
-                        (ElementKind::Hex8, 1)
-                    };
-                    let x: Vec<[f64; 3]> = ns.iter().map(|&n| coords[n]).collect();
-                    if crate::fe::element::measure(kind, &x) < 0.0 {
-                        // The mirror numbering: swap within each face's cycle.
-                        if per == 4 {
-                            ns.swap(1, 2);
-                        } else {
-                            ns.swap(1, 3);
-                            ns.swap(5, 7);
-                        }
-                    }
-                    volumes[slot].0.extend_from_slice(&ns);
-                    volumes[slot].1.push(tag);
-                }
-                2 | 3 => {
-                    let mut f = [usize::MAX; 4];
-                    f[..per].copy_from_slice(&ns);
-                    for &g in &groups {
-                        faces.push((set_name(2, g), f));
-                    }
-                }
-                1 | 15 => {}
-                other => {
-                    return Err(format!(
-                        "element with Gmsh tag {tag} has type {other} ({}), which a solid \
-                         model does not take (use 4-node tetrahedra, 8-node hexahedra, \
-                         3-node triangles and 4-node quadrilaterals)",
-                        type_name(other)
-                    ))
-                }
-            }
-            for &g in &groups {
+            visit(FileElement {
+                element_type: block.element_type,
+                tag,
+                nodes: &mut ns,
+                groups: &groups,
+            })?;
+            for g in &groups {
                 node_sets
-                    .entry(set_name(dim, g))
+                    .entry(g.clone())
                     .or_default()
                     .extend_from_slice(&ns);
             }
@@ -263,6 +205,60 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
     for (_, _, name) in &msh.physical_names {
         node_sets.entry(name.clone()).or_default();
     }
+    Ok(node_sets)
+}
+
+/// A file with volume elements: a solid part of 4-node tetrahedra and 8-node
+/// hexahedra (each renumbered to positive volume if the file lists it the other way
+/// round), its 3- and 4-node surface elements as face sets of their physical groups
+/// (oriented outwards from the volume element they bound), and every physical
+/// group's nodes as a node set. Other element types are refused by name.
+fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
+    let (coords, node_tags, tag_to_index) = nodes(msh, true)?;
+    let set_names = group_names(msh)?;
+    let mut volumes: [(Vec<usize>, Vec<u64>); 2] = Default::default();
+    let mut faces: Vec<(String, [usize; 4])> = Vec::new();
+    let node_sets = walk_elements(msh, &tag_to_index, &set_names, |el| {
+        let (tag, ns) = (el.tag, &mut *el.nodes);
+        match el.element_type {
+            4 | 5 => {
+                let (kind, slot) = if ns.len() == 4 {
+                    (ElementKind::Tet4, 0)
+                } else {
+                    (ElementKind::Hex8, 1)
+                };
+                let x: Vec<[f64; 3]> = ns.iter().map(|&n| coords[n]).collect();
+                if crate::fe::element::measure(kind, &x) < 0.0 {
+                    // The mirror numbering: swap within each face's cycle.
+                    if kind == ElementKind::Tet4 {
+                        ns.swap(1, 2);
+                    } else {
+                        ns.swap(1, 3);
+                        ns.swap(5, 7);
+                    }
+                }
+                volumes[slot].0.extend_from_slice(ns);
+                volumes[slot].1.push(tag);
+            }
+            2 | 3 => {
+                let mut f = [usize::MAX; 4];
+                f[..ns.len()].copy_from_slice(ns);
+                for g in el.groups {
+                    faces.push((g.clone(), f));
+                }
+            }
+            1 | 15 => {}
+            other => {
+                return Err(format!(
+                    "element with Gmsh tag {tag} has type {other} ({}), which a solid \
+                     model does not take (use 4-node tetrahedra, 8-node hexahedra, \
+                     3-node triangles and 4-node quadrilaterals)",
+                    type_name(other)
+                ))
+            }
+        }
+        Ok(())
+    })?;
     let mut blocks = Vec::new();
     for (kind, (conn, tags)) in [ElementKind::Tet4, ElementKind::Hex8]
         .into_iter()
