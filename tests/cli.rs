@@ -395,8 +395,9 @@ fn a_frictional_run_reports_friction_in_every_output() {
 fn a_solid_runs_end_to_end_and_what_it_cannot_hold_is_refused() {
     // examples/solid/cantilever.toml for 40 steps: hexahedra in the VTK files with
     // six stress components, the ledger closing to round-off (a linear model, so
-    // the balance is exact); then the same box with Rankine-Hill plasticity (plane stress only), a thickness,
-    // and a z support on a plane body are refused, each naming its field.
+    // the balance is exact); then the same box with nonlocal damage (its neighbour
+    // search is the plane's), a thickness, and a z support on a plane body are
+    // refused, each naming its field.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     let (ok, _, err) = rothe(&[
@@ -424,7 +425,7 @@ fn a_solid_runs_end_to_end_and_what_it_cannot_hold_is_refused() {
     for (from, to, field) in [
         (
             "model = \"elastic\"",
-            "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }",
+            "model = \"mazars\"\nidentify = { class = \"C30/37\" }\nnonlocal = { radius = 0.1 }",
             "materials.steel.model",
         ),
         (

@@ -596,10 +596,11 @@ fn the_ledger_closes_for_every_solid_material() {
     // Reference: the discrete energy identity of backward Euler (theory/energy.md)
     // holds for every model whatever the dimension: on the solid cantilever of
     // examples/solid (16 x 4 x 4 hexahedra, 40 steps of 1e-5 s under a step traction
-    // that cracks the clamped end of the Mazars beam) the balance closes to 1e-12 of
-    // the work for the linear models and to the iteration tolerance (1e-9) for
-    // Mazars, every dissipation line is non-negative, and the viscous models
-    // dissipate.
+    // that cracks the clamped end of the Mazars beam and yields the root of the
+    // Rankine-Hill one) the balance closes to 1e-12 of the work for the linear
+    // models and to the iteration tolerance (1e-9) for Mazars and Rankine-Hill,
+    // every dissipation line is non-negative, and the viscous, damage and plastic
+    // models dissipate.
     use rothe::time::backward_euler::BackwardEuler;
     use rothe::time::Integrator;
     let base = std::fs::read_to_string(
@@ -614,6 +615,11 @@ fn the_ledger_closes_for_every_solid_material() {
         ("model = \"maxwell\"\nbeta = 1.0e-3", 1e-12, true),
         (
             "model = \"mazars\"\nvariant = \"classic\"\nidentify = { class = \"C30/37\" }",
+            1e-9,
+            false,
+        ),
+        (
+            "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 10e6, post_yield_modulus = 20e9 }\ncompression = { law = \"bilinear\", strength = 40e6, post_yield_modulus = 20e9 }",
             1e-9,
             false,
         ),
@@ -634,6 +640,7 @@ fn the_ledger_closes_for_every_solid_material() {
         for (line, v) in [
             ("viscous", d.viscous),
             ("damage", d.damage),
+            ("plastic", d.plastic),
             ("numerical", d.numerical),
         ] {
             assert!(
@@ -646,6 +653,9 @@ fn the_ledger_closes_for_every_solid_material() {
         }
         if model_lines.contains("mazars") {
             assert!(d.damage > 0.0, "the Mazars beam cracks");
+        }
+        if model_lines.contains("rankine") {
+            assert!(d.plastic > 0.0, "the Rankine-Hill beam yields at its root");
         }
     }
 }

@@ -2,9 +2,9 @@
 //! the Gauss-point loop allocates nothing: a system of dimension `n ≤ MAX_DIM` lives
 //! in the leading `n x n` block of a [`Small`] matrix.
 
-/// Largest system these routines handle (the Rankine-Hill return: two principal
-/// stresses and up to three multipliers).
-pub const MAX_DIM: usize = 5;
+/// Largest system these routines handle (the Rankine-Hill return in a solid: three
+/// principal stresses and up to four multipliers).
+pub const MAX_DIM: usize = 7;
 
 /// A dense matrix whose leading `n x n` block is used.
 pub type Small = [[f64; MAX_DIM]; MAX_DIM];
@@ -66,9 +66,9 @@ mod tests {
     fn solves_and_inverts_a_pivoting_system() {
         // A system that needs a row swap (zero leading pivot).
         let mut a = [[0.0; MAX_DIM]; MAX_DIM];
-        a[0] = [0.0, 2.0, 1.0, 0.0, 0.0];
-        a[1] = [1.0, 1.0, 0.0, 0.0, 0.0];
-        a[2] = [3.0, 0.0, 4.0, 0.0, 0.0];
+        a[0][..3].copy_from_slice(&[0.0, 2.0, 1.0]);
+        a[1][..3].copy_from_slice(&[1.0, 1.0, 0.0]);
+        a[2][..3].copy_from_slice(&[3.0, 0.0, 4.0]);
         let x_true = [1.0, -2.0, 0.5];
         let mut b = [0.0; MAX_DIM];
         for i in 0..3 {

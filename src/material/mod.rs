@@ -9,6 +9,7 @@
 //! the plane idealisation chosen for the run.
 
 pub mod elastic;
+pub mod frame;
 pub mod hardening;
 pub mod identify;
 pub mod linalg;
@@ -112,7 +113,7 @@ pub enum Model {
     },
     /// Mazars damage `σ = (1 − D) C ε`.
     Mazars(MazarsParams),
-    /// Rankine-Hill plasticity (plane stress).
+    /// Rankine-Hill plasticity (plane stress, or a solid's principal stress space).
     RankineHill(RankineHillParams),
 }
 
@@ -128,8 +129,8 @@ impl<const V: usize> Default for StrainStep<V> {
 }
 
 /// The largest number of history values a model keeps per point (a solid's
-/// standard linear solid: six dashpot strains).
-pub const MAX_STATE: usize = 6;
+/// Rankine-Hill point: six plastic strains and two hardening variables).
+pub const MAX_STATE: usize = 8;
 
 /// A material: elastic constants, density and constitutive model.
 #[derive(Clone, Debug, PartialEq)]
@@ -329,11 +330,12 @@ impl Material {
             Model::Elastic | Model::KelvinVoigt(_) => 0,
             Model::Sls { .. } => voigt,
             Model::Mazars(_) => 3,
-            Model::RankineHill(_) => 5,
+            Model::RankineHill(_) => rankine_hill::n_state(voigt),
         }
     }
 
-    /// Names of the history values (columns of `rothe material` output).
+    /// Names of the history values of a plane point (columns of `rothe material`
+    /// output; a solid's Rankine-Hill point has six plastic strains before its `κ`s).
     pub fn state_names(&self) -> &'static [&'static str] {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) => &[],
@@ -351,7 +353,10 @@ impl Material {
     pub fn output_fields(&self, state: &[f64]) -> (f64, f64) {
         match self.model {
             Model::Mazars(_) => (state[2], 0.0),
-            Model::RankineHill(_) => (0.0, state[3] + state[4]),
+            Model::RankineHill(_) => {
+                let n = state.len();
+                (0.0, state[n - 2] + state[n - 1])
+            }
             _ => (0.0, 0.0),
         }
     }
@@ -523,35 +528,55 @@ impl Material {
                 mazars::update(&p, &c, self.nu, plane, step, averaged, state_n, state)
             }
             Model::RankineHill(p) => {
-                assert_eq!(V, 3, "validation keeps Rankine-Hill to the plane");
-                let narrow = |v: &[f64; V]| -> [f64; 3] { std::array::from_fn(|i| v[i]) };
-                let c3: [[f64; 3]; 3] = std::array::from_fn(|i| narrow(&c[i]));
-                let step3 = StrainStep {
-                    eps_n: narrow(&step.eps_n),
-                    eps: narrow(&step.eps),
-                    dt: step.dt,
-                    length: step.length,
-                };
-                let r = rankine_hill::update(&p, &c3, self.e, self.nu, &step3, state_n, state);
-                let widen = |v: &[f64; 3]| -> [f64; V] {
-                    std::array::from_fn(|i| if i < 3 { v[i] } else { 0.0 })
-                };
-                PointResponse {
-                    sigma: widen(&r.sigma),
-                    tangent: std::array::from_fn(|i| {
-                        if i < 3 {
-                            widen(&r.tangent[i])
-                        } else {
-                            [0.0; V]
-                        }
-                    }),
-                    psi: r.psi,
-                    dissipation: r.dissipation,
-                    status: r.status,
+                if V == 3 {
+                    rankine_hill_as::<V, 3, 2, frame::PlaneFrame>(
+                        &p, &c, self.e, self.nu, step, state_n, state,
+                    )
+                } else {
+                    rankine_hill_as::<V, 6, 3, frame::SolidFrame>(
+                        &p, &c, self.e, self.nu, step, state_n, state,
+                    )
                 }
             }
         }
     }
+}
+
+/// The Rankine-Hill update of a `V`-component point through the return written for
+/// the frame `F` of `W == V` components (the const dispatch copies between the
+/// equal sizes).
+fn rankine_hill_as<const V: usize, const W: usize, const P: usize, F: frame::Frame<W, P>>(
+    p: &RankineHillParams,
+    c: &[[f64; V]; V],
+    e: f64,
+    nu: f64,
+    step: &StrainStep<V>,
+    state_n: &[f64],
+    state: &mut [f64],
+) -> PointResponse<V> {
+    let cw: [[f64; W]; W] = cast(&c.map(|row| cast(&row)));
+    let sw = StrainStep {
+        eps_n: cast(&step.eps_n),
+        eps: cast(&step.eps),
+        dt: step.dt,
+        length: step.length,
+    };
+    let r = rankine_hill::update::<W, P, F>(p, &cw, e, nu, &sw, state_n, state);
+    PointResponse {
+        sigma: cast(&r.sigma),
+        tangent: cast(&r.tangent.map(|row| cast(&row))),
+        psi: r.psi,
+        dissipation: r.dissipation,
+        status: r.status,
+    }
+}
+
+/// `x` as an array of `B` entries where `A == B` (the const dispatch of a model
+/// written for one Voigt size; a size mismatch is a programming error).
+#[inline]
+fn cast<T: Copy, const A: usize, const B: usize>(x: &[T; A]) -> [T; B] {
+    assert_eq!(A, B, "Voigt sizes agree");
+    std::array::from_fn(|i| x[i])
 }
 
 /// `x` to four significant digits, in plain notation between 10⁻³ and 10⁵.

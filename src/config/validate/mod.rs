@@ -265,26 +265,16 @@ fn initial_overlap(model: &Model) -> Result<()> {
     ))
 }
 
-/// A body's thickness times its material's stiffness and density (and times its
-/// area) must stay finite: a thickness of 1e300 overflows the element matrices,
-/// which would otherwise surface as a singular stiffness far from its cause.
-/// What a solid model can hold so far: every material model but Rankine-Hill
-/// (whose returns are written for plane stress) and nonlocal averaging (its
-/// neighbour search is the plane's), supports, loads, gravity and probes under
+/// What a solid model can hold so far: every material model but nonlocal averaging
+/// (its neighbour search is the plane's), supports, loads, gravity and probes under
 /// statics, backward Euler and central differences; no contact (three-dimensional
 /// contact is its own work) and no bars. Each refusal names the field.
 fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material]) -> Result<()> {
     for block in &mesh.blocks {
         let m = &materials[block.material];
-        let why = match m.model {
-            crate::material::Model::RankineHill(_) => {
-                Some("Rankine-Hill plasticity is written for plane stress")
-            }
-            _ if m.nonlocal_radius().is_some() => {
-                Some("nonlocal averaging searches its neighbours in the plane")
-            }
-            _ => None,
-        };
+        let why = m
+            .nonlocal_radius()
+            .map(|_| "nonlocal averaging searches its neighbours in the plane");
         if let Some(why) = why {
             return Err(Error::config(
                 format!("materials.{}.model", m.name),
@@ -312,6 +302,9 @@ fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material
     Ok(())
 }
 
+/// A body's thickness times its material's stiffness and density (and times its
+/// area) must stay finite: a thickness of 1e300 overflows the element matrices,
+/// which would otherwise surface as a singular stiffness far from its cause.
 fn products_are_finite(
     field: &str,
     thickness: f64,
