@@ -16,8 +16,10 @@ use rothe::time::march::{march, Marched, StepControl};
 /// Mazars with a brittle exponential tension law (`A_t = 1`: softening to zero).
 const SOFTENING: &str = "model = \"mazars\"\nE = 30e9\nnu = 0.2\nrho = 2400.0\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
 
-/// A bar `length` × `height` (thickness 0.01 m) of `nx` × 1 Q4 of material `mat`,
-/// its left end held, its right end pulled to `u_end` by a ramp over `t_end`.
+/// A bar `length` × `height` (thickness 0.01 m) of `nx` × 1 Q4 (or, `solid`,
+/// `nx` × 1 × 1 Hex8) of material `mat`, its left end held, its right end pulled to
+/// `u_end` by a ramp over `t_end`.
+#[allow(clippy::too_many_arguments)]
 fn bar_text(
     length: f64,
     height: f64,
@@ -26,7 +28,15 @@ fn bar_text(
     u_end: f64,
     t_end: f64,
     dt: f64,
+    solid: bool,
 ) -> String {
+    // The solid bar: a box one hexahedron across, as thick as the plane one, held
+    // against rigid motion out of the plane too.
+    let body = if solid {
+        format!("mesh = {{ kind = \"box\", size = [{length}, {height}, 0.01], divisions = [{nx}, 1, 1] }}\n[[supports]]\nset = \"bar.left_back\"\nfix = [\"z\"]")
+    } else {
+        format!("thickness = 0.01\nmesh = {{ kind = \"rectangle\", size = [{length}, {height}], divisions = [{nx}, 1] }}")
+    };
     format!(
         r#"
 [analysis]
@@ -40,8 +50,7 @@ max_iterations = 80
 [[bodies]]
 name = "bar"
 material = "concrete"
-thickness = 0.01
-mesh = {{ kind = "rectangle", size = [{length}, {height}], divisions = [{nx}, 1] }}
+{body}
 [[supports]]
 set = "bar.left"
 fix = ["x"]
@@ -71,14 +80,15 @@ struct BarResult {
 /// height narrowed by 5 % at mid-length in a smooth dip 0.04 m wide (the same
 /// imperfection on every mesh), pulled over 2 ms to twice its elongation at the
 /// peak (about 20 wave transits: slow dynamics), with `radius` for the nonlocal
-/// model. Asserts the ledger's closure at every step.
-fn softening_bar(nx: usize, radius: Option<f64>) -> BarResult {
+/// model, in plane stress or as a `solid`. Asserts the ledger's closure at every
+/// step.
+fn softening_bar(nx: usize, radius: Option<f64>, solid: bool) -> BarResult {
     let (l, b, t) = (0.24, 0.02, 0.01);
     let mat = match radius {
         Some(r) => format!("{SOFTENING}\nnonlocal = {{ radius = {r} }}"),
         None => SOFTENING.to_string(),
     };
-    let text = bar_text(l, b, nx, &mat, 2.0e-4 * l, 2e-3, 4e-6);
+    let text = bar_text(l, b, nx, &mat, 2.0e-4 * l, 2e-3, 4e-6, solid);
     let mut model = rothe::config::from_str(&text, std::path::Path::new(".")).unwrap();
     for p in model.mesh.coords.iter_mut() {
         if p[1] > 0.5 * b {
@@ -108,23 +118,17 @@ fn softening_bar(nx: usize, radius: Option<f64>) -> BarResult {
     )
     .unwrap();
     // The points' cumulative dissipation densities and the lengths of bar they stand
-    // for (a quarter of the element's area over the bar's height).
+    // for (their share of the element's area over the bar's height, of its volume
+    // over the cross-section in a solid).
     let c = s.points[0].committed();
     let block = &model.mesh.blocks[0];
+    let ng = c.n_points() / block.elements.len();
+    let cross = if solid { b * t } else { b };
     let mut dens: Vec<(f64, f64)> = Vec::new();
     for e in 0..block.elements.len() {
-        let x: Vec<[f64; 3]> = block
-            .elements
-            .element(e)
-            .iter()
-            .map(|&n| model.mesh.coords[n])
-            .collect();
-        let area = 0.5
-            * (0..4)
-                .map(|a| x[a][0] * x[(a + 1) % 4][1] - x[(a + 1) % 4][0] * x[a][1])
-                .sum::<f64>();
-        for q in 0..4 {
-            dens.push((c.dissipated(4 * e + q), 0.25 * area / b));
+        let share = model.mesh.element_area(0, e) / ng as f64 / cross;
+        for q in 0..ng {
+            dens.push((c.dissipated(ng * e + q), share));
         }
     }
     let total: f64 = dens.iter().map(|p| p.0 * p.1).sum();
@@ -156,8 +160,14 @@ fn softening_bar_converges_with_averaging_and_not_without() {
     // R = 0.04 m; element sizes R/2, R/4, R/8, R/16.
     let r = 0.04;
     let meshes = [12usize, 24, 48, 96];
-    let nonlocal: Vec<BarResult> = meshes.iter().map(|&n| softening_bar(n, Some(r))).collect();
-    let local: Vec<BarResult> = meshes.iter().map(|&n| softening_bar(n, None)).collect();
+    let nonlocal: Vec<BarResult> = meshes
+        .iter()
+        .map(|&n| softening_bar(n, Some(r), false))
+        .collect();
+    let local: Vec<BarResult> = meshes
+        .iter()
+        .map(|&n| softening_bar(n, None, false))
+        .collect();
     for (a, b) in nonlocal.iter().zip(&local) {
         eprintln!(
             "h = R/{:<2.0}: nonlocal {:.3} J/m² over {:.4} m; local {:.3} J/m² over {:.4} m",
@@ -309,8 +319,8 @@ fn averages_keep_uniform_fields_and_ignore_the_numbering() {
     }
     // Numbering: a field of the coordinates averages to the same values at the same
     // points whichever way the elements are listed.
-    let field = |p: [f64; 2]| [(7.0 * p[0]).sin() + p[1] * p[1], p[0] * p[1] - 0.2];
-    let averaged = |reversed: bool| -> Vec<([f64; 2], [f64; 2])> {
+    let field = |p: [f64; 3]| [(7.0 * p[0]).sin() + p[1] * p[1], p[0] * p[1] - 0.2];
+    let averaged = |reversed: bool| -> Vec<([f64; 3], [f64; 2])> {
         let mesh = mixed_body(reversed);
         let t = NonlocalTable::build(&mesh, &mats).unwrap();
         let local: Vec<f64> = (0..t.n_points()).flat_map(|i| field(t.point(i))).collect();
@@ -403,6 +413,188 @@ fn under_a_uniform_strain_nonlocal_is_local() {
                 "{variant:?} {eps:?}: damaged everywhere: {:?}",
                 &dl[..4]
             );
+            for (a, b) in dl.iter().zip(&dn) {
+                assert!(
+                    (a - b).abs() <= 1e-13,
+                    "{variant:?} {eps:?}: damage {a} vs {b}"
+                );
+            }
+            let scale = fl.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for (a, b) in fl.iter().zip(&fnl) {
+                assert!((a - b).abs() <= 1e-12 * scale, "force {a} vs {b}");
+            }
+            assert!((psil - psin).abs() <= 1e-12 * psil && (wl - wn).abs() <= 1e-12 * wl);
+        }
+    }
+}
+
+#[test]
+fn a_solid_softening_bar_dissipates_as_the_plane_one() {
+    // Reference: the plane-stress bar above as a solid one hexahedron across, its
+    // height narrowed alike. Both carry uniaxial stress; the averages differ only by
+    // the Gauss points' offsets across the thickness (±0.003 m against R = 0.04 m,
+    // a weight change below 1 %), so the dissipated energy per cross-section agrees
+    // with the plane bar's and the damaged zone has its width, at R/4 and R/8.
+    let r = 0.04;
+    for nx in [24usize, 48] {
+        let plane = softening_bar(nx, Some(r), false);
+        let solid = softening_bar(nx, Some(r), true);
+        eprintln!(
+            "h = R/{:.0}: plane {:.3} J/m² over {:.4} m, solid {:.3} J/m² over {:.4} m",
+            r / plane.h,
+            plane.dissipated,
+            plane.width,
+            solid.dissipated,
+            solid.width
+        );
+        assert!(
+            (solid.dissipated - plane.dissipated).abs() < 0.01 * plane.dissipated,
+            "R/{}: solid {} vs plane {}",
+            r / plane.h,
+            solid.dissipated,
+            plane.dissipated
+        );
+        assert!(
+            (solid.width - plane.width).abs() <= plane.h + 1e-12,
+            "width {} vs {}",
+            solid.width,
+            plane.width
+        );
+    }
+}
+
+/// A 0.3 × 0.2 × 0.2 m box of `kind` cut into 6 × 4 × 4 cells, one body.
+fn solid_body(kind: ElementKind) -> Mesh {
+    let part = rothe::mesh::solid::uniform([0.0; 3], [0.3, 0.2, 0.2], [6, 4, 4], kind);
+    let mut mesh = Mesh::default();
+    mesh.add_part(&part, 0, "b", 0, 1.0);
+    mesh
+}
+
+#[test]
+fn solid_averages_weigh_by_distance_in_space_and_keep_uniform_fields() {
+    // Reference: α_ij = w(r_ij) V_j / Σ_k w(r_ik) V_k with r the distance in space;
+    // on these boxes every point has the same integration volume (cubes with 2x2x2
+    // points; Kuhn tetrahedra, a sixth of a cube each), so α_ij is w(r_ij)
+    // normalised, computed here over all pairs. The table's neighbours and weights
+    // are those, and a uniform field averages to itself at faces, edges and corners.
+    let radius = 0.1;
+    let mats = [nonlocal_mazars(radius)];
+    for kind in [ElementKind::Hex8, ElementKind::Tet4] {
+        let mesh = solid_body(kind);
+        let t = NonlocalTable::build(&mesh, &mats).unwrap();
+        let n = t.n_points();
+        let per = if kind == ElementKind::Hex8 { 8 } else { 6 };
+        assert_eq!(n, 96 * per, "{kind:?}: every Gauss point");
+        for i in 0..n {
+            let p = t.point(i);
+            let mut want: Vec<(u32, f64)> = (0..n)
+                .filter_map(|j| {
+                    let q = t.point(j);
+                    let r2: f64 = (0..3).map(|d| (q[d] - p[d]).powi(2)).sum();
+                    let s = 1.0 - r2 / (radius * radius);
+                    (s > 0.0).then_some((j as u32, s * s))
+                })
+                .collect();
+            let total: f64 = want.iter().map(|x| x.1).sum();
+            for x in want.iter_mut() {
+                x.1 /= total;
+            }
+            let (cols, w) = t.neighbours(i);
+            assert_eq!(
+                cols,
+                want.iter().map(|x| x.0).collect::<Vec<_>>(),
+                "{kind:?} point {i}: neighbours"
+            );
+            for (a, b) in w.iter().zip(&want) {
+                assert!(
+                    (a - b.1).abs() < 1e-14,
+                    "{kind:?} point {i}: {a} vs {}",
+                    b.1
+                );
+            }
+        }
+        let local: Vec<f64> = (0..n).flat_map(|_| [3.7e-4, -1.3e-4]).collect();
+        let mut avg = vec![0.0; DRIVERS * n];
+        t.average(&local, &mut avg);
+        for i in 0..n {
+            for k in 0..DRIVERS {
+                let (a, x) = (avg[DRIVERS * i + k], local[k]);
+                assert!(
+                    (a - x).abs() <= 1e-13 * x.abs(),
+                    "{kind:?} point {i}: {a} vs {x}"
+                );
+            }
+        }
+        // An interior point reaches across cells in all three directions.
+        let (lo, hi) = t.neighbour_range();
+        assert!(
+            hi > 4 * lo / 3 && hi > 100,
+            "{kind:?}: neighbour counts {lo}..{hi}"
+        );
+    }
+}
+
+#[test]
+fn under_a_uniform_strain_a_nonlocal_solid_is_local() {
+    // The solid counterpart of `under_a_uniform_strain_nonlocal_is_local`: a uniform
+    // strain with all six components, past the tensile peak and in compression, on
+    // a hexahedral box: the nonlocal pass gives the local one's damage, forces and
+    // energies to round-off, for both variants.
+    use rothe::assembly::internal::{new_stores, PointPass};
+    use rothe::assembly::Assembler;
+    let mesh = solid_body(ElementKind::Hex8);
+    for variant in [MazarsVariant::Paper, MazarsVariant::Classic] {
+        for eps in [
+            [3e-4, -0.5e-4, 0.4e-4, -0.3e-4, 0.2e-4, -0.1e-4],
+            [-2.5e-3, 0.4e-3, 0.6e-3, 0.5e-3, -0.3e-3, 0.2e-3],
+        ] {
+            // Tensor ε_ij from the Voigt strain (engineering shears).
+            let e = [
+                [eps[0], 0.5 * eps[2], 0.5 * eps[5]],
+                [0.5 * eps[2], eps[1], 0.5 * eps[4]],
+                [0.5 * eps[5], 0.5 * eps[4], eps[3]],
+            ];
+            let u: Vec<f64> = mesh
+                .coords
+                .iter()
+                .flat_map(|p| (0..3).map(move |i| (0..3).map(|j| e[i][j] * p[j]).sum::<f64>()))
+                .collect();
+            let evaluate = |nonlocal: bool| {
+                let mut m = nonlocal_mazars(0.1);
+                if let Model::Mazars(p) = &mut m.model {
+                    p.variant = variant;
+                    if !nonlocal {
+                        p.regularisation = Regularisation::Local;
+                    }
+                }
+                let mats = [m];
+                let asm = Assembler::new(&mesh);
+                let mut stores = new_stores(&mesh, &mats);
+                let mut f = vec![0.0; u.len()];
+                let totals = asm.internal_force(
+                    &mesh,
+                    &mats,
+                    rothe::fe::Plane::Solid,
+                    PointPass {
+                        u: &u,
+                        dt: 1e-5,
+                        at_rest: false,
+                        frozen: false,
+                    },
+                    &mut stores,
+                    &mut f,
+                    None,
+                    None,
+                    None,
+                );
+                let t = stores[0].trial();
+                let d: Vec<f64> = (0..t.n_points()).map(|g| t.history(g)[2]).collect();
+                (d, f, totals.psi, totals.dissipation.damage)
+            };
+            let (dl, fl, psil, wl) = evaluate(false);
+            let (dn, fnl, psin, wn) = evaluate(true);
+            assert!(dl.iter().all(|&d| d > 0.05), "{variant:?} {eps:?}: damaged");
             for (a, b) in dl.iter().zip(&dn) {
                 assert!(
                     (a - b).abs() <= 1e-13,

@@ -174,6 +174,24 @@ fn memory_is_estimated_before_it_is_taken() {
         ),
         &["divisions", "overflows"],
     );
+    // A box of hexahedra: 8 000 000 cells (a solid's factor grows as n^{4/3}),
+    // refused by the estimate before anything is built; and one whose node count
+    // overflows.
+    let solid = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/solid/cantilever.toml"),
+    )
+    .unwrap();
+    refused(
+        &solid.replace("divisions = [16, 4, 4]", "divisions = [800, 100, 100]"),
+        &["bodies[..].mesh.divisions", "needs about", "available"],
+    );
+    refused(
+        &solid.replace(
+            "divisions = [16, 4, 4]",
+            "divisions = [4294967296, 4294967296, 4294967296]",
+        ),
+        &["divisions", "overflows"],
+    );
     // Through the library with a small limit: the model is refused naming the parts.
     let e = rothe::config::from_str_with(
         &good(),

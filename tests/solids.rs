@@ -738,3 +738,80 @@ at = [0.3, 0.2, 0.1]
     let uz: f64 = last[col].parse().unwrap();
     assert!((uz - want[2]).abs() < 1e-9 * 0.02, "{uz}");
 }
+
+#[test]
+fn a_bar_along_a_space_diagonal_carries_its_axial_stiffness() {
+    // Reference: a steel bar (E = 210 GPa, A = 1e-4 m²) along the space diagonal of
+    // a 1 m cube of a nearly void solid (E = 1 Pa), clamped on its left face, pulled
+    // at the far corner by F = 10 kN along the diagonal: the corner moves
+    // F L / (E A) along the bar (L = √3 m; the solid adds 1e-7 of the bar's
+    // stiffness); across it the chain of bars is a mechanism that only the void
+    // holds, so that motion is not the bar's. The bar's nodes are the cube's
+    // diagonal nodes (one bar element per cell).
+    let text = r#"
+[analysis]
+kind = "static"
+t_end = 1.0
+dt = 0.25
+vtk_every = 0
+
+[materials.void]
+model = "elastic"
+E = 1.0
+nu = 0.0
+rho = 1.0e-6
+
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+
+[[bodies]]
+name = "cube"
+material = "void"
+mesh = { kind = "box", size = [1.0, 1.0, 1.0], divisions = [4, 4, 4] }
+
+[[bars]]
+name = "tie"
+body = "cube"
+material = "steel"
+area = 1.0e-4
+from = [0.0, 0.0, 0.0]
+to = [1.0, 1.0, 1.0]
+
+[[supports]]
+set = "cube.left"
+fix = ["x", "y", "z"]
+
+[[loads]]
+kind = "nodal"
+set = "cube.top_right_front"
+value = [5773.502691896258, 5773.502691896258, 5773.502691896258]
+function = { kind = "ramp", t0 = 0.0, t1 = 1.0 }
+"#;
+    let model = rothe::config::from_str(text, std::path::Path::new(".")).unwrap();
+    assert_eq!(
+        model.mesh.blocks[1].elements.len(),
+        4,
+        "one bar element per cell"
+    );
+    let tip = model.mesh.node_sets["cube.top_right_front"][0];
+    let u = &statics::solve(&model, Backend::Faer, &[1.0]).unwrap()[0].u;
+    let want = 1e4 * 3f64.sqrt() / (210e9 * 1e-4);
+    let along = (u[3 * tip] + u[3 * tip + 1] + u[3 * tip + 2]) / 3f64.sqrt();
+    assert!((along - want).abs() < 1e-6 * want, "{along} vs {want}");
+    // Each bar element carries F: its axial strain F/(EA) from the nodes' motion.
+    let bars = &model.mesh.blocks[1].elements;
+    for e in 0..bars.len() {
+        let n = bars.element(e);
+        let x = [model.mesh.coords[n[0]], model.mesh.coords[n[1]]];
+        let ue: Vec<f64> = n
+            .iter()
+            .flat_map(|&k| (0..3).map(move |i| u[3 * k + i]))
+            .collect();
+        let eps = rothe::fe::element::bar_strain(&x, 3, &ue);
+        let want = 1e4 / (210e9 * 1e-4);
+        assert!((eps - want).abs() < 1e-6 * want, "bar {e}: {eps} vs {want}");
+    }
+}

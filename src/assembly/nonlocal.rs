@@ -6,7 +6,8 @@
 //!
 //! `ε̄_i = Σ_j α_ij ε_j`,  `α_ij = w(r_ij) V_j / Σ_k w(r_ik) V_k`,  `w(r) = (1 − r²/R²)²`
 //!
-//! (`V_j` the point's integration volume `w_q det J t`). The weights are normalised
+//! (`V_j` the point's integration volume `w_q det J t`, `w_q det J` in a solid;
+//! distances in the mesh's dimension, plane points at `z = 0`). The weights are normalised
 //! per point, so a uniform field averages to itself, at a boundary too. The table of
 //! neighbours and weights depends on the reference geometry only: it is built once
 //! per mesh with an R-tree (`rstar`) and kept ([`NonlocalTable`]); each pass then
@@ -19,7 +20,7 @@ use rayon::prelude::*;
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
-use crate::fe::{kinematics, stiffness_rule, strain, ElementKind, Plane};
+use crate::fe::{kinematics, stiffness_rule, ElementKind, Plane, MAX_NODES};
 use crate::material::store::StateStore;
 use crate::material::{mazars, Material, MazarsVariant, Model};
 use crate::mesh::Mesh;
@@ -28,7 +29,7 @@ use crate::mesh::Mesh;
 pub const DRIVERS: usize = 2;
 
 /// An R-tree of member points (their member numbers as data).
-type PointTree = RTree<GeomWithData<[f64; 2], u32>>;
+type PointTree = RTree<GeomWithData<[f64; 3], u32>>;
 
 /// Points per leaf of the parallel passes.
 const POINT_LEAF: usize = 256;
@@ -42,16 +43,17 @@ pub struct NonlocalTable {
     offsets: Vec<Option<usize>>,
     /// Per block: the radius the table was built with (to know it still fits).
     radii: Vec<Option<f64>>,
-    /// Member coordinates.
-    points: Vec<[f64; 2]>,
+    /// Member coordinates (`z = 0` in the plane).
+    points: Vec<[f64; 3]>,
     /// Row starts (members + 1).
     row_ptr: Vec<usize>,
     /// Neighbour members.
     cols: Vec<u32>,
     /// Normalised weights `α_ij`.
     weights: Vec<f64>,
-    /// The bucket grid that bounds the averages: origin, cell size and cells per row.
-    grid: ([f64; 2], f64, usize, usize),
+    /// The bucket grid that bounds the averages: origin, cell size and cells along
+    /// x, y and z (one layer in the plane).
+    grid: ([f64; 3], f64, [usize; 3]),
     /// Per member: its bucket.
     bucket: Vec<u32>,
     /// Per member: how many buckets its radius reaches in each direction.
@@ -61,20 +63,21 @@ pub struct NonlocalTable {
 }
 
 /// A Gauss point of a continuum element: its position and integration volume.
-fn point_geometry(mesh: &Mesh, bi: usize, e: usize, q: usize) -> ([f64; 2], f64) {
+fn point_geometry(mesh: &Mesh, bi: usize, e: usize, q: usize) -> ([f64; 3], f64) {
     let block = &mesh.blocks[bi];
     let kind = block.elements.kind;
     let nodes = block.elements.element(e);
-    let mut x = [[0.0; 3]; 4];
+    let mut x = [[0.0; 3]; MAX_NODES];
     for (a, &n) in nodes.iter().enumerate() {
         x[a] = mesh.coords[n];
     }
     let (xi, wq) = stiffness_rule(kind)[q];
     let k = kinematics(kind, &x[..nodes.len()], xi);
-    let mut p = [0.0; 2];
+    let mut p = [0.0; 3];
     for a in 0..nodes.len() {
-        p[0] += k.n[a] * x[a][0];
-        p[1] += k.n[a] * x[a][1];
+        for d in 0..3 {
+            p[d] += k.n[a] * x[a][d];
+        }
     }
     (p, wq * k.det_j * block.section)
 }
@@ -89,8 +92,8 @@ fn block_radius(mesh: &Mesh, materials: &[Material], bi: usize) -> Option<f64> {
 }
 
 /// An estimate of the table's entries before it is built (for the memory estimate):
-/// per nonlocal block, its points times those of its body's points a disc of the
-/// radius holds at the block's mean point density.
+/// per nonlocal block, its points times those of its body's points a disc (a ball
+/// in a solid) of the radius holds at the block's mean point density.
 pub fn estimated_entries(mesh: &Mesh, materials: &[Material]) -> (u64, u64) {
     let (mut points, mut entries) = (0u64, 0u64);
     for (bi, b) in mesh.blocks.iter().enumerate() {
@@ -98,11 +101,15 @@ pub fn estimated_entries(mesh: &Mesh, materials: &[Material]) -> (u64, u64) {
             continue;
         };
         let n = (b.elements.len() * stiffness_rule(b.elements.kind).len()) as u64;
-        let area: f64 = (0..b.elements.len())
+        let measure: f64 = (0..b.elements.len())
             .map(|e| mesh.element_area(bi, e))
             .sum();
-        let per_point = (std::f64::consts::PI * r * r * n as f64 / area.max(f64::MIN_POSITIVE))
-            .clamp(1.0, n as f64);
+        let reach = if b.elements.kind.dim() == 3 {
+            4.0 / 3.0 * std::f64::consts::PI * r * r * r
+        } else {
+            std::f64::consts::PI * r * r
+        };
+        let per_point = (reach * n as f64 / measure.max(f64::MIN_POSITIVE)).clamp(1.0, n as f64);
         points += n;
         entries += (n as f64 * per_point) as u64;
     }
@@ -162,8 +169,12 @@ impl NonlocalTable {
                     .locate_within_distance(points[i], r2)
                     .filter_map(|g| {
                         let j = g.data as usize;
-                        let (dx, dy) = (points[j][0] - points[i][0], points[j][1] - points[i][1]);
-                        let s = 1.0 - (dx * dx + dy * dy) / r2;
+                        let (dx, dy, dz) = (
+                            points[j][0] - points[i][0],
+                            points[j][1] - points[i][1],
+                            points[j][2] - points[i][2],
+                        );
+                        let s = 1.0 - (dx * dx + dy * dy + dz * dz) / r2;
                         (s > 0.0).then_some((g.data, s * s * volumes[j]))
                     })
                     .collect();
@@ -176,21 +187,24 @@ impl NonlocalTable {
         // within `ceil(R / cell)` of its own.
         let r_max = owner.iter().map(|o| o.1).fold(0.0, f64::max);
         let cell = 0.5 * r_max;
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in &points {
-            for d in 0..2 {
+            for d in 0..3 {
                 lo[d] = lo[d].min(p[d]);
                 hi[d] = hi[d].max(p[d]);
             }
         }
-        let cells = |d: usize| (((hi[d] - lo[d]) / cell).floor() as usize + 1).min(1 << 12);
-        let (nx, ny) = (cells(0), cells(1));
+        // At most 4096 cells a side in the plane, 128 in a solid (two million
+        // buckets); points past the last cell fall into it, which keeps the bounds
+        // conservative.
+        let limit = if mesh.dim == 3 { 1 << 7 } else { 1 << 12 };
+        let n = std::array::from_fn(|d| (((hi[d] - lo[d]) / cell).floor() as usize + 1).min(limit));
         let bucket = points
             .iter()
             .map(|p| {
-                let ix = (((p[0] - lo[0]) / cell) as usize).min(nx - 1);
-                let iy = (((p[1] - lo[1]) / cell) as usize).min(ny - 1);
-                (iy * nx + ix) as u32
+                let i: [usize; 3] =
+                    std::array::from_fn(|d| (((p[d] - lo[d]) / cell) as usize).min(n[d] - 1));
+                ((i[2] * n[1] + i[1]) * n[0] + i[0]) as u32
             })
             .collect();
         let reach = owner
@@ -213,7 +227,7 @@ impl NonlocalTable {
             row_ptr,
             cols,
             weights,
-            grid: (lo, cell, nx, ny),
+            grid: (lo, cell, n),
             bucket,
             reach,
             block,
@@ -238,7 +252,7 @@ impl NonlocalTable {
 
     /// Bytes the table holds (indices, weights, rows, coordinates).
     pub fn bytes(&self) -> u64 {
-        (self.cols.len() * 12 + self.row_ptr.len() * 8 + self.points.len() * 16) as u64
+        (self.cols.len() * 12 + self.row_ptr.len() * 8 + self.points.len() * 24) as u64
     }
 
     /// The smallest and largest neighbour count of a point (itself included).
@@ -254,8 +268,8 @@ impl NonlocalTable {
         self.offsets.get(bi).copied().flatten()
     }
 
-    /// Coordinates of member `i`.
-    pub fn point(&self, i: usize) -> [f64; 2] {
+    /// Coordinates of member `i` (`z = 0` in the plane).
+    pub fn point(&self, i: usize) -> [f64; 3] {
         self.points[i]
     }
 
@@ -275,7 +289,7 @@ impl NonlocalTable {
 
     /// Number of buckets of the bounding grid.
     pub fn n_buckets(&self) -> usize {
-        self.grid.2 * self.grid.3
+        self.grid.2.iter().product()
     }
 
     /// [`NonlocalTable::average`] for the members where `needed(i, bound)` holds,
@@ -287,7 +301,7 @@ impl NonlocalTable {
     {
         self.bucket_maxima(local, bounds);
         let bounds = &*bounds;
-        let (_, _, nx, ny) = self.grid;
+        let (_, _, [nx, ny, nz]) = self.grid;
         out.par_chunks_mut(DRIVERS * POINT_LEAF)
             .enumerate()
             .for_each(|(c, chunk)| {
@@ -295,12 +309,15 @@ impl NonlocalTable {
                 for (k, o) in chunk.chunks_exact_mut(DRIVERS).enumerate() {
                     let i = first + k;
                     let b = self.bucket[i] as usize;
-                    let (bx, by, r) = (b % nx, b / nx, self.reach[i] as usize);
+                    let (bx, by, bz) = (b % nx, (b / nx) % ny, b / (nx * ny));
+                    let r = self.reach[i] as usize;
                     let mut bound = [f64::NEG_INFINITY; 2];
-                    for y in by.saturating_sub(r)..(by + r + 1).min(ny) {
-                        for x in bx.saturating_sub(r)..(bx + r + 1).min(nx) {
-                            let m = bounds[y * nx + x];
-                            bound = [bound[0].max(m[0]), bound[1].max(m[1])];
+                    for z in bz.saturating_sub(r)..(bz + r + 1).min(nz) {
+                        for y in by.saturating_sub(r)..(by + r + 1).min(ny) {
+                            for x in bx.saturating_sub(r)..(bx + r + 1).min(nx) {
+                                let m = bounds[(z * ny + y) * nx + x];
+                                bound = [bound[0].max(m[0]), bound[1].max(m[1])];
+                            }
                         }
                     }
                     if !needed(i, bound) {
@@ -341,6 +358,22 @@ impl NonlocalTable {
         u: &[f64],
         local: &mut [f64],
     ) {
+        if mesh.dim == 3 {
+            self.local_drivers_d::<3, 6>(mesh, materials, plane, u, local)
+        } else {
+            self.local_drivers_d::<2, 3>(mesh, materials, plane, u, local)
+        }
+    }
+
+    /// [`NonlocalTable::local_drivers`] in dimension `D` with `V` Voigt components.
+    fn local_drivers_d<const D: usize, const V: usize>(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        plane: Plane,
+        u: &[f64],
+        local: &mut [f64],
+    ) {
         for (bi, b) in mesh.blocks.iter().enumerate() {
             let Some(off) = self.offset(bi) else { continue };
             let mat = &materials[b.material];
@@ -357,10 +390,10 @@ impl NonlocalTable {
                     for (k, el) in chunk.chunks_exact_mut(DRIVERS * ng).enumerate() {
                         let e = c * per + k;
                         let (x, ue, nn) =
-                            super::internal::gather::<2>(mesh, b.elements.element(e), u);
+                            super::internal::gather::<D>(mesh, b.elements.element(e), u);
                         for (q, &(xi, _)) in stiffness_rule(kind).iter().enumerate() {
                             let kin = kinematics(kind, &x[..nn], xi);
-                            let eps = strain(&kin, nn, &ue);
+                            let eps = super::internal::strain_v::<V>(&kin, nn, &ue);
                             let d = mazars::drivers(p, mat.nu, plane, &eps);
                             el[DRIVERS * q] = d[0];
                             el[DRIVERS * q + 1] = d[1];

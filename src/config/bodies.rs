@@ -117,12 +117,12 @@ pub struct BarSpec {
     pub material: String,
     /// Cross-section area (m²).
     pub area: f64,
-    /// Start point of the line.
-    #[serde(deserialize_with = "exact::array")]
-    pub from: [f64; 2],
+    /// Start point of the line (as many coordinates as the model has dimensions).
+    #[serde(deserialize_with = "exact::vector")]
+    pub from: exact::Vector,
     /// End point of the line.
-    #[serde(deserialize_with = "exact::array")]
-    pub to: [f64; 2],
+    #[serde(deserialize_with = "exact::vector")]
+    pub to: exact::Vector,
 }
 
 /// A displacement component.

@@ -388,8 +388,8 @@ impl NodalLaws {
                     let eps = element::bar_strain(&x[..2], D, &ue[..2 * D]);
                     store.set_committed(
                         e,
-                        &[eps, 0.0, 0.0],
-                        &[mat.e * eps, 0.0, 0.0],
+                        &[eps, 0.0, 0.0, 0.0, 0.0, 0.0],
+                        &[mat.e * eps, 0.0, 0.0, 0.0, 0.0, 0.0],
                         f64::NAN,
                         &[],
                     );

@@ -181,16 +181,13 @@ fn cells_along(length: f64, size: f64, lines: &[f64]) -> f64 {
         .sum()
 }
 
-impl Cuts<'_, 2> {
-    /// Cells along x and y.
-    fn counts(&self, size: [f64; 2]) -> (u64, u64) {
-        match self {
-            Cuts::Equal(d) => (d[0] as u64, d[1] as u64),
-            Cuts::Sized { size: h, lines } => (
-                cells_along(size[0], *h, lines[0]) as u64,
-                cells_along(size[1], *h, lines[1]) as u64,
-            ),
-        }
+impl<const N: usize> Cuts<'_, N> {
+    /// Cells along each axis.
+    fn counts(&self, size: [f64; N]) -> [u64; N] {
+        std::array::from_fn(|a| match self {
+            Cuts::Equal(d) => d[a] as u64,
+            Cuts::Sized { size: h, lines } => cells_along(size[a], *h, lines[a]) as u64,
+        })
     }
 }
 
@@ -203,53 +200,99 @@ pub(super) fn check_generated_size(
     opts: &LoadOptions,
 ) -> Result<()> {
     let (mut nodes, mut elements, mut points, mut history) = (0u64, 0u64, 0u64, 0u64);
+    let mut dim = 2;
     for (bi, b) in s.bodies.iter().enumerate() {
-        if let MeshSpec::Rectangle {
-            size,
-            divisions,
-            element_size,
-            x_lines,
-            y_lines,
-            element,
-            ..
-        } = &b.mesh
-        {
-            let field = format!("bodies[{bi}].mesh");
-            let cuts = rectangle_cuts(
-                &field,
-                *size,
-                *divisions,
-                *element_size,
-                [x_lines, y_lines],
-                &s.meshing,
-            )?;
-            let (nx, ny) = cuts.counts(*size);
-            let (n, e) = rectangle_size(nx, ny, *element).ok_or_else(|| {
-                Error::config(
-                    format!("{field}.divisions"),
-                    format!("[{nx}, {ny}] cells: the node count overflows"),
-                )
-            })?;
+        let field = format!("bodies[{bi}].mesh");
+        let counted = match &b.mesh {
+            MeshSpec::Rectangle {
+                size,
+                divisions,
+                element_size,
+                x_lines,
+                y_lines,
+                element,
+                ..
+            } => {
+                let cuts = rectangle_cuts(
+                    &field,
+                    *size,
+                    *divisions,
+                    *element_size,
+                    [x_lines, y_lines],
+                    &s.meshing,
+                )?;
+                let [nx, ny] = cuts.counts(*size);
+                let (n, e) = rectangle_size(nx, ny, *element).ok_or_else(|| {
+                    Error::config(
+                        format!("{field}.divisions"),
+                        format!("[{nx}, {ny}] cells: the node count overflows"),
+                    )
+                })?;
+                let per = if *element == ElementKind::Tri3 { 1 } else { 4 };
+                Some((n, e, e.saturating_mul(per)))
+            }
+            MeshSpec::Box {
+                size,
+                divisions,
+                element_size,
+                x_lines,
+                y_lines,
+                z_lines,
+                element,
+                ..
+            } => {
+                let cuts = rectangle_cuts(
+                    &field,
+                    *size,
+                    *divisions,
+                    *element_size,
+                    [x_lines, y_lines, z_lines],
+                    &s.meshing,
+                )?;
+                let [nx, ny, nz] = cuts.counts(*size);
+                let n = (nx + 1)
+                    .checked_mul(ny + 1)
+                    .and_then(|v| v.checked_mul(nz + 1));
+                let cells = nx.checked_mul(ny).and_then(|v| v.checked_mul(nz));
+                let (Some(n), Some(cells)) = (n, cells) else {
+                    return Err(Error::config(
+                        format!("{field}.divisions"),
+                        format!("[{nx}, {ny}, {nz}] cells: the node count overflows"),
+                    ));
+                };
+                dim = 3;
+                // A cell is one Hex8 (eight points) or six one-point Tet4.
+                let (e, per) = if *element == ElementKind::Tet4 {
+                    (cells.saturating_mul(6), 1)
+                } else {
+                    (cells, 8)
+                };
+                Some((n, e, e.saturating_mul(per)))
+            }
+            MeshSpec::Gmsh { .. } => None,
+        };
+        if let Some((n, e, p)) = counted {
             nodes = nodes.saturating_add(n);
             elements = elements.saturating_add(e);
-            let per = if *element == ElementKind::Tri3 { 1 } else { 4 };
-            points = points.saturating_add(e.saturating_mul(per));
+            points = points.saturating_add(p);
             if let Some(&m) = mat_index.get(&b.material) {
-                history = history.max(materials[m].n_state() as u64);
+                let voigt = if dim == 3 { 6 } else { 3 };
+                history = history.max(materials[m].n_state_for(voigt) as u64);
             }
         }
     }
     if nodes == 0 {
         return Ok(());
     }
-    let dofs = usize::try_from(nodes.saturating_mul(2)).unwrap_or(usize::MAX);
+    let dofs = usize::try_from(nodes.saturating_mul(dim as u64)).unwrap_or(usize::MAX);
     let tangent = materials.iter().any(|m| !m.has_constant_tangent());
     let est = Estimate::of(
+        dim,
         nodes,
         elements,
         points,
         history,
-        factor_nnz_estimate(dofs),
+        factor_nnz_estimate(dofs, dim),
         tangent,
     );
     est.check(
@@ -283,14 +326,23 @@ pub fn estimate(mesh: &Mesh, materials: &[Material], factor_nnz: Option<usize>) 
                 as u64
         })
         .sum();
-    let history = materials.iter().map(|m| m.n_state()).max().unwrap_or(0) as u64;
+    let voigt = crate::assembly::internal::voigt_of(mesh);
+    let history = materials
+        .iter()
+        .map(|m| m.n_state_for(voigt))
+        .max()
+        .unwrap_or(0) as u64;
     let tangent = materials.iter().any(|m| !m.has_constant_tangent());
     let mut est = Estimate::of(
+        mesh.dim,
         mesh.n_nodes() as u64,
         mesh.n_elements() as u64,
         points,
         history,
-        factor_nnz.map_or_else(|| factor_nnz_estimate(mesh.n_dofs()), |n| n as u64),
+        factor_nnz.map_or_else(
+            || factor_nnz_estimate(mesh.n_dofs(), mesh.dim),
+            |n| n as u64,
+        ),
         tangent,
     );
     // The nonlocal table (index and weight per entry) and its per-point buffers.
@@ -418,8 +470,10 @@ pub(super) fn add_bars(
             ));
         }
         positive(&format!("{field}.area"), bar.area)?;
-        finite(&format!("{field}.from"), &bar.from)?;
-        finite(&format!("{field}.to"), &bar.to)?;
+        let from = super::constraints::dimensioned(mesh.dim, &format!("{field}.from"), &bar.from)?;
+        let to = super::constraints::dimensioned(mesh.dim, &format!("{field}.to"), &bar.to)?;
+        // Points are printed with the model's dimension.
+        let shown = |p: [f64; 3]| format!("{:?}", &p[..mesh.dim]);
         let mat = find_material(format!("{field}.material"), &bar.material)?;
         if !materials[mat].is_linear_elastic() {
             return Err(Error::config(
@@ -443,28 +497,26 @@ pub(super) fn add_bars(
                 format!("`{set}` is already a set of the mesh; give the bar another name"),
             ));
         }
-        let len = ((bar.to[0] - bar.from[0]).powi(2) + (bar.to[1] - bar.from[1]).powi(2)).sqrt();
+        let len = crate::mesh::distance(from, to);
         if !(len > 0.0 && len.is_finite()) {
             return Err(Error::config(
                 format!("{field}.to"),
                 format!(
-                    "the bar line from {:?} to {:?} has no length",
-                    bar.from, bar.to
+                    "the bar line from {} to {} has no length",
+                    shown(from),
+                    shown(to)
                 ),
             ));
         }
-        let nodes = mesh.nodes_on_segment(
-            body,
-            [bar.from[0], bar.from[1], 0.0],
-            [bar.to[0], bar.to[1], 0.0],
-            1e-9 * len.max(1.0),
-        );
+        let nodes = mesh.nodes_on_segment(body, from, to, 1e-9 * len.max(1.0));
         if nodes.len() < 2 {
             return Err(Error::config(
                 field,
                 format!(
-                    "the line from {:?} to {:?} passes through fewer than two nodes of `{}`",
-                    bar.from, bar.to, bar.body
+                    "the line from {} to {} passes through fewer than two nodes of `{}`",
+                    shown(from),
+                    shown(to),
+                    bar.body
                 ),
             ));
         }

@@ -145,7 +145,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     mesh.check_elements(&names)?;
     let dim = mesh.dim;
     if dim == 3 {
-        solid_scope(s, &mesh, &materials)?;
+        solid_scope(s)?;
     }
     let gravity = match &a.gravity {
         Some(g) => Some(constraints::dimensioned(mesh.dim, "analysis.gravity", g)?),
@@ -265,38 +265,16 @@ fn initial_overlap(model: &Model) -> Result<()> {
     ))
 }
 
-/// What a solid model can hold so far: every material model but nonlocal averaging
-/// (its neighbour search is the plane's), supports, loads, gravity and probes under
-/// statics, backward Euler and central differences; no contact (three-dimensional
-/// contact is its own work) and no bars. Each refusal names the field.
-fn solid_scope(s: &Scenario, mesh: &Mesh, materials: &[crate::material::Material]) -> Result<()> {
-    for block in &mesh.blocks {
-        let m = &materials[block.material];
-        let why = m
-            .nonlocal_radius()
-            .map(|_| "nonlocal averaging searches its neighbours in the plane");
-        if let Some(why) = why {
-            return Err(Error::config(
-                format!("materials.{}.model", m.name),
-                format!(
-                    "`{}` in a solid is not available yet: {why} (use it in plane stress or \
-                     strain, or a local model in the solid)",
-                    m.model_name()
-                ),
-            ));
-        }
-    }
+/// What a solid model can hold so far: every material model (nonlocal averaging
+/// included), bars, supports, loads, gravity and probes under statics, backward
+/// Euler and central differences; no contact (three-dimensional contact is its own
+/// work), refused naming the field.
+fn solid_scope(s: &Scenario) -> Result<()> {
     if !s.contact.is_empty() {
         return Err(Error::config(
             "contact[0]",
             "contact between solids is not available yet: three-dimensional models run \
              without contact",
-        ));
-    }
-    if !s.bars.is_empty() {
-        return Err(Error::config(
-            "bars[0]",
-            "bars in a solid are not available yet",
         ));
     }
     Ok(())
