@@ -9,8 +9,8 @@ use super::nonlocal::DRIVERS;
 use super::{Assembler, SharedValues};
 use crate::energy::Dissipation;
 use crate::fe::{
-    element, kinematics, stiffness_rule, strain, strain_solid, ElementKind, Plane, PointKinematics,
-    MAX_ELEMENT_DOFS, MAX_NODES,
+    element, kinematics_from, rule_shapes, stiffness_rule, strain, strain_solid, ElementKind,
+    Plane, PointKinematics, MAX_ELEMENT_DOFS, MAX_NODES,
 };
 use crate::halves::in_halves;
 use crate::material::store::{Committed, Layout, StateStore};
@@ -227,19 +227,33 @@ fn element_points<const D: usize, const V: usize, F>(
         return;
     }
     let rule = stiffness_rule(cx.kind);
+    let shapes = rule_shapes(cx.kind);
     // Element size for crack-band regularisation: the square root of its area (the
-    // cube root of its volume).
+    // cube root of its volume, `Σ w det J` over the points, whose kinematics a
+    // solid element evaluates first and keeps).
+    let mut solid_points = [PointKinematics::ZERO; 8];
     let length = if D == 3 {
-        element::measure(cx.kind, &x[..nn]).abs().cbrt()
+        let mut volume = 0.0;
+        for (q, &(_, wq)) in rule.iter().enumerate() {
+            solid_points[q] = kinematics_from(cx.kind, &x[..nn], &shapes[q]);
+            volume += wq * solid_points[q].det_j;
+        }
+        volume.abs().cbrt()
     } else {
         crate::mesh::polygon_area(&x[..nn]).abs().sqrt()
     };
     let ns = cx.mat.n_state_for(V);
     let mut scratch = [0.0; MAX_STATE];
-    for (q, &(xi, wq)) in rule.iter().enumerate() {
+    for (q, &(_, wq)) in rule.iter().enumerate() {
         let g = e * rule.len() + q;
-        let k = kinematics(cx.kind, &x[..nn], xi);
-        let eps = strain_v::<V>(&k, nn, &ue);
+        let plane_point;
+        let k = if D == 3 {
+            &solid_points[q]
+        } else {
+            plane_point = kinematics_from(cx.kind, &x[..nn], &shapes[q]);
+            &plane_point
+        };
+        let eps = strain_v::<V>(k, nn, &ue);
         let (eps_n, dt) = if cx.at_rest {
             // A vanishing step: rates are zero and history does not evolve.
             (eps, f64::MIN_POSITIVE)
@@ -289,7 +303,7 @@ fn element_points<const D: usize, const V: usize, F>(
                 &mut scratch[..ns],
             ),
         };
-        point(wq * k.det_j * cx.section, &resp, Some(&k), &x[..nn], pred);
+        point(wq * k.det_j * cx.section, &resp, Some(k), &x[..nn], pred);
     }
 }
 
@@ -541,7 +555,9 @@ impl Assembler {
                         let mut fe = [0.0; MAX_ELEMENT_DOFS];
                         let mut fe_pred = [0.0; MAX_ELEMENT_DOFS];
                         let nd = D * nodes.len();
-                        ke[..nd * nd].fill(0.0);
+                        if block_tangent {
+                            ke[..nd * nd].fill(0.0);
+                        }
                         let mut changed = !by_delta;
                         let mut q = 0;
                         element_points::<D, V, _>(

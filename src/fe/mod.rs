@@ -316,13 +316,68 @@ pub struct PointKinematics {
     pub det_j: f64,
 }
 
+/// Shape function values and reference derivatives at one point of a rule.
+pub type ReferenceShape = ([f64; MAX_NODES], [[f64; 3]; MAX_NODES]);
+
+/// [`shape`] at every point of `kind`'s stiffness rule, computed once per kind (the
+/// Gauss-point passes read them instead of evaluating the shape functions at every
+/// point of every element).
+pub fn rule_shapes(kind: ElementKind) -> &'static [ReferenceShape] {
+    use std::sync::OnceLock;
+    static TABLES: [OnceLock<Vec<ReferenceShape>>; 5] = [
+        OnceLock::new(),
+        OnceLock::new(),
+        OnceLock::new(),
+        OnceLock::new(),
+        OnceLock::new(),
+    ];
+    let slot = match kind {
+        ElementKind::Quad4 => 0,
+        ElementKind::Tri3 => 1,
+        ElementKind::Bar2 => 2,
+        ElementKind::Hex8 => 3,
+        ElementKind::Tet4 => 4,
+    };
+    TABLES[slot].get_or_init(|| {
+        if kind == ElementKind::Bar2 {
+            return Vec::new();
+        }
+        stiffness_rule(kind)
+            .iter()
+            .map(|&(xi, _)| shape(kind, xi))
+            .collect()
+    })
+}
+
+impl PointKinematics {
+    /// All zero (a placeholder to be overwritten).
+    pub const ZERO: PointKinematics = PointKinematics {
+        n: [0.0; MAX_NODES],
+        dndx: [[0.0; 3]; MAX_NODES],
+        det_j: 0.0,
+    };
+}
+
 /// Evaluates shape functions and physical gradients at `xi` for nodes `x`.
 #[inline]
 pub fn kinematics(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKinematics {
-    if kind.dim() == 3 {
-        return kinematics_solid(kind, x, xi);
+    kinematics_from(kind, x, &shape(kind, xi))
+}
+
+/// [`kinematics`] from the shape values and reference derivatives `reference` of the
+/// point (as [`rule_shapes`] holds them).
+#[inline]
+pub fn kinematics_from(
+    kind: ElementKind,
+    x: &[[f64; 3]],
+    reference: &ReferenceShape,
+) -> PointKinematics {
+    match kind {
+        ElementKind::Hex8 => return kinematics_solid::<8>(x, reference),
+        ElementKind::Tet4 => return kinematics_solid::<4>(x, reference),
+        _ => {}
     }
-    let (n2, d) = shape_plane(kind, [xi[0], xi[1]]);
+    let (n2, d) = reference;
     let nn = kind.nodes();
     let mut j = [[0.0; 2]; 2]; // j[i][k] = ∂x_i/∂ξ_k
     for a in 0..nn {
@@ -350,12 +405,14 @@ pub fn kinematics(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKinem
     PointKinematics { n, dndx, det_j }
 }
 
-/// [`kinematics`] of a solid kind: the 3x3 Jacobian inverted by cofactors.
+/// [`kinematics`] of a solid kind of `N` nodes: the 3x3 Jacobian inverted by
+/// cofactors (loops of a known length, which the compiler unrolls).
 #[inline]
-fn kinematics_solid(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKinematics {
-    let (n, d) = shape(kind, xi);
+fn kinematics_solid<const N: usize>(x: &[[f64; 3]], reference: &ReferenceShape) -> PointKinematics {
+    let (n, d) = reference;
+    let x = &x[..N];
     let mut j = [[0.0; 3]; 3]; // j[i][k] = ∂x_i/∂ξ_k
-    for a in 0..kind.nodes() {
+    for a in 0..N {
         for i in 0..3 {
             for k in 0..3 {
                 j[i][k] += x[a][i] * d[a][k];
@@ -365,12 +422,12 @@ fn kinematics_solid(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKin
     let (inv, det_j) = inverse3(&j);
     // ∂N_a/∂x_i = Σ_k ∂N_a/∂ξ_k (J⁻¹)_{k i}
     let mut dndx = [[0.0; 3]; MAX_NODES];
-    for a in 0..kind.nodes() {
+    for a in 0..N {
         for i in 0..3 {
             dndx[a][i] = d[a][0] * inv[0][i] + d[a][1] * inv[1][i] + d[a][2] * inv[2][i];
         }
     }
-    PointKinematics { n, dndx, det_j }
+    PointKinematics { n: *n, dndx, det_j }
 }
 
 /// The inverse and determinant of a 3x3 matrix (cofactors; the inverse is not
