@@ -1,0 +1,211 @@
+//! The two QP paths of the contact correction: the condensed dual on the factor
+//! (the default, with friction's cone programs) and the primal QP over all free
+//! dofs (the frictionless reference). Each leaves its `δ` in `delta0` and the
+//! multipliers of its rows in `lambda_rows`.
+
+use std::time::Instant;
+
+use super::{ContactCorrection, GUESS_GAP_TOLERANCE};
+use crate::contact::qp::{primal_qp, solve_by_active_set, QpStats};
+use crate::error::Result;
+use crate::system::EffectiveSystem;
+
+impl ContactCorrection<'_> {
+    /// The condensed dual on the `m` rows of `g` chosen: `W = G A⁻¹ Gᵀ` (from the kept
+    /// compliance or a blocked solve), the QP (on the last active set first, or the
+    /// Coulomb cone programs with friction), and `δ = δ₀ + A⁻¹Gᵀλ` into `delta0`.
+    /// The inner error is the QP's failure, for the step to be cut.
+    pub(super) fn condensed(
+        &mut self,
+        sys: &mut EffectiveSystem,
+        g: &nalgebra_sparse::CsrMatrix<f64>,
+        m: usize,
+    ) -> Result<std::result::Result<(), String>> {
+        let nf = self.dofs.free.len();
+        let t = Instant::now();
+        // S pays once the factor has outlived a QP (theory/contact.md).
+        let generation = sys.factorizations();
+        let compliant = self.compliance.is_current(sys) || self.qp_generation == generation;
+        self.qp_generation = generation;
+        if compliant {
+            self.needed.clear();
+            for &i in &self.rows {
+                self.needed.extend_from_slice(g.row(i).col_indices());
+            }
+            self.compliance.cover(sys, &self.needed)?;
+            self.stats.compliant += 1;
+            self.w.clear();
+            self.w.resize(m * m, 0.0);
+            for (j, &ij) in self.rows.iter().enumerate() {
+                let rj = g.row(ij);
+                for (k, &ik) in self.rows.iter().enumerate().skip(j) {
+                    let rk = g.row(ik);
+                    let mut w = 0.0;
+                    for (&e, v) in rk.col_indices().iter().zip(rk.values()) {
+                        for (&f, u) in rj.col_indices().iter().zip(rj.values()) {
+                            w += v * u * self.compliance.at(e, f);
+                        }
+                    }
+                    self.w[k + j * m] = w;
+                    self.w[j + k * m] = w;
+                }
+            }
+        } else {
+            self.y.clear();
+            self.y.resize(nf * m, 0.0);
+            for (j, &i) in self.rows.iter().enumerate() {
+                let row = g.row(i);
+                for (&e, v) in row.col_indices().iter().zip(row.values()) {
+                    self.y[j * nf + e] += v;
+                }
+            }
+            sys.solve_block(&mut self.y, m)?;
+            self.w.clear();
+            self.w.resize(m * m, 0.0);
+            for j in 0..m {
+                let yj = &self.y[j * nf..(j + 1) * nf];
+                for (k, &i) in self.rows.iter().enumerate() {
+                    let row = g.row(i);
+                    self.w[k + j * m] = row
+                        .col_indices()
+                        .iter()
+                        .zip(row.values())
+                        .map(|(&e, v)| v * yj[e])
+                        .sum();
+                }
+            }
+        }
+        self.stats.w_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        // The previous active set first: accepted only if it satisfies the
+        // KKT conditions, so the QP's solution either way.
+        self.guess.clear();
+        for (j, &i) in self.rows[..self.normal_rows].iter().enumerate() {
+            if self.previous.binary_search(&self.cands[i].key()).is_ok() {
+                self.guess.push(j);
+            }
+        }
+        let gap_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let slip_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let r = if !self.cones.is_empty()
+            && crate::contact::coulomb::solve_by_guess(
+                &self.w,
+                &self.c,
+                self.normal_rows,
+                &self.cones,
+                &self.pressed,
+                &self.guess_t,
+                slip_tol,
+                &mut self.lambda_rows,
+            ) {
+            self.stats.guessed += 1;
+            self.stats.frictional += 1;
+            self.stats.friction_guessed += 1;
+            Ok(QpStats::default())
+        } else if !self.cones.is_empty() {
+            let r = crate::contact::coulomb::solve(
+                &self.w,
+                &self.c,
+                self.normal_rows,
+                &self.cones,
+                &mut self.lambda_rows,
+            );
+            if let Ok(q) = &r {
+                self.stats.frictional += 1;
+                self.stats.cone_programs += q.programs as usize;
+            }
+            r
+        } else if !self.guess.is_empty()
+            && solve_by_active_set(
+                &self.w,
+                &self.c,
+                &mut self.guess,
+                gap_tol,
+                &mut self.lambda_rows,
+                &mut self.guess_work,
+            )
+        {
+            self.stats.guessed += 1;
+            Ok(QpStats::default())
+        } else {
+            self.dual.solve(&self.w, &self.c, &mut self.lambda_rows)
+        };
+        self.stats.qp_s += t.elapsed().as_secs_f64();
+        if r.is_ok() {
+            if compliant {
+                // δ = δ₀ + A⁻¹Gᵀλ: one solve of a right-hand side on the
+                // contact dofs (its forward sweep over their reach only).
+                self.push_entries.clear();
+                for (j, &i) in self.rows.iter().enumerate() {
+                    let row = g.row(i);
+                    for (&e, v) in row.col_indices().iter().zip(row.values()) {
+                        self.push_entries.push((e, self.lambda_rows[j] * v));
+                    }
+                }
+                self.push.clear();
+                self.push.resize(nf, 0.0);
+                sys.solve_sparse(&self.push_entries, &mut self.push)?;
+                for (d, p) in self.delta0.iter_mut().zip(&self.push) {
+                    *d += p;
+                }
+            } else {
+                for (j, &l) in self.lambda_rows.iter().enumerate() {
+                    if l != 0.0 {
+                        let yj = &self.y[j * nf..(j + 1) * nf];
+                        for (d, y) in self.delta0.iter_mut().zip(yj) {
+                            *d += l * y;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(r.map(|_| ()))
+    }
+
+    /// The primal QP over all free dofs (the frictionless reference), its `δ` into
+    /// `delta0`.
+    pub(super) fn full(
+        &mut self,
+        sys: &EffectiveSystem,
+        g: &nalgebra_sparse::CsrMatrix<f64>,
+        rhs: &[f64],
+    ) -> std::result::Result<(), String> {
+        let free = &self.dofs.free;
+        debug_assert!(self.cones.is_empty(), "validation: friction is condensed");
+        let t = Instant::now();
+        let r_free: Vec<f64> = free
+            .iter()
+            .zip(rhs.iter())
+            .map(|(&d, &b)| self.f_c[d] - b)
+            .collect();
+        let gaps: Vec<f64> = self.rows.iter().map(|&i| self.gaps[i]).collect();
+        let row_entries: Vec<Vec<(usize, f64)>> = self
+            .rows
+            .iter()
+            .map(|&i| {
+                let row = g.row(i);
+                row.col_indices()
+                    .iter()
+                    .copied()
+                    .zip(row.values().iter().copied())
+                    .collect()
+            })
+            .collect();
+        let mut delta = Vec::new();
+        let sigma = self.delta0.iter().fold(self.tol, |a, x| a.max(x.abs()));
+        let r = primal_qp(
+            sys.matrix(),
+            &r_free,
+            &gaps,
+            &row_entries,
+            sigma,
+            &mut delta,
+            &mut self.lambda_rows,
+        );
+        self.stats.qp_s += t.elapsed().as_secs_f64();
+        if r.is_ok() {
+            self.delta0.copy_from_slice(&delta);
+        }
+        r.map(|_| ())
+    }
+}
