@@ -79,7 +79,7 @@ fn element_updates(c: &mut Criterion) {
                             m.plane,
                             PointPass {
                                 u: &u,
-                                dt: m.analysis.dt,
+                                dt: m.analysis.time.dt,
                                 at_rest: false,
                                 frozen: false,
                             },

@@ -57,7 +57,7 @@ fn steps(c: &mut Criterion) {
             let m = model(file, size, variant, full);
             let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
             let mut s0: State = be.initial_state();
-            while s0.t < BEFORE_IMPACT - 0.5 * m.analysis.dt {
+            while s0.t < BEFORE_IMPACT - 0.5 * m.analysis.time.dt {
                 be.step_accepted(&mut s0).unwrap();
             }
             g.bench_with_input(BenchmarkId::new(file, name), &(), |b, _| {

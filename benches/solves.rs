@@ -44,7 +44,7 @@ fn triad(c: &mut Criterion) {
 
 fn w1_factor(ny: usize) -> (FaerCholesky, usize, usize) {
     let model = rothe::workload::w1(ny).unwrap();
-    let h = model.analysis.dt;
+    let h = model.analysis.time.dt;
     let a = rothe::workload::effective_matrix(&model, 1.0 / (h * h), 1.0);
     let mut f = FaerCholesky::new();
     f.analyze(&a).unwrap();

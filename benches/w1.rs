@@ -38,7 +38,7 @@ fn factorisation_and_step(c: &mut Criterion) {
         let model = rothe::workload::w1(ny).unwrap();
         let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
         g.bench_with_input(BenchmarkId::new("refactorize", ny), &ny, |b, _| {
-            b.iter(|| be.set_step(model.analysis.dt).unwrap())
+            b.iter(|| be.set_step(model.analysis.time.dt).unwrap())
         });
         let mut s = be.initial_state();
         g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| {
@@ -56,7 +56,7 @@ fn sls(c: &mut Criterion) {
     for ny in [25usize, 100] {
         for state in [ViscoelasticState::Nodal, ViscoelasticState::Points] {
             let mut model = rothe::workload::w1_with(ny, rothe::workload::W1_SLS).unwrap();
-            model.analysis.viscoelastic_state = state;
+            model.analysis.time.viscoelastic_state = state;
             let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
             let mut s = be.initial_state();
             let name = format!("step_{state:?}").to_lowercase();

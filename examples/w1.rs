@@ -41,7 +41,7 @@ fn main() -> rothe::Result<()> {
     let t0 = Instant::now();
     let variant = args.get(2).map(String::as_str).unwrap_or("elastic");
     let mut model = rothe::workload::w1_variant(ny, variant)?;
-    model.analysis.ordering = match args.get(3).map(String::as_str) {
+    model.analysis.iteration.ordering = match args.get(3).map(String::as_str) {
         None | Some("auto") => rothe::model::Ordering::Auto,
         Some("amd") => rothe::model::Ordering::Amd,
         Some("nested_dissection") => rothe::model::Ordering::NestedDissection,

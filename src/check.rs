@@ -114,7 +114,7 @@ pub fn volume(model: &Model) -> Volume {
     // A row: 12 ledger columns, 2 solver columns, 2 per probe, about 20 bytes each.
     let row_bytes = (16 + 2 * probes) as u64 * 20;
     let history = (steps + 1, (steps as u64 + 1) * row_bytes);
-    let vtk_files = steps.checked_div(a.vtk_every).map_or(0, |k| k + 1);
+    let vtk_files = steps.checked_div(a.output.vtk_every).map_or(0, |k| k + 1);
     // Points (3 doubles), connectivity, two vector fields, cell fields, as ASCII.
     let vtk_file_bytes =
         (mesh.n_nodes() as u64) * (3 + 3 + 3) * 24 + (mesh.n_elements() as u64) * (5 + 6) * 24;
@@ -123,7 +123,7 @@ pub fn volume(model: &Model) -> Volume {
     if steps >= crate::config::HUGE_STEPS {
         warnings.push(format!(
             "{steps} steps: is dt ({:e} s) meant? t_end / dt sets the step count",
-            a.dt
+            a.time.dt
         ));
     }
     if history.1 + vtk.1 >= HUGE_OUTPUT {
@@ -153,7 +153,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         &pattern,
         dofs,
         Backend::Faer,
-        model.analysis.ordering,
+        model.analysis.iteration.ordering,
         &mesh.coords,
     )?;
     let nnz_l = system.factor_nnz().unwrap_or(0);
@@ -167,8 +167,8 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         mut warnings,
     } = volume(model);
     warnings.extend(model.warnings.iter().cloned());
-    let cfl =
-        crate::time::cfl::critical_step(model).map(|c| (c.dt, c.block, c.element, a.dt / c.dt));
+    let cfl = crate::time::cfl::critical_step(model)
+        .map(|c| (c.dt, c.block, c.element, a.time.dt / c.dt));
     Ok(Report {
         bodies: model
             .bodies
@@ -192,15 +192,15 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         nodes: mesh.n_nodes(),
         elements: mesh.n_elements(),
         dofs: (mesh.n_dofs(), system.dofs().n_free()),
-        steps: (steps, a.dt, a.t_end),
+        steps: (steps, a.time.dt, a.time.t_end),
         history,
         vtk,
         cfl,
         stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
-        scheme: (a.kind == crate::model::AnalysisKind::Dynamic).then_some(a.scheme),
-        iteration: (a.scheme == crate::model::TimeScheme::BackwardEuler
+        scheme: (a.time.kind == crate::model::AnalysisKind::Dynamic).then_some(a.time.scheme),
+        iteration: (a.time.scheme == crate::model::TimeScheme::BackwardEuler
             && model.materials.iter().any(|m| !m.has_constant_tangent()))
-        .then_some((a.iteration, a.refactor_rate)),
+        .then_some((a.iteration.method, a.iteration.refactor_rate)),
         nnz: (system.matrix().row_idx.len(), nnz_l),
         nested_dissection: system.nested_dissection(),
         memory,

@@ -161,9 +161,24 @@ pub enum AnalysisKind {
     Static,
 }
 
-/// Time stepping and damping settings.
+/// The analysis settings, one struct per concern.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Analysis {
+    /// What is integrated in time and how.
+    pub time: TimeSettings,
+    /// Mass and Rayleigh damping.
+    pub damping: Damping,
+    /// The equilibrium iterations of the implicit schemes and the solves they make.
+    pub iteration: IterationSettings,
+    /// Impenetrability.
+    pub contact: ContactSettings,
+    /// What a run writes besides its history.
+    pub output: OutputSettings,
+}
+
+/// Time stepping.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeSettings {
     /// Static or dynamic.
     pub kind: AnalysisKind,
     /// The dynamic scheme.
@@ -176,12 +191,22 @@ pub struct Analysis {
     pub t_end: f64,
     /// Lumped (row-sum) instead of consistent mass.
     pub lumped_mass: bool,
+    /// Where the implicit schemes keep the state of linear viscoelastic materials.
+    pub viscoelastic_state: ViscoelasticState,
+}
+
+/// Damping `C = ζ M + a_m M + a_k K`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Damping {
     /// Mass damping factor `zeta` of eq. (4): `C = zeta M`.
     pub zeta: f64,
     /// Rayleigh damping `C += a_m M + a_k K`.
     pub rayleigh: [f64; 2],
-    /// Write VTK every this many steps (0: never).
-    pub vtk_every: usize,
+}
+
+/// Equilibrium iterations, step cuts and the factorisations they use.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IterationSettings {
     /// Relative residual tolerance of equilibrium iterations.
     pub tolerance: f64,
     /// Iteration limit per step.
@@ -189,7 +214,7 @@ pub struct Analysis {
     /// Relative tolerance on the last displacement correction.
     pub displacement_tolerance: f64,
     /// How a state-dependent tangent is followed.
-    pub iteration: IterationMethod,
+    pub method: IterationMethod,
     /// Keep the factor while the iterations converge on it (`refactor_rate`), or
     /// refactorise whenever the tangent changed (`None`).
     pub refactor_rate: Option<f64>,
@@ -197,12 +222,22 @@ pub struct Analysis {
     pub max_cuts: usize,
     /// Fill-reducing ordering for the faer backend.
     pub ordering: Ordering,
+}
+
+/// Contact settings of the analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactSettings {
     /// Largest penetration a contact step accepts (m).
-    pub contact_tolerance: f64,
+    pub tolerance: f64,
     /// How the contact QP is solved.
-    pub contact_qp: ContactQp,
-    /// Where the implicit schemes keep the state of linear viscoelastic materials.
-    pub viscoelastic_state: ViscoelasticState,
+    pub qp: ContactQp,
+}
+
+/// Output settings of the analysis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputSettings {
+    /// Write VTK every this many steps (0: never).
+    pub vtk_every: usize,
 }
 
 /// Fill-reducing ordering of the effective matrix. Nested dissection is handed to
@@ -265,7 +300,7 @@ pub const DEFAULT_REFACTOR_RATE: f64 = 0.1;
 impl Analysis {
     /// Number of steps `m = round(T / h)`.
     pub fn n_steps(&self) -> usize {
-        (self.t_end / self.dt).round().max(1.0) as usize
+        (self.time.t_end / self.time.dt).round().max(1.0) as usize
     }
 }
 

@@ -137,7 +137,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         elements: model.mesh.n_elements(),
         steps: 0,
         t_end: 0.0,
-        dt: a.dt,
+        dt: a.time.dt,
         materials: model
             .materials
             .iter()
@@ -152,7 +152,8 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             backend: opts.backend.name().into(),
             factorizations: 0,
             reused_factors: 0,
-            keep_factor: a.scheme == TimeScheme::BackwardEuler && a.refactor_rate.is_some(),
+            keep_factor: a.time.scheme == TimeScheme::BackwardEuler
+                && a.iteration.refactor_rate.is_some(),
             fallbacks: 0,
             iterations: 0,
             iterations_per_step: 0.0,
@@ -168,7 +169,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
     // blocking on it for each pass (which costs a pair of futex calls per pass and
     // keeps one more thread than cores runnable).
     let result = rayon::scope(|_| {
-        catch_unwind(AssertUnwindSafe(|| match (a.kind, a.scheme) {
+        catch_unwind(AssertUnwindSafe(|| match (a.time.kind, a.time.scheme) {
             (AnalysisKind::Dynamic, TimeScheme::CentralDifference) => CentralDifference::new(model)
                 .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
             (AnalysisKind::Dynamic, TimeScheme::BackwardEuler) => {
@@ -274,7 +275,7 @@ fn integrate<I: Integrator>(
     summary: &mut Summary,
 ) -> Result<()> {
     let mut s = integrator.initial_state()?;
-    let vtk_every = model.analysis.vtk_every;
+    let vtk_every = model.analysis.output.vtk_every;
     // The Gauss-point state of a step the VTK series writes, when `s` keeps it in
     // nodal fields.
     let output_points = |integrator: &I, s: &State| {
@@ -290,7 +291,7 @@ fn integrate<I: Integrator>(
     let mut last_write = Instant::now();
     let n_steps = model.analysis.n_steps();
     let pb = progress(n_steps, opts.progress);
-    let t_end = model.analysis.t_end;
+    let t_end = model.analysis.time.t_end;
     let mut counts = Counts::default();
     let mut step_cuts = 0;
     let control = StepControl::of(model);

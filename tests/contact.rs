@@ -45,7 +45,7 @@ fn a_block_resting_on_a_block_carries_its_weight() {
     let m = model(&text);
     let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
     let mut s = be.initial_state();
-    let tol = m.analysis.contact_tolerance;
+    let tol = m.analysis.contact.tolerance;
     for _ in 0..m.analysis.n_steps() {
         be.step_accepted(&mut s).unwrap();
         assert!(
@@ -95,7 +95,7 @@ fn bar_impact(h: f64, qp: &str) -> (f64, f64, f64, f64, f64) {
     let p0 = momentum(&m, &s, 0, &mass, 0).0 + momentum(&m, &s, 1, &mass, 0).0;
     let (mut t_on, mut t_off, mut plateau, mut count) = (None, None, 0.0, 0);
     let mut dp: f64 = 0.0;
-    let tol = m.analysis.contact_tolerance;
+    let tol = m.analysis.contact.tolerance;
     for _ in 0..m.analysis.n_steps() {
         be.step_accepted(&mut s).unwrap();
         let f = s.contact.pairs[0].force;
@@ -170,7 +170,7 @@ fn the_condensed_and_the_full_qp_give_the_same_forces() {
     let run = |qp: &str| {
         let m = model(&bars(2e-6, qp));
         assert_eq!(
-            m.analysis.contact_qp,
+            m.analysis.contact.qp,
             if qp == "full" {
                 ContactQp::Full
             } else {
@@ -185,7 +185,7 @@ fn the_condensed_and_the_full_qp_give_the_same_forces() {
             for (_, l) in &s.contact.active {
                 assert!(*l >= 0.0);
             }
-            assert!(s.contact.pairs[0].penetration <= m.analysis.contact_tolerance);
+            assert!(s.contact.pairs[0].penetration <= m.analysis.contact.tolerance);
             forces.push(s.contact.active.clone());
         }
         forces
@@ -221,7 +221,7 @@ fn a_beam_dropped_on_unilateral_supports_bounces_off_them() {
             "a support pulls"
         );
         for p in &s.contact.pairs {
-            assert!(p.penetration <= m.analysis.contact_tolerance);
+            assert!(p.penetration <= m.analysis.contact.tolerance);
         }
         let (p, mm) = momentum(&m, &s, 0, &mass, 1);
         if f > 0.0 {
@@ -347,7 +347,7 @@ fn contact_ledgers_close_with_every_material_model() {
                 prev = *d;
                 u_prev.clone_from(&s.u);
                 max_force = max_force.max(s.contact.pairs[0].force);
-                assert!(s.contact.pairs[0].penetration <= m.analysis.contact_tolerance);
+                assert!(s.contact.pairs[0].penetration <= m.analysis.contact.tolerance);
                 Ok(())
             },
         )
@@ -600,7 +600,7 @@ fn check_writes_the_matrices_and_the_gap_rows_in_matrix_market() {
         .collect();
     let nf = free.len();
     assert_eq!((k_eff.nrows(), nf), (n - m.constraints.len(), nf));
-    let h = m.analysis.dt;
+    let h = m.analysis.time.dt;
     for (a, &i) in free.iter().enumerate() {
         for (b, &j) in free.iter().enumerate() {
             let want = md[i * n + j] / (h * h) + kd[i * n + j];
@@ -688,7 +688,7 @@ fn a_rigid_mass_hitting_a_wall_splits_its_energy_as_the_closed_form_says() {
             let d = s.ledger.dissipated();
             steps.push((d.contact, d.numerical, s.ledger.kinetic()));
             assert!(s.ledger.relative_residual() < 1e-9);
-            assert!(s.contact.pairs[0].penetration <= model.analysis.contact_tolerance);
+            assert!(s.contact.pairs[0].penetration <= model.analysis.contact.tolerance);
         }
         eprintln!("θ = {theta}: (D_contact, D_num, E_kin) after each step {steps:?}");
         let close = |got: f64, want: f64, what: &str| {

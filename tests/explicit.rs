@@ -99,7 +99,7 @@ fn a_step_just_above_the_mesh_limit_blows_up_and_just_below_does_not() {
     eprintln!("paper {paper:.4e} s, element bound {bound:.4e} s, mesh {exact:.4e} s");
     assert!(paper <= bound && bound <= exact * (1.0 + 1e-9));
     // The default step is ω times the paper's estimate.
-    assert!((m.analysis.dt - 0.9 * paper).abs() < 1e-15);
+    assert!((m.analysis.time.dt - 0.9 * paper).abs() < 1e-15);
     // 2 % below the mesh's limit: bounded for 4000 steps; 2 % above: it blows up.
     let below = load(&plate(Some(0.98 * exact), 4000.0 * 0.98 * exact), true).unwrap();
     let (drift, finite) = energy_drift(&below);
@@ -305,7 +305,7 @@ fn two_bars_collide_as_1d_wave_theory_says_and_conserve_momentum() {
             assert!(s.ledger.residual().abs() <= 1e-11 * s.ledger.scale());
             let f = s.contact.pairs[0].force;
             if f > 0.0 {
-                t_on.get_or_insert(s.t - m.analysis.dt);
+                t_on.get_or_insert(s.t - m.analysis.time.dt);
                 t_off = Some(s.t);
                 if s.t > 1e-4 && s.t < 3e-4 {
                     plateau += f;
@@ -319,7 +319,7 @@ fn two_bars_collide_as_1d_wave_theory_says_and_conserve_momentum() {
         let (pt, mt) = momentum(&m, &s, &mass, 1);
         eprintln!(
             "omega {omega}: h = {:.3e} s, duration {duration:.4e} s, plateau {plateau:.5e} N, striker {:.4} m/s, target {:.4} m/s, D_contact {:.4e} J",
-            m.analysis.dt,
+            m.analysis.time.dt,
             ps / ms,
             pt / mt,
             s.ledger.dissipated().contact
@@ -507,7 +507,7 @@ fn both_paths_agree_as_both_steps_shrink() {
         let (pe, de) = peak_and_loss(&mut CentralDifference::new(&me).unwrap());
         eprintln!(
             "implicit h = {h:e}: peak {pi:.5e} m, loss {di:.3} J; explicit h = {:.3e}: peak {pe:.5e} m, loss {de:.3} J",
-            me.analysis.dt
+            me.analysis.time.dt
         );
         diffs.push(((pi - pe).abs() / pe, (di - de).abs() / de));
     }
@@ -576,7 +576,7 @@ fn explicit_ledgers_close_with_every_material_model() {
         let d = s.ledger.dissipated();
         eprintln!(
             "{name}: h = {:.3e} s, D_contact {:.3} J, D_num {:.3} J, material {:.3} J of E_kin0 {:.1} J, max force {max_force:.3e} N",
-            m.analysis.dt,
+            m.analysis.time.dt,
             d.contact,
             d.numerical,
             d.material(),

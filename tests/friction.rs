@@ -132,7 +132,7 @@ fn a_block_on_an_incline_slides_with_the_closed_form_acceleration() {
         "{d:e} against {closed:e}"
     );
     // Sliding keeps every node on the line.
-    assert!(s.contact.pairs[0].penetration <= m.analysis.contact_tolerance);
+    assert!(s.contact.pairs[0].penetration <= m.analysis.contact.tolerance);
     assert!(s.contact.slip.iter().any(|&x| x > 0.5 * u));
 }
 
@@ -332,7 +332,7 @@ fn a_block_pressed_onto_a_floor_in_statics_is_held_by_contact_and_friction() {
         "{rec:?}"
     );
     assert!(rec.sticking > 0 && rec.slipping == 0, "{rec:?}");
-    assert!(rec.penetration <= m.analysis.contact_tolerance);
+    assert!(rec.penetration <= m.analysis.contact.tolerance);
     // The block rests: its mean sideways displacement is elastic (micrometres).
     let (_, u) = mean_x(&m, &s);
     assert!(u.abs() < 1e-6, "u = {u:e}");

@@ -195,8 +195,8 @@ fn exercise_scenario(text: &str, dir: &Path) -> Result<(), String> {
     if rothe::check::report(&model, Some(LIMIT)).is_err() {
         return Ok(());
     }
-    let mut integrator: Box<dyn Integrator> = match model.analysis.kind {
-        AnalysisKind::Dynamic if model.analysis.scheme == TimeScheme::CentralDifference => {
+    let mut integrator: Box<dyn Integrator> = match model.analysis.time.kind {
+        AnalysisKind::Dynamic if model.analysis.time.scheme == TimeScheme::CentralDifference => {
             match CentralDifference::new(&model) {
                 Ok(i) => Box::new(i),
                 Err(_) => return Ok(()),

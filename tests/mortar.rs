@@ -161,9 +161,9 @@ fn impact(formulation: &str) -> (f64, f64, f64, f64) {
         be.step_accepted(&mut s).unwrap();
         peak = peak.max(-s.u[2 * probe + 1]);
         let f = s.contact.pairs[0].force;
-        impulse += f * m.analysis.dt;
+        impulse += f * m.analysis.time.dt;
         max_force = max_force.max(f);
-        assert!(s.contact.pairs[0].penetration <= m.analysis.contact_tolerance);
+        assert!(s.contact.pairs[0].penetration <= m.analysis.contact.tolerance);
     }
     (
         peak,

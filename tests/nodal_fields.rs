@@ -178,8 +178,8 @@ fn nodal_fields_follow_a_step_change_and_statics() {
     let (mut sa, mut sb) = (a.initial_state(), b.initial_state());
     for k in 0..30 {
         if k == 10 {
-            a.set_step(0.5 * ma.analysis.dt).unwrap();
-            b.set_step(0.5 * mb.analysis.dt).unwrap();
+            a.set_step(0.5 * ma.analysis.time.dt).unwrap();
+            b.set_step(0.5 * mb.analysis.time.dt).unwrap();
         }
         a.step_accepted(&mut sa).unwrap();
         b.step_accepted(&mut sb).unwrap();
@@ -242,7 +242,7 @@ fn vtk_of_the_nodal_path_has_the_stress_of_the_gauss_point_path() {
     let mut arrays = Vec::new();
     for state in ["nodal", "points"] {
         let mut m = beam(MODELS[2], "lumped", state);
-        m.analysis.vtk_every = 10;
+        m.analysis.output.vtk_every = 10;
         let out = dir.path().join(state);
         let summary =
             rothe::run::run(&m, &rothe::run::RunOptions::new(&out, Backend::Faer)).unwrap();

@@ -371,8 +371,8 @@ fn iterations_on_a_kept_factor_reach_full_newtons_answer_over_a_large_yielded_zo
         let mut runs = Vec::new();
         for rate in [None, Some(rothe::model::DEFAULT_REFACTOR_RATE)] {
             let mut model = loaded_cantilever(name, from, to);
-            model.analysis.refactor_rate = rate;
-            let tolerance = model.analysis.tolerance;
+            model.analysis.iteration.refactor_rate = rate;
+            let tolerance = model.analysis.iteration.tolerance;
             let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
             let mut s = be.initial_state();
             let mut iterations = 0;

@@ -139,7 +139,7 @@ fn compare_with_references(cases: &[(&str, f64)], kept: bool) {
     for &(name, tol) in cases {
         let mut model = rothe::config::load(&dir().join(format!("{name}.toml"))).unwrap();
         if !kept {
-            model.analysis.refactor_rate = None;
+            model.analysis.iteration.refactor_rate = None;
         }
         let out = tmp.path().join(name);
         run(

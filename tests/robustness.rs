@@ -729,7 +729,7 @@ fn a_body_crossing_a_master_within_one_step_is_caught_by_both_paths() {
                         - tol
                 };
                 assert!(
-                    s.contact.pairs[0].penetration <= m.analysis.contact_tolerance,
+                    s.contact.pairs[0].penetration <= m.analysis.contact.tolerance,
                     "rigid {rigid}, {scheme}, step {step}: penetration {}",
                     s.contact.pairs[0].penetration
                 );
@@ -1116,21 +1116,31 @@ fn the_kept_factor_settings_are_checked_and_default_by_the_kind_of_analysis() {
     let load = |text: &str| rothe::config::from_str(text, Path::new(".")).unwrap();
     let dynamic = load(&good());
     assert_eq!(
-        dynamic.analysis.refactor_rate,
+        dynamic.analysis.iteration.refactor_rate,
         Some(rothe::model::DEFAULT_REFACTOR_RATE)
     );
     assert_eq!(
-        load(&with("refactor_rate = 0.3")).analysis.refactor_rate,
+        load(&with("refactor_rate = 0.3"))
+            .analysis
+            .iteration
+            .refactor_rate,
         Some(0.3)
     );
     assert_eq!(
-        load(&with("keep_factor = false")).analysis.refactor_rate,
+        load(&with("keep_factor = false"))
+            .analysis
+            .iteration
+            .refactor_rate,
         None
     );
     let statics = good().replace("[analysis]", "[analysis]\nkind = \"static\"");
-    assert_eq!(load(&statics).analysis.refactor_rate, None);
+    assert_eq!(load(&statics).analysis.iteration.refactor_rate, None);
     let kept_statics = statics.replace("vtk_every = 5", "vtk_every = 5\nkeep_factor = true");
-    assert!(load(&kept_statics).analysis.refactor_rate.is_some());
+    assert!(load(&kept_statics)
+        .analysis
+        .iteration
+        .refactor_rate
+        .is_some());
     // `check` says how the steps will iterate.
     let mazars = good().replace(
         "model = \"elastic\"",

@@ -525,9 +525,9 @@ fn bar_end(cells: usize, dt: f64, steps: usize, p: f64) -> (f64, rothe::time::St
         &mut f,
     );
     model.loads.push(load_from(&f, TimeFunction::Constant));
-    model.analysis.kind = rothe::model::AnalysisKind::Dynamic;
-    model.analysis.dt = dt;
-    model.analysis.t_end = dt * steps as f64;
+    model.analysis.time.kind = rothe::model::AnalysisKind::Dynamic;
+    model.analysis.time.dt = dt;
+    model.analysis.time.t_end = dt * steps as f64;
     let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
     let mut s = be.initial_state();
     for _ in 0..steps {

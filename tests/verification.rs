@@ -265,10 +265,10 @@ fn bar_model(lumped: bool, dt: f64, t_end: f64) -> rothe::model::Model {
             phase: 0.0,
         },
     ));
-    model.analysis.kind = AnalysisKind::Dynamic;
-    model.analysis.lumped_mass = lumped;
-    model.analysis.dt = dt;
-    model.analysis.t_end = t_end;
+    model.analysis.time.kind = AnalysisKind::Dynamic;
+    model.analysis.time.lumped_mass = lumped;
+    model.analysis.time.dt = dt;
+    model.analysis.time.t_end = t_end;
     model
 }
 
@@ -593,7 +593,7 @@ fn orderings_give_the_same_solution() {
     ] {
         let part = structured::rectangle([0.0, 0.0], [5.0, 0.5], 200, 20, ElementKind::Quad4);
         let mut model = model_of(&part, Plane::Stress, 30e9, 0.25, 2400.0, 0.1);
-        model.analysis.ordering = ordering;
+        model.analysis.iteration.ordering = ordering;
         let left = model.mesh.node_sets["b.left"].clone();
         prescribe(&mut model, &left, 0, |_| 0.0);
         prescribe(&mut model, &left, 1, |_| 0.0);

@@ -182,7 +182,7 @@ impl<'m> KinematicContact<'m> {
         self.rigid.beneath = super::detect::beneath_rigid(
             &self.model.contacts,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact_tolerance,
+            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
             &self.rigid.beneath,
         );
         // Slaves on a rigid line stay on it a little past its ends.
@@ -190,7 +190,7 @@ impl<'m> KinematicContact<'m> {
         self.rigid.held = super::detect::held_rigid(
             &self.model.contacts,
             |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact_tolerance,
+            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
             &previous,
         );
         self.collisions(u, v, h);

@@ -65,7 +65,7 @@ impl Recorder {
             &pair_names,
             model.mesh.dim,
         )?;
-        let vtk = if model.analysis.vtk_every > 0 {
+        let vtk = if model.analysis.output.vtk_every > 0 {
             Some(VtkSeries::new(out, &model.mesh)?)
         } else {
             None
@@ -77,7 +77,7 @@ impl Recorder {
         Ok(Recorder {
             history,
             vtk,
-            vtk_every: model.analysis.vtk_every,
+            vtk_every: model.analysis.output.vtk_every,
             probes,
             samples: Vec::with_capacity(model.probes.len()),
             contact: pair_names

@@ -104,7 +104,7 @@ pub fn halvings(scenario: &Path, base: &Overrides, n: usize) -> Result<Vec<f64>>
         ));
     }
     let model = load_with_overrides(scenario, &LoadOptions::default(), base)?;
-    let h = model.analysis.dt;
+    let h = model.analysis.time.dt;
     Ok((0..=n).map(|k| h / f64::powi(2.0, k as i32)).collect())
 }
 

@@ -42,9 +42,9 @@ impl<'m> BackwardEuler<'m> {
     ) -> Result<Self> {
         let a = &model.analysis;
         let scheme = Scheme::BackwardEuler {
-            h: a.dt,
-            damp_m: a.zeta + a.rayleigh[0],
-            damp_k: a.rayleigh[1],
+            h: a.time.dt,
+            damp_m: a.damping.zeta + a.damping.rayleigh[0],
+            damp_k: a.damping.rayleigh[1],
         };
         Ok(BackwardEuler {
             core: Core::new(model, backend, scheme, memory_limit)?,

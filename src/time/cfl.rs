@@ -74,7 +74,7 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
     let mut seen: HashMap<(usize, Vec<i64>), f64> = HashMap::new();
     for (bi, b) in mesh.blocks.iter().enumerate() {
         let m = &model.materials[b.material];
-        let a_k = model.analysis.rayleigh[1];
+        let a_k = model.analysis.damping.rayleigh[1];
         for e in 0..b.elements.len() {
             let nodes = b.elements.element(e);
             let x: Vec<[f64; 3]> = nodes.iter().map(|&n| mesh.coords[n]).collect();

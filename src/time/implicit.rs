@@ -666,13 +666,13 @@ fn finish(
 /// but not factorised (the tangent at rest for materials with history).
 pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, EffectiveSystem)> {
     let a = &model.analysis;
-    let scheme = match a.kind {
+    let scheme = match a.time.kind {
         crate::model::AnalysisKind::Dynamic => Scheme::BackwardEuler {
-            h: a.dt,
-            damp_m: a.zeta + a.rayleigh[0],
-            damp_k: a.rayleigh[1],
+            h: a.time.dt,
+            damp_m: a.damping.zeta + a.damping.rayleigh[0],
+            damp_k: a.damping.rayleigh[1],
         },
-        crate::model::AnalysisKind::Static => Scheme::Static { dt: a.dt },
+        crate::model::AnalysisKind::Static => Scheme::Static { dt: a.time.dt },
     };
     let ops = Operators::new(model, scheme);
     let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
@@ -680,7 +680,7 @@ pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, Effec
         &ops.asm.pattern,
         dofs,
         Backend::Faer,
-        a.ordering,
+        a.iteration.ordering,
         &model.mesh.coords,
     )?;
     let kt = match ops.response {

@@ -37,9 +37,9 @@ impl StepControl {
     pub fn of(model: &crate::model::Model) -> Self {
         let a = &model.analysis;
         StepControl {
-            h: a.dt,
-            t_end: a.t_end,
-            max_cuts: a.max_cuts,
+            h: a.time.dt,
+            t_end: a.time.t_end,
+            max_cuts: a.iteration.max_cuts,
         }
     }
 }

@@ -84,17 +84,17 @@ impl Operators {
         let a = &model.analysis;
         let asm = Assembler::new(&model.mesh);
         let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
-        let mass = asm.mass(&model.mesh, &model.materials, a.lumped_mass);
+        let mass = asm.mass(&model.mesh, &model.materials, a.time.lumped_mass);
         let gravity = gravity_force(model, &mass, &asm.pattern);
         let response = if model.materials.iter().all(|m| m.is_linear_elastic()) {
             Response::Elastic
         } else if model.materials.iter().all(|m| m.has_constant_tangent()) {
-            match a.viscoelastic_state {
+            match a.time.viscoelastic_state {
                 ViscoelasticState::Nodal => Response::Nodal,
                 ViscoelasticState::Points => Response::Constant,
             }
         } else {
-            Response::StateDependent(a.iteration)
+            Response::StateDependent(a.iteration.method)
         };
         let mut free_mask = vec![1.0; model.mesh.n_dofs()];
         for c in &model.constraints {
@@ -113,12 +113,12 @@ impl Operators {
             rate_independent: model.materials.iter().all(|m| m.is_rate_independent()),
             seat: 0.0,
             test: Convergence {
-                tolerance: a.tolerance,
-                displacement_tolerance: a.displacement_tolerance,
-                max_iterations: a.max_iterations,
-                penetration_tolerance: a.contact_tolerance,
-                complementarity_tolerance: a.contact_tolerance,
-                refactor_rate: a.refactor_rate,
+                tolerance: a.iteration.tolerance,
+                displacement_tolerance: a.iteration.displacement_tolerance,
+                max_iterations: a.iteration.max_iterations,
+                penetration_tolerance: a.contact.tolerance,
+                complementarity_tolerance: a.contact.tolerance,
+                refactor_rate: a.iteration.refactor_rate,
             },
         };
         if response == Response::Nodal {
@@ -225,7 +225,7 @@ impl Operators {
             &self.asm.pattern,
             dofs,
             backend,
-            model.analysis.ordering,
+            model.analysis.iteration.ordering,
             &model.mesh.coords,
         )?;
         // The analysis knows the factor's size: refuse before it is allocated.

@@ -31,7 +31,7 @@ impl<'m> Statics<'m> {
         memory_limit: Option<u64>,
     ) -> Result<Self> {
         let scheme = Scheme::Static {
-            dt: model.analysis.dt,
+            dt: model.analysis.time.dt,
         };
         Ok(Statics {
             core: Core::new(model, backend, scheme, memory_limit)?,

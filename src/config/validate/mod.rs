@@ -24,7 +24,10 @@ use super::{LoadOptions, Scenario};
 use crate::error::{Error, Result};
 use crate::fe::Plane;
 use crate::mesh::Mesh;
-use crate::model::{Analysis, AnalysisKind, Body, Model, TimeScheme};
+use crate::model::{
+    Analysis, AnalysisKind, Body, ContactSettings, Damping, IterationSettings, Model,
+    OutputSettings, TimeScheme, TimeSettings,
+};
 
 /// Builds the model of `s`; relative file names resolve against `dir`.
 pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
@@ -191,31 +194,41 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         probes,
         contacts,
         analysis: Analysis {
-            kind: a.kind,
-            scheme: a.scheme,
-            omega: a.omega.unwrap_or(DEFAULT_OMEGA),
-            dt: a.dt.unwrap_or(f64::NAN),
-            t_end: a.t_end,
-            lumped_mass: explicit || a.mass == Some(super::MassKind::Lumped),
-            zeta: a.zeta,
-            rayleigh: a.rayleigh,
-            vtk_every: a.vtk_every,
-            tolerance: a.tolerance,
-            max_iterations: a.max_iterations,
-            displacement_tolerance: a.displacement_tolerance,
-            iteration: a.iteration.unwrap_or_default(),
-            refactor_rate: a
-                .keep_factor
-                .unwrap_or(a.kind == crate::model::AnalysisKind::Dynamic)
-                .then(|| {
-                    a.refactor_rate
-                        .unwrap_or(crate::model::DEFAULT_REFACTOR_RATE)
-                }),
-            max_cuts: a.max_cuts,
-            ordering: a.ordering,
-            contact_tolerance,
-            contact_qp: a.contact_qp.unwrap_or_default(),
-            viscoelastic_state: a.viscoelastic_state.unwrap_or_default(),
+            time: TimeSettings {
+                kind: a.kind,
+                scheme: a.scheme,
+                omega: a.omega.unwrap_or(DEFAULT_OMEGA),
+                dt: a.dt.unwrap_or(f64::NAN),
+                t_end: a.t_end,
+                lumped_mass: explicit || a.mass == Some(super::MassKind::Lumped),
+                viscoelastic_state: a.viscoelastic_state.unwrap_or_default(),
+            },
+            damping: Damping {
+                zeta: a.zeta,
+                rayleigh: a.rayleigh,
+            },
+            iteration: IterationSettings {
+                tolerance: a.tolerance,
+                max_iterations: a.max_iterations,
+                displacement_tolerance: a.displacement_tolerance,
+                method: a.iteration.unwrap_or_default(),
+                refactor_rate: a
+                    .keep_factor
+                    .unwrap_or(a.kind == crate::model::AnalysisKind::Dynamic)
+                    .then(|| {
+                        a.refactor_rate
+                            .unwrap_or(crate::model::DEFAULT_REFACTOR_RATE)
+                    }),
+                max_cuts: a.max_cuts,
+                ordering: a.ordering,
+            },
+            contact: ContactSettings {
+                tolerance: contact_tolerance,
+                qp: a.contact_qp.unwrap_or_default(),
+            },
+            output: OutputSettings {
+                vtk_every: a.vtk_every,
+            },
         },
         warnings: unread_keys(a),
     };
@@ -234,7 +247,7 @@ fn initial_overlap(model: &Model) -> Result<()> {
     let mut cands = Vec::new();
     let coords = &model.mesh.coords;
     crate::contact::detect::detect(&model.contacts, |n| crate::mesh::xy(coords[n]), &mut cands);
-    let tol = model.analysis.contact_tolerance;
+    let tol = model.analysis.contact.tolerance;
     let deepest = cands
         .iter()
         .filter(|c| c.gap < -tol)
@@ -387,8 +400,8 @@ fn explicit_step(model: &mut Model, dt: Option<f64>, opts: &LoadOptions) -> Resu
     let a = &mut model.analysis;
     match dt {
         None => {
-            a.dt = a.omega * paper.dt.min(stable.dt);
-            step_count("analysis.dt", a.t_end, a.dt)?;
+            a.time.dt = a.time.omega * paper.dt.min(stable.dt);
+            step_count("analysis.dt", a.time.t_end, a.time.dt)?;
         }
         Some(h) if h > stable.dt && !opts.allow_unstable => {
             return Err(Error::config(

@@ -161,8 +161,8 @@ impl<'m> ContactCorrection<'m> {
         ContactCorrection {
             model,
             pairs: &model.contacts,
-            tol: model.analysis.contact_tolerance,
-            qp: model.analysis.contact_qp,
+            tol: model.analysis.contact.tolerance,
+            qp: model.analysis.contact.qp,
             area,
             dofs: crate::system::DofMap::new(n, model.constraints.iter().map(|c| c.dof)),
             cands: Vec::new(),
