@@ -496,7 +496,7 @@ fn mark_failed(path: &Path, e: &rothe::Error) {
         .ok()
         .and_then(|s| serde_json::from_str(&s).ok())
         .unwrap_or_else(|| serde_json::json!({}));
-    v["status"] = "failed".into();
+    v["status"] = rothe::output::summary::RunStatus::Failed.as_str().into();
     v["error"] = e.to_string().into();
     if let Ok(text) = serde_json::to_string_pretty(&v) {
         let _ = std::fs::create_dir_all(path.parent().unwrap_or(Path::new(".")));

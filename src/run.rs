@@ -20,7 +20,7 @@ use crate::model::{AnalysisKind, Model, TimeScheme};
 use crate::output::checks::Checks;
 use crate::output::recorder::{Recorder, Snapshot};
 use crate::output::summary::{
-    EnergySummary, MaterialSummary, SolverSummary, Summary, TimingSummary,
+    EnergySummary, MaterialSummary, RunStatus, SolverSummary, Summary, TimingSummary,
 };
 use crate::time::backward_euler::BackwardEuler;
 use crate::time::central_difference::CentralDifference;
@@ -125,7 +125,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         eprintln!("warning: {w}");
     }
     let mut summary = Summary {
-        status: "running".into(),
+        status: RunStatus::Running,
         error: None,
         warnings: model
             .warnings
@@ -187,7 +187,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
     summary.timing.total_s = start.elapsed().as_secs_f64();
     match result {
         Ok(()) => {
-            summary.status = "completed".into();
+            summary.status = RunStatus::Completed;
             summary.write(&summary_path)?;
             for f in summary.checks.failures() {
                 eprintln!("warning: {}: energy check failed: {f}", opts.out.display());
@@ -195,7 +195,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             Ok(summary)
         }
         Err(e) => {
-            summary.status = "failed".into();
+            summary.status = RunStatus::Failed;
             summary.error = Some(e.to_string());
             summary.write(&summary_path)?;
             Err(e)

@@ -33,7 +33,11 @@ fn model(m: &str) -> Overrides {
 }
 
 fn assert_ledger_and_checks(s: &Summary, what: &str) {
-    assert_eq!(s.status, "completed", "{what}");
+    assert_eq!(
+        s.status,
+        rothe::output::summary::RunStatus::Completed,
+        "{what}"
+    );
     assert!(
         s.energy.balance_residual_rel < 1e-8,
         "{what}: balance residual {:.3e} relative",

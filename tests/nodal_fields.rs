@@ -246,7 +246,7 @@ fn vtk_of_the_nodal_path_has_the_stress_of_the_gauss_point_path() {
         let out = dir.path().join(state);
         let summary =
             rothe::run::run(&m, &rothe::run::RunOptions::new(&out, Backend::Faer)).unwrap();
-        assert_eq!(summary.status, "completed");
+        assert_eq!(summary.status, rothe::output::summary::RunStatus::Completed);
         arrays.push(cell_arrays(&out.join("vtk/step_0000030.vtu")));
     }
     let get = |k: usize, name: &str| {

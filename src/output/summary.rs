@@ -225,11 +225,48 @@ impl MaterialSummary {
     }
 }
 
+/// Where a run stands, as `summary.json` says it (`"running"`, `"completed"`,
+/// `"failed"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunStatus {
+    /// The run is going, or was killed before it could say otherwise.
+    Running,
+    /// The run reached its end time.
+    Completed,
+    /// The run stopped with an error (`error` says which).
+    Failed,
+}
+
+impl RunStatus {
+    /// The word `summary.json` holds.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RunStatus::Running => "running",
+            RunStatus::Completed => "completed",
+            RunStatus::Failed => "failed",
+        }
+    }
+
+    /// The status of a `summary.json` value's word, if it is one.
+    pub fn parse(word: &str) -> Option<RunStatus> {
+        [RunStatus::Running, RunStatus::Completed, RunStatus::Failed]
+            .into_iter()
+            .find(|s| s.as_str() == word)
+    }
+}
+
+impl std::fmt::Display for RunStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// The whole summary.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
-    /// `running` (the run is going, or was killed), `completed` or `failed`.
-    pub status: String,
+    /// Where the run stands.
+    pub status: RunStatus,
     /// The error, when failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,

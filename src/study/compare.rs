@@ -6,8 +6,8 @@
 
 use std::path::Path;
 
-use super::collect::RunData;
 use super::plan::{Plan, PlannedRun, StudyKind};
+use super::run_data::RunData;
 use super::table::{num, Table};
 use crate::config::Overrides;
 use crate::error::{Error, Result};
@@ -251,8 +251,8 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     if !a.completed() || !b.completed() {
         return Err(Error::Stepping(format!(
             "both runs must complete: implicit {}, explicit {}",
-            a.status(),
-            b.status()
+            a.status_word(),
+            b.status_word()
         )));
     }
     let table = ledger_table(a, b);

@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use super::collect::{RunData, DISSIPATION_LINES};
 use super::orders::observed;
 use super::plan::{Plan, PlannedRun, StudyKind};
+use super::run_data::{RunData, DISSIPATION_LINES};
 use super::table::{num, Table};
 use crate::config::Overrides;
 use crate::error::{Error, Result};

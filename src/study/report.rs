@@ -5,10 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use super::collect::RunData;
 use super::compare::{ledger_table, pair};
 use super::mesh_study::{dissipation_cells, dissipation_header};
 use super::plan::{Plan, PlannedRun, StudyKind};
+use super::run_data::RunData;
 use super::table::{num, Table};
 use crate::config::Overrides;
 use crate::error::{Error, Result};
@@ -416,7 +416,7 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
         }
         t.push(vec![
             r.run.label.clone(),
-            r.status().into(),
+            r.status_word().into(),
             if r.checks_hold() {
                 "hold".into()
             } else {
@@ -484,7 +484,7 @@ fn energies(r: &RunData, title: &str, stem: &Path) -> Result<()> {
     for (c, l) in [("E_kin", "E_kin"), ("E_el", "E_el"), ("W_ext", "W_ext")] {
         fig = fig.with(Series::new(l, r.series(c, 1.0), Style::Line));
     }
-    for c in super::collect::DISSIPATION_COLUMNS {
+    for c in super::run_data::DISSIPATION_COLUMNS {
         let s = r.series(c, 1.0);
         if s.iter().any(|p| p.1 != 0.0) {
             fig = fig.with(Series::new(c, s, Style::Line));

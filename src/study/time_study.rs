@@ -14,10 +14,10 @@
 
 use std::path::Path;
 
-use super::collect::RunData;
 use super::norms::{Norms, Products};
 use super::orders::{observed, richardson, richardson_order};
 use super::plan::{Plan, PlannedRun, StudyKind};
+use super::run_data::RunData;
 use super::table::{num, Table};
 use crate::config::{load_with_overrides, LoadOptions, Overrides};
 use crate::error::{Error, Result};
