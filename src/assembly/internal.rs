@@ -328,15 +328,11 @@ pub(crate) fn gather<const D: usize>(
     nodes: &[usize],
     u: &[f64],
 ) -> ([[f64; 3]; MAX_NODES], [f64; MAX_ELEMENT_DOFS], usize) {
-    let mut x = [[0.0; 3]; MAX_NODES];
-    let mut ue = [0.0; MAX_ELEMENT_DOFS];
-    for (a, &n) in nodes.iter().enumerate() {
-        x[a] = mesh.coords[n];
-        for i in 0..D {
-            ue[D * a + i] = u[D * n + i];
-        }
-    }
-    (x, ue, nodes.len())
+    (
+        super::element_coords(mesh, nodes),
+        super::element_values(u, nodes, D),
+        nodes.len(),
+    )
 }
 
 /// Writes a Voigt vector (element by element: no call to `memcpy` on the hot path).

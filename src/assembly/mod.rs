@@ -17,6 +17,31 @@ use crate::material::Material;
 use crate::mesh::{ElementKind, Mesh};
 pub use pattern::{Pattern, Stored};
 
+/// The coordinates of an element's nodes (the first `nodes.len()` entries).
+#[inline(always)]
+pub fn element_coords(mesh: &Mesh, nodes: &[usize]) -> [[f64; 3]; MAX_NODES] {
+    let mut x = [[0.0; 3]; MAX_NODES];
+    for (a, &n) in nodes.iter().enumerate() {
+        x[a] = mesh.coords[n];
+    }
+    x
+}
+
+/// A nodal field's values at an element's nodes, `dim` per node (the first
+/// `dim · nodes.len()` entries; all zero for an empty field).
+#[inline(always)]
+pub fn element_values(field: &[f64], nodes: &[usize], dim: usize) -> [f64; MAX_ELEMENT_DOFS] {
+    let mut out = [0.0; MAX_ELEMENT_DOFS];
+    if !field.is_empty() {
+        for (a, &n) in nodes.iter().enumerate() {
+            for i in 0..dim {
+                out[dim * a + i] = field[dim * n + i];
+            }
+        }
+    }
+    out
+}
+
 /// Mass matrix: consistent (on the shared pattern) or lumped (a diagonal).
 #[derive(Clone, Debug)]
 pub enum Mass {
@@ -217,12 +242,9 @@ impl Assembler {
                     #[allow(clippy::redundant_locals)]
                     let shared = shared;
                     let mut ke = [0.0; MAX_ELEMENT_DOFS * MAX_ELEMENT_DOFS];
-                    let mut x = [[0.0; 3]; MAX_NODES];
                     for &e in chunk {
                         let nodes = block.elements.element(e);
-                        for (a, &n) in nodes.iter().enumerate() {
-                            x[a] = mesh.coords[n];
-                        }
+                        let x = element_coords(mesh, nodes);
                         element(bi, e, &x[..nn], &mut ke);
                         self.scatter(nodes, &ke, shared);
                     }

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
-use crate::fe::{kinematics, stiffness_rule, ElementKind, Plane, MAX_NODES};
+use crate::fe::{kinematics, stiffness_rule, ElementKind, Plane};
 use crate::material::store::StateStore;
 use crate::material::{mazars, Material, MazarsVariant, Model};
 use crate::mesh::Mesh;
@@ -67,10 +67,7 @@ fn point_geometry(mesh: &Mesh, bi: usize, e: usize, q: usize) -> ([f64; 3], f64)
     let block = &mesh.blocks[bi];
     let kind = block.elements.kind;
     let nodes = block.elements.element(e);
-    let mut x = [[0.0; 3]; MAX_NODES];
-    for (a, &n) in nodes.iter().enumerate() {
-        x[a] = mesh.coords[n];
-    }
+    let x = super::element_coords(mesh, nodes);
     let (xi, wq) = stiffness_rule(kind)[q];
     let k = kinematics(kind, &x[..nodes.len()], xi);
     let mut p = [0.0; 3];

@@ -8,6 +8,7 @@
 //! the element means of the fields.
 
 use crate::assembly::internal::points_per_element;
+use crate::assembly::{element_coords, element_values};
 use crate::fe::{
     element, kinematics, stiffness_rule, strain, strain_solid, ElementKind, MAX_NODES,
 };
@@ -25,11 +26,8 @@ fn point_weights(mesh: &Mesh, block: usize, e: usize, out: &mut [f64; MAX_NODES]
         out[0] = 1.0;
         return 1;
     }
-    let mut x = [[0.0; 3]; MAX_NODES];
     let nodes = b.elements.element(e);
-    for (a, &n) in nodes.iter().enumerate() {
-        x[a] = mesh.coords[n];
-    }
+    let x = element_coords(mesh, nodes);
     let rule = stiffness_rule(kind);
     for (q, &(xi, w)) in rule.iter().enumerate() {
         out[q] = w * kinematics(kind, &x[..nodes.len()], xi).det_j;
@@ -82,14 +80,8 @@ pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64;
         let nn = kind.nodes();
         for e in 0..block.elements.len() {
             let nodes = block.elements.element(e);
-            let mut x = [[0.0; 3]; MAX_NODES];
-            let mut ue = [0.0; 3 * MAX_NODES];
-            for (a, &n) in nodes.iter().enumerate() {
-                x[a] = mesh.coords[n];
-                for i in 0..dim {
-                    ue[dim * a + i] = u[dim * n + i];
-                }
-            }
+            let x = element_coords(mesh, nodes);
+            let ue = element_values(u, nodes, dim);
             if kind == ElementKind::Bar2 {
                 let eps = element::bar_strain(&x[..2], dim, &ue[..2 * dim]);
                 out.push(pad([mat.e * eps, 0.0, 0.0]));

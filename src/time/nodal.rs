@@ -21,9 +21,9 @@
 use rayon::prelude::*;
 
 use crate::assembly::internal::{new_stores, points_per_element, strain_v};
-use crate::assembly::{Assembler, Mass, Pattern};
+use crate::assembly::{element_coords, element_values, Assembler, Mass, Pattern};
 use crate::energy::Dissipation;
-use crate::fe::{element, kinematics, stiffness_rule, ElementKind, MAX_ELEMENT_DOFS, MAX_NODES};
+use crate::fe::{element, kinematics, stiffness_rule, ElementKind};
 use crate::halves::{add, in_halves, split_slices, Slices, VECTOR_LEAF};
 use crate::material::store::StateStore;
 use crate::material::{mul3, Model as Law, Viscosity};
@@ -364,23 +364,10 @@ impl NodalLaws {
             let c: [[f64; V]; V] = mat.c_voigt(model.plane);
             let (law, fields) = self.law_of_block(model, bi, s);
             let rule = stiffness_rule(kind);
-            let gather = |field: &[f64], nodes: &[usize]| -> [f64; MAX_ELEMENT_DOFS] {
-                let mut out = [0.0; MAX_ELEMENT_DOFS];
-                if !field.is_empty() {
-                    for (a, &n) in nodes.iter().enumerate() {
-                        for j in 0..D {
-                            out[D * a + j] = field[D * n + j];
-                        }
-                    }
-                }
-                out
-            };
+            let gather = |field: &[f64], nodes: &[usize]| element_values(field, nodes, D);
             for e in 0..block.elements.len() {
                 let nodes = block.elements.element(e);
-                let mut x = [[0.0; 3]; MAX_NODES];
-                for (a, &n) in nodes.iter().enumerate() {
-                    x[a] = mesh.coords[n];
-                }
+                let x = element_coords(mesh, nodes);
                 let ue = gather(u, nodes);
                 let de = gather(&s.du, nodes);
                 let ude = gather(fields.map_or(&[][..], |f| &f.ud[..]), nodes);
