@@ -518,7 +518,7 @@ fn full_run_histories_agree() {
             overwrite: true,
         };
         let summary = rothe::run::run(&model, &opts).unwrap();
-        assert_eq!(summary.status, "completed");
+        assert_eq!(summary.status, rothe::output::summary::RunStatus::Completed);
         assert_eq!(summary.solver.backend, backend.name());
         assert_eq!(summary.steps, 20);
         histories.push(probe_columns(&out.join("history.csv")));
