@@ -432,7 +432,8 @@ impl SymmetricSolver for CholmodCholesky {
         // SAFETY: `self.factor` holds the numeric factorisation just computed with
         // `self.common`.
         let rcond = unsafe { cholmod_l_rcond(self.factor, &mut *self.common) };
-        if !(rcond > SINGULAR_RCOND * n.max(1) as f64) {
+        // A NaN estimate (a NaN in the matrix) counts as singular too.
+        if rcond.is_nan() || rcond <= SINGULAR_RCOND * n.max(1) as f64 {
             return Err(Error::NotPositiveDefinite {
                 backend: NAME,
                 column: None,
