@@ -4,6 +4,8 @@
 //! peak, ledger closure to the iteration tolerance, step cuts, failure reports).
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
+mod common;
+
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
 use rothe::fe::Plane;
@@ -394,35 +396,11 @@ fn rankine_hill_consistent_tangent_matches_finite_differences() {
     }
 }
 
-fn path_strategy() -> impl Strategy<Value = Vec<[f64; 3]>> {
-    proptest::collection::vec(proptest::array::uniform3(-2e-4f64..2e-4), 2..60).prop_map(|incs| {
-        let mut e = [0.0; 3];
-        incs.iter()
-            .map(|d| {
-                for i in 0..3 {
-                    e[i] += d[i];
-                }
-                e
-            })
-            .collect()
-    })
-}
-
-/// `cases` cases from a fixed seed (the same cases every run, so CI is
-/// reproducible); set `PROPTEST_RNG_SEED` to explore others.
-fn seeded(cases: u32) -> ProptestConfig {
-    let mut c = ProptestConfig::with_cases(cases);
-    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
-        c.rng_seed = proptest::test_runner::RngSeed::Fixed(0x5eed_0001);
-    }
-    c
-}
-
 proptest! {
-    #![proptest_config(seeded(64))]
+    #![proptest_config(common::seeded(64, 0x5eed_0001))]
 
     #[test]
-    fn random_paths_keep_the_invariants(path in path_strategy(), variant in 0usize..4) {
+    fn random_paths_keep_the_invariants(path in common::strain_paths::<3>(60), variant in 0usize..4) {
         // Damage never decreases and stays below 1; dissipation per step is
         // non-negative; after every return the stress is admissible.
         let text = match variant {

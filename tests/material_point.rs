@@ -3,6 +3,8 @@
 //! exact point energy identity, and properties over random parameters and paths.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
+mod common;
+
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
 use rothe::fe::Plane;
@@ -300,18 +302,8 @@ fn model_strategy() -> impl Strategy<Value = String> {
     ]
 }
 
-/// `cases` cases from a fixed seed (the same cases every run, so CI is
-/// reproducible); set `PROPTEST_RNG_SEED` to explore others.
-fn seeded(cases: u32) -> ProptestConfig {
-    let mut c = ProptestConfig::with_cases(cases);
-    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
-        c.rng_seed = proptest::test_runner::RngSeed::Fixed(0x5eed_0001);
-    }
-    c
-}
-
 proptest! {
-    #![proptest_config(seeded(64))]
+    #![proptest_config(common::seeded(64, 0x5eed_0001))]
 
     #[test]
     fn dissipation_is_non_negative_and_stress_objective(

@@ -350,14 +350,54 @@ fn averages_keep_uniform_fields_and_ignore_the_numbering() {
     assert!(changed > a.len() / 2, "the average smooths a varying field");
 }
 
+/// One Gauss-point pass of `mats` on `mesh` at `u` from fresh states: every point's
+/// trial damage (block after block), the internal force, the stored energy and the
+/// damage dissipation.
+fn one_pass(
+    mesh: &Mesh,
+    mats: &[Material],
+    plane: rothe::fe::Plane,
+    u: &[f64],
+) -> (Vec<f64>, Vec<f64>, f64, f64) {
+    use rothe::assembly::internal::{new_stores, PointPass};
+    use rothe::assembly::Assembler;
+    let asm = Assembler::new(mesh);
+    let mut stores = new_stores(mesh, mats);
+    let mut f = vec![0.0; u.len()];
+    let totals = asm.internal_force(
+        mesh,
+        mats,
+        plane,
+        PointPass {
+            u,
+            dt: 1e-5,
+            at_rest: false,
+            frozen: false,
+        },
+        &mut stores,
+        &mut f,
+        None,
+        None,
+        None,
+    );
+    let d: Vec<f64> = stores
+        .iter()
+        .flat_map(|s| {
+            let t = s.trial();
+            (0..t.n_points())
+                .map(move |g| t.history(g)[2])
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    (d, f, totals.psi, totals.dissipation.damage)
+}
+
 #[test]
 fn under_a_uniform_strain_nonlocal_is_local() {
     // A uniform strain past the tensile peak (and one in compression with shear) on
     // the two-block body: every point has the same drivers, so the averages are the
     // points' own values, and the nonlocal pass gives the local one's damage, forces
     // and energies to round-off, for both variants.
-    use rothe::assembly::internal::{new_stores, PointPass};
-    use rothe::assembly::Assembler;
     let mesh = mixed_body(false);
     for variant in [MazarsVariant::Paper, MazarsVariant::Classic] {
         for eps in [[3e-4, -0.5e-4, 0.4e-4], [-2.5e-3, 0.4e-3, 0.6e-3]] {
@@ -369,42 +409,13 @@ fn under_a_uniform_strain_nonlocal_is_local() {
                         p.regularisation = Regularisation::Local;
                     }
                 }
-                let mats = [m];
-                let asm = Assembler::new(&mesh);
-                let mut stores = new_stores(&mesh, &mats);
                 // u = ε x: ε_xx = e0, ε_yy = e1, γ_xy = e2.
                 let u: Vec<f64> = mesh
                     .coords
                     .iter()
                     .flat_map(|p| [eps[0] * p[0] + eps[2] * p[1], eps[1] * p[1]])
                     .collect();
-                let mut f = vec![0.0; u.len()];
-                let totals = asm.internal_force(
-                    &mesh,
-                    &mats,
-                    rothe::fe::Plane::Stress,
-                    PointPass {
-                        u: &u,
-                        dt: 1e-5,
-                        at_rest: false,
-                        frozen: false,
-                    },
-                    &mut stores,
-                    &mut f,
-                    None,
-                    None,
-                    None,
-                );
-                let d: Vec<f64> = stores
-                    .iter()
-                    .flat_map(|s| {
-                        let t = s.trial();
-                        (0..t.n_points())
-                            .map(move |g| t.history(g)[2])
-                            .collect::<Vec<_>>()
-                    })
-                    .collect();
-                (d, f, totals.psi, totals.dissipation.damage)
+                one_pass(&mesh, &[m], rothe::fe::Plane::Stress, &u)
             };
             let (dl, fl, psil, wl) = evaluate(None);
             let (dn, fnl, psin, wn) = evaluate(Some(0.1));
@@ -541,8 +552,6 @@ fn under_a_uniform_strain_a_nonlocal_solid_is_local() {
     // strain with all six components, past the tensile peak and in compression, on
     // a hexahedral box: the nonlocal pass gives the local one's damage, forces and
     // energies to round-off, for both variants.
-    use rothe::assembly::internal::{new_stores, PointPass};
-    use rothe::assembly::Assembler;
     let mesh = solid_body(ElementKind::Hex8);
     for variant in [MazarsVariant::Paper, MazarsVariant::Classic] {
         for eps in [
@@ -568,29 +577,7 @@ fn under_a_uniform_strain_a_nonlocal_solid_is_local() {
                         p.regularisation = Regularisation::Local;
                     }
                 }
-                let mats = [m];
-                let asm = Assembler::new(&mesh);
-                let mut stores = new_stores(&mesh, &mats);
-                let mut f = vec![0.0; u.len()];
-                let totals = asm.internal_force(
-                    &mesh,
-                    &mats,
-                    rothe::fe::Plane::Solid,
-                    PointPass {
-                        u: &u,
-                        dt: 1e-5,
-                        at_rest: false,
-                        frozen: false,
-                    },
-                    &mut stores,
-                    &mut f,
-                    None,
-                    None,
-                    None,
-                );
-                let t = stores[0].trial();
-                let d: Vec<f64> = (0..t.n_points()).map(|g| t.history(g)[2]).collect();
-                (d, f, totals.psi, totals.dissipation.damage)
+                one_pass(&mesh, &[m], rothe::fe::Plane::Solid, &u)
             };
             let (dl, fl, psil, wl) = evaluate(false);
             let (dn, fnl, psin, wn) = evaluate(true);

@@ -5,6 +5,8 @@
 //! finite differences, and invariants along random paths.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
 use proptest::prelude::*;
 use rothe::fe::Plane;
 use rothe::material::frame::eigen_sym3;
@@ -504,33 +506,11 @@ fn jacobi_frames_agree_with_the_closed_form_principal_values() {
     }
 }
 
-fn path_strategy() -> impl Strategy<Value = Vec<[f64; 6]>> {
-    proptest::collection::vec(proptest::array::uniform6(-2e-4f64..2e-4), 2..40).prop_map(|incs| {
-        let mut e = [0.0; 6];
-        incs.iter()
-            .map(|d| {
-                for i in 0..6 {
-                    e[i] += d[i];
-                }
-                e
-            })
-            .collect()
-    })
-}
-
-fn seeded(cases: u32) -> ProptestConfig {
-    let mut c = ProptestConfig::with_cases(cases);
-    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
-        c.rng_seed = proptest::test_runner::RngSeed::Fixed(0x5eed_0003);
-    }
-    c
-}
-
 proptest! {
-    #![proptest_config(seeded(48))]
+    #![proptest_config(common::seeded(48, 0x5eed_0003))]
 
     #[test]
-    fn random_solid_paths_stay_admissible(path in path_strategy()) {
+    fn random_solid_paths_stay_admissible(path in common::strain_paths::<6>(40)) {
         // After every return the principal stresses lie inside the criterion at
         // the new hardening variables, which never decrease, and the step's
         // plastic dissipation is non-negative (bilinear laws).

@@ -89,3 +89,33 @@ pub fn load_from(f: &[f64], function: TimeFunction) -> Load {
 pub fn orders(errors: &[f64]) -> Vec<f64> {
     errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
 }
+
+/// `cases` proptest cases from the fixed `seed` (the same cases every run, so CI is
+/// reproducible); set `PROPTEST_RNG_SEED` to explore others.
+pub fn seeded(cases: u32, seed: u64) -> proptest::test_runner::Config {
+    let mut c = proptest::test_runner::Config::with_cases(cases);
+    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
+        c.rng_seed = proptest::test_runner::RngSeed::Fixed(seed);
+    }
+    c
+}
+
+/// Strain paths of `V` components: 2 to `max_len − 1` points, each a random
+/// increment of at most 2e-4 per component from the last (from zero).
+pub fn strain_paths<const V: usize>(
+    max_len: usize,
+) -> impl proptest::strategy::Strategy<Value = Vec<[f64; V]>> {
+    use proptest::strategy::Strategy;
+    proptest::collection::vec(proptest::array::uniform::<_, V>(-2e-4f64..2e-4), 2..max_len)
+        .prop_map(|incs| {
+            let mut e = [0.0; V];
+            incs.iter()
+                .map(|d| {
+                    for i in 0..V {
+                        e[i] += d[i];
+                    }
+                    e
+                })
+                .collect()
+        })
+}
