@@ -530,3 +530,148 @@ proptest! {
         }
     }
 }
+
+/// One plane-strain point update (element size 0.1), state of six values.
+fn plane_strain_point(
+    m: &Material,
+    eps_n: [f64; 3],
+    eps: [f64; 3],
+    state_n: &[f64],
+) -> (PointResponse, Vec<f64>) {
+    let mut st = vec![0.0; m.n_state()];
+    let r = m.update(
+        Plane::Strain,
+        &StrainStep {
+            eps_n,
+            eps,
+            dt: 1e-4,
+            length: 0.1,
+        },
+        state_n,
+        &mut st,
+    );
+    (r, st)
+}
+
+#[test]
+fn plane_strain_uniaxial_compression_follows_the_closed_form() {
+    // Reference: plane strain with ε_yy = 0 is uniaxial strain (ε_yy = ε_zz = 0).
+    // The lateral stresses are equal, von Mises reads q = |σ_xx − σ_l|, the flow
+    // (−1, ½, ½)κ is deviatoric, so the mean stress stays K ε and
+    // q = 2μ|ε| − 3μκ = f_y + Hκ: κ = (2μ|ε| − f_y)/(3μ + H) past yield,
+    // σ_xx = Kε − ⅔q, σ_yy = Kε + ⅓q, εᵖ_zz = κ/2. Rankine stays inactive
+    // (σ1 = σ_yy < 0). Backward Euler is exact on this radial path with a linear
+    // law; unloading is elastic with the plane-strain modulus λ + 2μ.
+    let m = mat(BILINEAR);
+    let (mu, k) = (E / (2.0 * (1.0 + NU)), E / (3.0 * (1.0 - 2.0 * NU)));
+    let h = E * ET / (E - ET);
+    let (mut en, mut st) = ([0.0; 3], vec![0.0; 6]);
+    let mut yielded = false;
+    for step in 1..=120 {
+        let e = -5e-3 * (step.min(100) as f64) / 100.0 + 1e-3 * (step.max(100) - 100) as f64 / 20.0;
+        let eps = [e, 0.0, 0.0];
+        let (r, next) = plane_strain_point(&m, en, eps, &st);
+        if step <= 100 {
+            let kappa = ((2.0 * mu * e.abs() - FC) / (3.0 * mu + h)).max(0.0);
+            let q = 2.0 * mu * e.abs() - 3.0 * mu * kappa;
+            let (sx, sy) = (k * e - 2.0 / 3.0 * q, k * e + q / 3.0);
+            assert!(
+                (r.sigma[0] - sx).abs() < 1e-6 * FC,
+                "ε = {e}: σ_xx {} vs {sx}",
+                r.sigma[0]
+            );
+            assert!(
+                (r.sigma[1] - sy).abs() < 1e-6 * FC,
+                "ε = {e}: σ_yy {} vs {sy}",
+                r.sigma[1]
+            );
+            assert!(
+                (next[4] - kappa).abs() < 1e-9 * kappa.max(1e-6),
+                "κ_c {} vs {kappa}",
+                next[4]
+            );
+            assert!(
+                (next[5] - 0.5 * kappa).abs() < 1e-9 * kappa.max(1e-6),
+                "εᵖ_zz {}",
+                next[5]
+            );
+            assert_eq!(next[3], 0.0, "Rankine inactive");
+            yielded |= kappa > 0.0;
+        } else {
+            // Unloading: Δσ_xx = (λ + 2μ) Δε.
+            let c11 = k + 4.0 / 3.0 * mu;
+            let (r0, _) = plane_strain_point(&m, en, en, &st);
+            let slope = (r.sigma[0] - r0.sigma[0]) / (e - en[0]);
+            assert!(
+                (slope - c11).abs() < 1e-6 * c11,
+                "unloading slope {slope} vs {c11}"
+            );
+            assert_eq!(next[4], st[4], "no flow on unloading");
+        }
+        (en, st) = (eps, next);
+    }
+    assert!(yielded);
+}
+
+#[test]
+fn plane_strain_tangents_match_finite_differences() {
+    // Reference: central differences (δε = 1e-9) of the plane-strain stress in the
+    // elastic range, in tension (Rankine), compression (von Mises) and the
+    // tension-compression corner, from virgin and hardened histories.
+    let hardened = [1e-5, -2e-5, 1e-5, 2e-5, 1e-4, 5e-6];
+    for laws in [BILINEAR, SOFTENING] {
+        let m = mat(laws);
+        for (eps, st) in [
+            ([3e-5, 1e-5, 0.0], [0.0; 6]),
+            ([3e-4, 5e-5, 1e-4], [0.0; 6]),
+            ([-2e-3, -4e-4, 6e-4], [0.0; 6]),
+            ([1.5e-3, -1.6e-3, 2e-4], [0.0; 6]),
+            ([4e-4, -1e-4, 2e-4], hardened),
+        ] {
+            let (r, _) = plane_strain_point(&m, [0.0; 3], eps, &st);
+            for j in 0..3 {
+                let (mut ep, mut em) = (eps, eps);
+                ep[j] += 1e-9;
+                em[j] -= 1e-9;
+                let sp = plane_strain_point(&m, [0.0; 3], ep, &st).0.sigma;
+                let sm = plane_strain_point(&m, [0.0; 3], em, &st).0.sigma;
+                for i in 0..3 {
+                    let fd = (sp[i] - sm[i]) / 2e-9;
+                    assert!(
+                        (fd - r.tangent[i][j]).abs() < 1e-4 * E,
+                        "D[{i}][{j}] = {} vs {fd} at {eps:?}",
+                        r.tangent[i][j]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_plane_strain_rankine_hill_run_closes_its_ledger() {
+    // The Rankine-Hill cantilever of the regression set in plane strain: the run
+    // reaches its end, yields (D_plastic > 0), and the ledger closes to the
+    // iteration tolerance (1e-6 of the work, as in plane stress).
+    use rothe::time::backward_euler::BackwardEuler;
+    use rothe::time::Integrator;
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/regression/rankine_hill_cantilever.toml"),
+    )
+    .unwrap()
+    .replace("[analysis]", "[analysis]\nplane = \"strain\"");
+    let model = rothe::config::from_str(&text, std::path::Path::new(".")).unwrap();
+    assert_eq!(model.plane, Plane::Strain);
+    let mut be = BackwardEuler::new(&model, rothe::linsolve::Backend::Faer).unwrap();
+    let mut s = be.initial_state();
+    for _ in 0..model.analysis.n_steps() {
+        be.step_accepted(&mut s).unwrap();
+    }
+    let rel = s.ledger.relative_residual();
+    assert!(rel.abs() < 1e-6, "balance {rel:e}");
+    assert!(
+        s.ledger.dissipated().plastic > 0.0,
+        "the plane-strain beam yields"
+    );
+}

@@ -330,6 +330,9 @@ impl Material {
             Model::Elastic | Model::KelvinVoigt(_) => 0,
             Model::Sls { .. } => voigt,
             Model::Mazars(_) => 3,
+            // The plane keeps a sixth value, `εᵖ_zz`, which plane strain's return
+            // through the solid's needs (zero in plane stress).
+            Model::RankineHill(_) if voigt == 3 => rankine_hill::n_state(voigt) + 1,
             Model::RankineHill(_) => rankine_hill::n_state(voigt),
         }
     }
@@ -345,18 +348,23 @@ impl Material {
                 ..
             }) => &["eps_t_max", "eps_c_max", "damage"],
             Model::Mazars(_) => &["kappa", "unused", "damage"],
-            Model::RankineHill(_) => &["eps_p_xx", "eps_p_yy", "gamma_p_xy", "kappa_t", "kappa_c"],
+            Model::RankineHill(_) => &[
+                "eps_p_xx",
+                "eps_p_yy",
+                "gamma_p_xy",
+                "kappa_t",
+                "kappa_c",
+                "eps_p_zz",
+            ],
         }
     }
 
-    /// Damage and equivalent plastic strain `κ_t + κ_c` of a point state, for output.
-    pub fn output_fields(&self, state: &[f64]) -> (f64, f64) {
+    /// Damage and equivalent plastic strain `κ_t + κ_c` of the state of a point with
+    /// `voigt` strain components, for output.
+    pub fn output_fields(&self, state: &[f64], voigt: usize) -> (f64, f64) {
         match self.model {
             Model::Mazars(_) => (state[2], 0.0),
-            Model::RankineHill(_) => {
-                let n = state.len();
-                (0.0, state[n - 2] + state[n - 1])
-            }
+            Model::RankineHill(_) => (0.0, state[voigt] + state[voigt + 1]),
             _ => (0.0, 0.0),
         }
     }
@@ -528,7 +536,9 @@ impl Material {
                 mazars::update(&p, &c, self.nu, plane, step, averaged, state_n, state)
             }
             Model::RankineHill(p) => {
-                if V == 3 {
+                if V == 3 && plane == Plane::Strain {
+                    self.rankine_hill_plane_strain(&p, step, state_n, state)
+                } else if V == 3 {
                     rankine_hill_as::<V, 3, 2, frame::PlaneFrame>(
                         &p, &c, self.e, self.nu, step, state_n, state,
                     )
@@ -538,6 +548,51 @@ impl Material {
                     )
                 }
             }
+        }
+    }
+}
+
+impl Material {
+    /// Rankine-Hill in plane strain: the solid's return with `ε_zz = γ_yz = γ_zx = 0`
+    /// (the out-of-plane axis stays principal, so the plastic strain keeps no
+    /// out-of-plane shear). The plane state `[εᵖ_xx, εᵖ_yy, γᵖ_xy, κ_t, κ_c, εᵖ_zz]`
+    /// is the solid's `[εᵖ (6), κ_t, κ_c]` rearranged; the stress and tangent are the
+    /// in-plane rows and columns (`σ_zz` is carried by the state, not output).
+    fn rankine_hill_plane_strain<const V: usize>(
+        &self,
+        p: &RankineHillParams,
+        step: &StrainStep<V>,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse<V> {
+        let widen = |e: &[f64; V]| [e[0], e[1], e[2], 0.0, 0.0, 0.0];
+        let solid_step = StrainStep {
+            eps_n: widen(&step.eps_n),
+            eps: widen(&step.eps),
+            dt: step.dt,
+            length: step.length,
+        };
+        let s = state_n;
+        let solid_n = [s[0], s[1], s[2], s[5], 0.0, 0.0, s[3], s[4]];
+        let mut solid = [0.0; 8];
+        let r = rankine_hill::update::<6, 3, frame::SolidFrame>(
+            p,
+            &self.c_solid(),
+            self.e,
+            self.nu,
+            &solid_step,
+            &solid_n,
+            &mut solid,
+        );
+        for (k, &i) in [0, 1, 2, 6, 7, 3].iter().enumerate() {
+            state[k] = solid[i];
+        }
+        PointResponse {
+            sigma: std::array::from_fn(|i| r.sigma[i]),
+            tangent: std::array::from_fn(|i| std::array::from_fn(|j| r.tangent[i][j])),
+            psi: r.psi,
+            dissipation: r.dissipation,
+            status: r.status,
         }
     }
 }

@@ -120,7 +120,7 @@ pub fn cell_history_fields(model: &Model, points: &[StateStore]) -> Vec<(&'stati
         let c = store.committed();
         for e in 0..block.elements.len() {
             let m = element_mean(mesh, bi, e, ng, |g| {
-                let (d, p) = mat.output_fields(c.history(g));
+                let (d, p) = mat.output_fields(c.history(g), c.layout().voigt);
                 [d, p, c.dissipated(g)]
             });
             damage.push(m[0]);

@@ -45,13 +45,6 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         mat_index.insert(name.clone(), materials.len());
         materials.push(material(name, &format!("materials.{name}"), spec)?);
     }
-    for m in &materials {
-        if matches!(m.model, crate::material::Model::RankineHill(_))
-            && a.plane == crate::fe::Plane::Strain
-        {
-            return Err(Error::config(format!("materials.{}", m.name), "Rankine-Hill plasticity is formulated in plane stress; set analysis.plane = \"stress\""));
-        }
-    }
     let find_material = |field: String, name: &str| -> Result<usize> {
         mat_index.get(name).copied().ok_or_else(|| {
             Error::config(
