@@ -260,10 +260,10 @@ fn point_energy_identity_is_exact() {
         );
         p.times = vec![0.0, 0.003, 0.006, 0.01];
         p.strains = vec![
-            [0.0; 3],
-            [1e-4, -3e-5, 2e-5],
-            [-5e-5, 8e-5, -4e-5],
-            [2e-5, 0.0, 1e-4],
+            vec![0.0; 3],
+            vec![1e-4, -3e-5, 2e-5],
+            vec![-5e-5, 8e-5, -4e-5],
+            vec![2e-5, 0.0, 1e-4],
         ];
         let recs = run_path(&m, &p).unwrap();
         let last = recs.last().unwrap();

@@ -675,3 +675,71 @@ fn a_plane_strain_rankine_hill_run_closes_its_ledger() {
         "the plane-strain beam yields"
     );
 }
+
+#[test]
+fn the_material_driver_takes_a_solid_point() {
+    // Reference: a solid's point under uniaxial stress is the plane-stress point
+    // under uniaxial stress (the two stress-free directions are alike), so
+    // `rothe material` with `plane = "solid"` gives the plane-stress curve: σ_xx to
+    // 1e-6 f_t at every step into hardening and back, the other five stresses at
+    // zero, the plastic work alike. The file form writes six strain and six stress
+    // columns and the solid's history names; a table of three-component strains
+    // for a solid's point is refused naming the row.
+    use rothe::material::point_driver::{run_file, run_path, run_solid_path, PathSpec};
+    let m = mat(BILINEAR);
+    let path = |plane: &str| -> PathSpec {
+        toml::from_str(&format!(
+            "kind = \"uniaxial_stress\"\nplane = \"{plane}\"\namplitude = 5e-4\nfunction = {{ kind = \"table\", points = [[0.0, 0.0], [1.0, 1.0], [1.5, 0.8]] }}\nt_end = 1.5\ndt = 0.01"
+        ))
+        .unwrap()
+    };
+    let plane = run_path(&m, &path("stress")).unwrap();
+    let solid = run_solid_path(&m, &path("solid")).unwrap();
+    assert_eq!(plane.len(), solid.len());
+    for (p, s) in plane.iter().zip(&solid) {
+        assert!(
+            (p.response.sigma[0] - s.response.sigma[0]).abs() < 1e-6 * FT,
+            "t = {}",
+            p.t
+        );
+        for i in 1..6 {
+            assert!(
+                s.response.sigma[i].abs() < 1e-6 * FT,
+                "t = {}: σ[{i}] = {}",
+                s.t,
+                s.response.sigma[i]
+            );
+        }
+        assert!((p.dissipated[2] - s.dissipated[2]).abs() <= 1e-9 * p.dissipated[2].max(1.0));
+    }
+    assert!(solid.last().unwrap().dissipated[2] > 0.0, "the path yields");
+
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("point.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "[material]\nmodel = \"rankine_hill\"\n{BILINEAR}\nE = {E}\nnu = {NU}\nrho = 2400.0\n[path]\nkind = \"table\"\nplane = \"solid\"\nt_end = 1.0\ndt = 0.1\ntimes = [0.0, 1.0]\nstrains = [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [3e-4, 2.9e-4, 0.0, 2.8e-4, 1e-5, 0.0]]\n"
+        ),
+    )
+    .unwrap();
+    let steps = run_file(&file, dir.path(), |_| {}).unwrap();
+    assert_eq!(steps, 10);
+    let csv = std::fs::read_to_string(dir.path().join("material.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.starts_with("t,eps_xx,eps_yy,gamma_xy,eps_zz,gamma_yz,gamma_zx,sig_xx,sig_yy,sig_xy,sig_zz,sig_yz,sig_zx,psi,eps_p_xx"),
+        "{header}"
+    );
+    assert!(header.contains("kappa_t,kappa_c,D_viscous"), "{header}");
+    assert_eq!(csv.lines().count(), 12);
+    let bad = std::fs::read_to_string(&file)
+        .unwrap()
+        .replace("[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]", "[0.0, 0.0, 0.0]");
+    std::fs::write(&file, bad).unwrap();
+    let e = run_file(&file, dir.path(), |_| {}).unwrap_err().to_string();
+    assert!(
+        e.contains("path.strains[0]") && e.contains("expected 6"),
+        "{e}"
+    );
+}

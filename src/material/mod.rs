@@ -337,8 +337,37 @@ impl Material {
         }
     }
 
+    /// Names of the history values of a point with `voigt` strain components
+    /// (columns of `rothe material` output).
+    pub fn state_names_for(&self, voigt: usize) -> &'static [&'static str] {
+        if voigt == 3 {
+            return self.state_names();
+        }
+        match self.model {
+            Model::Sls { .. } => &[
+                "eps_d_xx",
+                "eps_d_yy",
+                "gamma_d_xy",
+                "eps_d_zz",
+                "gamma_d_yz",
+                "gamma_d_zx",
+            ],
+            Model::RankineHill(_) => &[
+                "eps_p_xx",
+                "eps_p_yy",
+                "gamma_p_xy",
+                "eps_p_zz",
+                "gamma_p_yz",
+                "gamma_p_zx",
+                "kappa_t",
+                "kappa_c",
+            ],
+            _ => self.state_names(),
+        }
+    }
+
     /// Names of the history values of a plane point (columns of `rothe material`
-    /// output; a solid's Rankine-Hill point has six plastic strains before its `κ`s).
+    /// output).
     pub fn state_names(&self) -> &'static [&'static str] {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) => &[],

@@ -70,7 +70,7 @@ fn constant() -> TimeFunction {
 pub struct PathSpec {
     /// The path kind.
     pub kind: PathKind,
-    /// Plane stress (default) or plane strain idealisation of the point.
+    /// Plane stress (default), plane strain, or a solid's point (six components).
     #[serde(default)]
     pub plane: Plane,
     /// Strain or stress control of the loaded components.
@@ -92,9 +92,10 @@ pub struct PathSpec {
     /// Table path: times.
     #[serde(default)]
     pub times: Vec<f64>,
-    /// Table path: strains `[ε_xx, ε_yy, γ_xy]` at `times` (linear in between).
+    /// Table path: strains at `times` (linear in between), `[ε_xx, ε_yy, γ_xy]` in
+    /// the plane, `[ε_xx, ε_yy, γ_xy, ε_zz, γ_yz, γ_zx]` for a solid's point.
     #[serde(default)]
-    pub strains: Vec<[f64; 3]>,
+    pub strains: Vec<Vec<f64>>,
     /// Size of the element the point stands for (m), the crack-band length of
     /// softening laws. Default 0.1 m, a typical concrete element.
     #[serde(default = "default_length")]
@@ -105,15 +106,15 @@ fn default_length() -> f64 {
     0.1
 }
 
-/// One output row.
+/// One output row (`V` strain components: 3 in the plane, 6 for a solid's point).
 #[derive(Clone, Debug, PartialEq)]
-pub struct PointRecord {
+pub struct PointRecord<const V: usize = 3> {
     /// Time.
     pub t: f64,
     /// Strain.
-    pub eps: [f64; 3],
+    pub eps: [f64; V],
     /// Material response of the step.
-    pub response: PointResponse,
+    pub response: PointResponse<V>,
     /// History after the step.
     pub state: Vec<f64>,
     /// Cumulative viscous, damage, plastic, numerical dissipation.
@@ -122,27 +123,38 @@ pub struct PointRecord {
     pub work: f64,
 }
 
-/// Targets per component at time `t`: `(strain_given, value)`.
-fn targets(p: &PathSpec, t: f64) -> [(bool, f64); 3] {
+/// Targets per component at time `t`: `(strain_given, value)`. A solid's point
+/// (`V = 6`, components `[xx, yy, xy, zz, yz, zx]`) leaves its out-of-plane
+/// components stress free where the plane path leaves `σ_yy` or `σ_xy` free, and
+/// holds their strain at zero where the plane path holds strain.
+fn targets<const V: usize>(p: &PathSpec, t: f64) -> [(bool, f64); V] {
     let a = p.amplitude * p.function.at(t);
     let s = p.control == Control::Strain;
+    let loaded = |i: usize, given: bool, v: f64| move |k: usize| (k == i).then_some((given, v));
+    let free = (false, 0.0);
+    let held = (true, 0.0);
+    let pick = |first: &[(usize, (bool, f64))], rest: (bool, f64)| -> [(bool, f64); V] {
+        std::array::from_fn(|k| {
+            first
+                .iter()
+                .find_map(|&(i, x)| loaded(i, x.0, x.1)(k))
+                .unwrap_or(rest)
+        })
+    };
     match p.kind {
-        PathKind::UniaxialStress => [(s, a), (false, 0.0), (false, 0.0)],
-        PathKind::UniaxialStrain => [(s, a), (true, 0.0), (true, 0.0)],
-        PathKind::PureShear => [(true, 0.0), (true, 0.0), (s, a)],
-        PathKind::Biaxial => [(s, a), (s, p.ratio * a), (false, 0.0)],
-        PathKind::Table => {
-            let f = |i: usize| {
-                let pts: Vec<[f64; 2]> = p
-                    .times
-                    .iter()
-                    .zip(&p.strains)
-                    .map(|(t, e)| [*t, e[i]])
-                    .collect();
-                TimeFunction::Table { points: pts }.at(t)
-            };
-            [(true, f(0)), (true, f(1)), (true, f(2))]
-        }
+        PathKind::UniaxialStress => pick(&[(0, (s, a))], free),
+        PathKind::UniaxialStrain => pick(&[(0, (s, a))], held),
+        PathKind::PureShear => pick(&[(2, (s, a))], held),
+        PathKind::Biaxial => pick(&[(0, (s, a)), (1, (s, p.ratio * a))], free),
+        PathKind::Table => std::array::from_fn(|i| {
+            let pts: Vec<[f64; 2]> = p
+                .times
+                .iter()
+                .zip(&p.strains)
+                .map(|(t, e)| [*t, e[i]])
+                .collect();
+            (true, TimeFunction::Table { points: pts }.at(t))
+        }),
     }
 }
 
@@ -174,7 +186,22 @@ fn check(p: &PathSpec) -> Result<()> {
             ));
         }
         crate::config::finite_pub("path.times", &p.times)?;
+        let v = p.plane.voigt();
         for (i, e) in p.strains.iter().enumerate() {
+            if e.len() != v {
+                return Err(Error::config(
+                    format!("path.strains[{i}]"),
+                    format!(
+                        "has {} components, expected {v} ({})",
+                        e.len(),
+                        if v == 6 {
+                            "a solid's point: [ε_xx, ε_yy, γ_xy, ε_zz, γ_yz, γ_zx]"
+                        } else {
+                            "a plane point: [ε_xx, ε_yy, γ_xy]"
+                        }
+                    ),
+                ));
+            }
             crate::config::finite_pub(&format!("path.strains[{i}]"), e)?;
         }
         if let Some(i) = p.times.windows(2).position(|w| w[1] <= w[0]) {
@@ -195,28 +222,55 @@ fn check(p: &PathSpec) -> Result<()> {
 /// Steps a material-point path may take (one row each in `material.csv`).
 const MAX_POINT_STEPS: f64 = 1e8;
 
-/// Runs the path and returns one record per step (the first at `t = 0`).
+/// Runs a plane path and returns one record per step (the first at `t = 0`).
 pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
+    collect_path::<3>(mat, p)
+}
+
+/// Runs a solid point's path (`plane = "solid"`) and returns one record per step.
+pub fn run_solid_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord<6>>> {
+    collect_path::<6>(mat, p)
+}
+
+fn collect_path<const V: usize>(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord<V>>> {
     let mut out = Vec::new();
-    run_path_with(mat, p, |r| {
+    drive::<V, _>(mat, p, |r| {
         out.push(r.clone());
         Ok(())
     })?;
     Ok(out)
 }
 
-/// Runs the path and hands each record to `sink` as it is computed (the first at
-/// `t = 0`), so a long path needs no memory of its own.
-pub fn run_path_with<F>(mat: &Material, p: &PathSpec, mut sink: F) -> Result<usize>
+/// Runs a plane path and hands each record to `sink` as it is computed (the first
+/// at `t = 0`), so a long path needs no memory of its own.
+pub fn run_path_with<F>(mat: &Material, p: &PathSpec, sink: F) -> Result<usize>
 where
     F: FnMut(&PointRecord) -> Result<()>,
 {
+    drive::<3, F>(mat, p, sink)
+}
+
+/// The path of a point with `V` strain components (the path's `plane` must say as
+/// many).
+fn drive<const V: usize, F>(mat: &Material, p: &PathSpec, mut sink: F) -> Result<usize>
+where
+    F: FnMut(&PointRecord<V>) -> Result<()>,
+{
     check(p)?;
-    let ns = mat.n_state();
+    if p.plane.voigt() != V {
+        return Err(Error::config(
+            "path.plane",
+            format!(
+                "a point of {} strain components driven as one of {V}",
+                p.plane.voigt()
+            ),
+        ));
+    }
+    let ns = mat.n_state_for(V);
     let mut state_n = vec![0.0; ns];
     mat.init_state(&mut state_n);
     let mut state = state_n.clone();
-    let mut eps_n = [0.0; 3];
+    let mut eps_n = [0.0; V];
     sink(&PointRecord {
         t: 0.0,
         eps: eps_n,
@@ -237,7 +291,7 @@ where
     };
     for k in 1..=n {
         let t = k as f64 * p.dt;
-        let tg = targets(p, t);
+        let tg = targets::<V>(p, t);
         let mut eps = eps_n;
         for (i, (given, v)) in tg.iter().enumerate() {
             if *given {
@@ -264,7 +318,7 @@ where
                      (strain {eps:?})"
                 )));
             }
-            let free: Vec<usize> = (0..3).filter(|&i| !tg[i].0).collect();
+            let free: Vec<usize> = (0..V).filter(|&i| !tg[i].0).collect();
             let r: Vec<f64> = free.iter().map(|&i| resp.sigma[i] - tg[i].1).collect();
             let scale = resp
                 .sigma
@@ -305,7 +359,7 @@ where
         diss[1] += d.damage;
         diss[2] += d.plastic;
         diss[3] += d.numerical;
-        work += (0..3)
+        work += (0..V)
             .map(|i| resp.sigma[i] * (eps[i] - eps_n[i]))
             .sum::<f64>();
         record.t = t;
@@ -350,33 +404,49 @@ pub fn run_file(file: &Path, out: &Path, announce: impl FnOnce(&Material)) -> Re
     check(&spec.path).map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
     announce(&mat);
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    if spec.path.plane.voigt() == 6 {
+        write_csv::<6>(&mat, &spec.path, out)
+    } else {
+        write_csv::<3>(&mat, &spec.path, out)
+    }
+}
+
+/// Runs the path of a point with `V` strain components and writes `material.csv`.
+fn write_csv<const V: usize>(mat: &Material, p: &PathSpec, out: &Path) -> Result<usize> {
     let path = out.join("material.csv");
     let mut w =
         std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| Error::io(&path, e))?);
-    let mut header = vec![
-        "t", "eps_xx", "eps_yy", "gamma_xy", "sig_xx", "sig_yy", "sig_xy", "psi",
-    ];
-    header.extend(mat.state_names());
+    let (strains, stresses): (&[&str], &[&str]) = if V == 6 {
+        (
+            &[
+                "eps_xx", "eps_yy", "gamma_xy", "eps_zz", "gamma_yz", "gamma_zx",
+            ],
+            &["sig_xx", "sig_yy", "sig_xy", "sig_zz", "sig_yz", "sig_zx"],
+        )
+    } else {
+        (
+            &["eps_xx", "eps_yy", "gamma_xy"],
+            &["sig_xx", "sig_yy", "sig_xy"],
+        )
+    };
+    let mut header = vec!["t"];
+    header.extend(strains);
+    header.extend(stresses);
+    header.push("psi");
+    header.extend(mat.state_names_for(V));
     header.extend(["D_viscous", "D_damage", "D_plastic", "D_num", "work"]);
     let io = |e| Error::io(&path, e);
     writeln!(w, "{}", header.join(",")).map_err(io)?;
     let mut line = String::new();
-    let steps = run_path_with(&mat, &spec.path, |r| {
+    let steps = drive::<V, _>(mat, p, |r| {
         line.clear();
-        let values = [
-            r.t,
-            r.eps[0],
-            r.eps[1],
-            r.eps[2],
-            r.response.sigma[0],
-            r.response.sigma[1],
-            r.response.sigma[2],
-            r.response.psi,
-        ]
-        .into_iter()
-        .chain(r.state.iter().copied())
-        .chain(r.dissipated)
-        .chain([r.work]);
+        let values = std::iter::once(r.t)
+            .chain(r.eps)
+            .chain(r.response.sigma)
+            .chain([r.response.psi])
+            .chain(r.state.iter().copied())
+            .chain(r.dissipated)
+            .chain([r.work]);
         for (k, v) in values.enumerate() {
             if k > 0 {
                 line.push(',');
