@@ -356,22 +356,12 @@ fn rankine_hill_corner_return_satisfies_kkt() {
 
 fn fd_tangent_check(m: &Material, eps_n: [f64; 3], eps: [f64; 3], state_n: &[f64]) {
     let (r, _) = rh_point(m, eps_n, eps, state_n);
-    let h = 1e-9;
-    for j in 0..3 {
-        let (mut ep, mut em) = (eps, eps);
-        ep[j] += h;
-        em[j] -= h;
-        let sp = rh_point(m, eps_n, ep, state_n).0.sigma;
-        let sm = rh_point(m, eps_n, em, state_n).0.sigma;
-        for i in 0..3 {
-            let fd = (sp[i] - sm[i]) / (2.0 * h);
-            assert!(
-                (fd - r.tangent[i][j]).abs() < 1e-4 * E,
-                "D[{i}][{j}] = {} vs finite difference {fd} at ε = {eps:?}",
-                r.tangent[i][j]
-            );
-        }
-    }
+    common::assert_tangent_is_the_derivative(
+        &r.tangent,
+        eps,
+        |e| rh_point(m, eps_n, e, state_n).0.sigma,
+        1e-4 * E,
+    );
 }
 
 #[test]

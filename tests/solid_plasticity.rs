@@ -473,22 +473,12 @@ fn solid_consistent_tangents_match_finite_differences() {
         ] {
             let eps = strain_along(&q, d);
             let (r, _) = point(&m, [0.0; 6], eps, &h);
-            let step = 1e-9;
-            for j in 0..6 {
-                let (mut ep, mut em) = (eps, eps);
-                ep[j] += step;
-                em[j] -= step;
-                let sp = point(&m, [0.0; 6], ep, &h).0.sigma;
-                let sm = point(&m, [0.0; 6], em, &h).0.sigma;
-                for i in 0..6 {
-                    let fd = (sp[i] - sm[i]) / (2.0 * step);
-                    assert!(
-                        (fd - r.tangent[i][j]).abs() < 1e-4 * E,
-                        "D[{i}][{j}] = {} vs finite difference {fd} at {d:?}",
-                        r.tangent[i][j]
-                    );
-                }
-            }
+            common::assert_tangent_is_the_derivative(
+                &r.tangent,
+                eps,
+                |e| point(&m, [0.0; 6], e, &h).0.sigma,
+                1e-4 * E,
+            );
         }
     }
 }
@@ -629,21 +619,12 @@ fn plane_strain_tangents_match_finite_differences() {
             ([4e-4, -1e-4, 2e-4], hardened),
         ] {
             let (r, _) = plane_strain_point(&m, [0.0; 3], eps, &st);
-            for j in 0..3 {
-                let (mut ep, mut em) = (eps, eps);
-                ep[j] += 1e-9;
-                em[j] -= 1e-9;
-                let sp = plane_strain_point(&m, [0.0; 3], ep, &st).0.sigma;
-                let sm = plane_strain_point(&m, [0.0; 3], em, &st).0.sigma;
-                for i in 0..3 {
-                    let fd = (sp[i] - sm[i]) / 2e-9;
-                    assert!(
-                        (fd - r.tangent[i][j]).abs() < 1e-4 * E,
-                        "D[{i}][{j}] = {} vs {fd} at {eps:?}",
-                        r.tangent[i][j]
-                    );
-                }
-            }
+            common::assert_tangent_is_the_derivative(
+                &r.tangent,
+                eps,
+                |e| plane_strain_point(&m, [0.0; 3], e, &st).0.sigma,
+                1e-4 * E,
+            );
         }
     }
 }

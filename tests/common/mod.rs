@@ -119,3 +119,28 @@ pub fn strain_paths<const V: usize>(
                 .collect()
         })
 }
+
+/// Asserts that `tangent` is the derivative of `stress` at `eps`: central
+/// differences with steps `δε = 1e-9`, every entry to `tol` (a stiffness).
+pub fn assert_tangent_is_the_derivative<const V: usize>(
+    tangent: &[[f64; V]; V],
+    eps: [f64; V],
+    stress: impl Fn([f64; V]) -> [f64; V],
+    tol: f64,
+) {
+    let h = 1e-9;
+    for j in 0..V {
+        let (mut ep, mut em) = (eps, eps);
+        ep[j] += h;
+        em[j] -= h;
+        let (sp, sm) = (stress(ep), stress(em));
+        for i in 0..V {
+            let fd = (sp[i] - sm[i]) / (2.0 * h);
+            assert!(
+                (fd - tangent[i][j]).abs() < tol,
+                "D[{i}][{j}] = {} vs finite difference {fd} at ε = {eps:?}",
+                tangent[i][j]
+            );
+        }
+    }
+}
