@@ -295,19 +295,7 @@ fn rh_point(
     eps: [f64; 3],
     state_n: &[f64],
 ) -> (rothe::material::PointResponse, Vec<f64>) {
-    let mut st = vec![0.0; 5];
-    let r = m.update(
-        Plane::Stress,
-        &StrainStep {
-            eps_n,
-            eps,
-            dt: 1e-4,
-            length: 0.1,
-        },
-        state_n,
-        &mut st,
-    );
-    (r, st)
+    common::point_update(m, Plane::Stress, eps_n, eps, state_n)
 }
 
 #[test]

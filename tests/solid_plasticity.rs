@@ -40,19 +40,7 @@ fn point(
     eps: [f64; 6],
     state_n: &[f64],
 ) -> (PointResponse<6>, Vec<f64>) {
-    let mut st = vec![0.0; m.n_state_for(6)];
-    let r = m.update(
-        Plane::Solid,
-        &StrainStep {
-            eps_n,
-            eps,
-            dt: 1e-4,
-            length: 0.1,
-        },
-        state_n,
-        &mut st,
-    );
-    (r, st)
+    common::point_update(m, Plane::Solid, eps_n, eps, state_n)
 }
 
 /// The symmetric tensor of a Voigt vector whose shears are `shear` times the
@@ -521,26 +509,14 @@ proptest! {
     }
 }
 
-/// One plane-strain point update (element size 0.1), state of six values.
+/// One plane-strain point update (element size 0.1).
 fn plane_strain_point(
     m: &Material,
     eps_n: [f64; 3],
     eps: [f64; 3],
     state_n: &[f64],
 ) -> (PointResponse, Vec<f64>) {
-    let mut st = vec![0.0; m.n_state()];
-    let r = m.update(
-        Plane::Strain,
-        &StrainStep {
-            eps_n,
-            eps,
-            dt: 1e-4,
-            length: 0.1,
-        },
-        state_n,
-        &mut st,
-    );
-    (r, st)
+    common::point_update(m, Plane::Strain, eps_n, eps, state_n)
 }
 
 #[test]

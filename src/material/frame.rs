@@ -77,15 +77,20 @@ impl Frame<3, 2> for PlaneFrame {
 /// The tensor index pairs of a solid's Voigt components `[xx, yy, xy, zz, yz, zx]`.
 pub const VOIGT6_PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (0, 1), (2, 2), (1, 2), (2, 0)];
 
-/// The solid's frame: a rotation whose rows are the principal directions.
+/// The solid's frame: a rotation whose rows are the principal directions, and its
+/// strain transformation (built once: a return reads it twice).
 pub struct SolidFrame {
     q: [[f64; 3]; 3],
+    t: [[f64; 6]; 6],
 }
 
 impl SolidFrame {
     /// The frame with the given principal directions (rows, orthonormal).
     pub fn new(q: [[f64; 3]; 3]) -> Self {
-        SolidFrame { q }
+        SolidFrame {
+            q,
+            t: strain_transformation(&q),
+        }
     }
 
     /// `Σ_k a_k Q_ki Q_kj` in Voigt layout, shears times `shear`.
@@ -113,12 +118,11 @@ impl Frame<6, 3> for SolidFrame {
     fn decompose(s: &[f64; 6]) -> (Self, [f64; 3]) {
         let t = [[s[0], s[2], s[5]], [s[2], s[1], s[4]], [s[5], s[4], s[3]]];
         let (values, q) = eigen_sym3(t);
-        (SolidFrame { q }, values)
+        (SolidFrame::new(q), values)
     }
 
     fn strain_to_frame(&self, e: &[f64; 6]) -> [f64; 6] {
-        let t = self.transform();
-        std::array::from_fn(|i| (0..6).map(|j| t[i][j] * e[j]).sum())
+        std::array::from_fn(|i| (0..6).map(|j| self.t[i][j] * e[j]).sum())
     }
 
     fn stress_from(&self, a: &[f64; 3]) -> [f64; 6] {
@@ -130,23 +134,27 @@ impl Frame<6, 3> for SolidFrame {
     }
 
     fn transform(&self) -> [[f64; 6]; 6] {
-        // ε'_ab = Σ_ij Q_ai Q_bj ε_ij; a Voigt shear γ_ij = 2 ε_ij enters through
-        // both ε_ij and ε_ji, and a shear row is γ'_ab = 2 ε'_ab.
-        let q = &self.q;
-        std::array::from_fn(|r| {
-            let (a, b) = VOIGT6_PAIRS[r];
-            let row_scale = if a == b { 1.0 } else { 2.0 };
-            std::array::from_fn(|c| {
-                let (i, j) = VOIGT6_PAIRS[c];
-                let v = if i == j {
-                    q[a][i] * q[b][i]
-                } else {
-                    0.5 * (q[a][i] * q[b][j] + q[a][j] * q[b][i])
-                };
-                row_scale * v
-            })
-        })
+        self.t
     }
+}
+
+/// The 6x6 strain transformation into the frame whose rows are `q`:
+/// `ε'_ab = Σ_ij Q_ai Q_bj ε_ij`; a Voigt shear `γ_ij = 2 ε_ij` enters through both
+/// `ε_ij` and `ε_ji`, and a shear row is `γ'_ab = 2 ε'_ab`.
+fn strain_transformation(q: &[[f64; 3]; 3]) -> [[f64; 6]; 6] {
+    std::array::from_fn(|r| {
+        let (a, b) = VOIGT6_PAIRS[r];
+        let row_scale = if a == b { 1.0 } else { 2.0 };
+        std::array::from_fn(|c| {
+            let (i, j) = VOIGT6_PAIRS[c];
+            let v = if i == j {
+                q[a][i] * q[b][i]
+            } else {
+                0.5 * (q[a][i] * q[b][j] + q[a][j] * q[b][i])
+            };
+            row_scale * v
+        })
+    })
 }
 
 /// Eigenvalues (decreasing) and eigenvectors (the rows of the returned matrix,

@@ -144,3 +144,28 @@ pub fn assert_tangent_is_the_derivative<const V: usize>(
         }
     }
 }
+
+/// One material-point update of `m` from `state_n` to the strain `eps` (step 1e-4 s,
+/// element size 0.1 m) in the idealisation `plane`: the response and the new
+/// state (as many values as `state_n`).
+pub fn point_update<const V: usize>(
+    m: &Material,
+    plane: Plane,
+    eps_n: [f64; V],
+    eps: [f64; V],
+    state_n: &[f64],
+) -> (rothe::material::PointResponse<V>, Vec<f64>) {
+    let mut st = vec![0.0; state_n.len()];
+    let r = m.update(
+        plane,
+        &rothe::material::StrainStep {
+            eps_n,
+            eps,
+            dt: 1e-4,
+            length: 0.1,
+        },
+        state_n,
+        &mut st,
+    );
+    (r, st)
+}
