@@ -347,6 +347,20 @@ pub enum Master {
         /// Unit normal pointing to the side the slave body lies on.
         n: [f64; 2],
     },
+    /// Faces of a solid (triangles or quadrilaterals, a triangle's fourth node
+    /// `usize::MAX`), numbered counter-clockwise seen from outside, so their normal
+    /// points out of the body.
+    Faces(Vec<[usize; 4]>),
+    /// A rigid plane through `point` with unit normal `n` towards the slave body: a
+    /// unilateral support of a solid, unbounded.
+    Plane {
+        /// A point of the plane.
+        point: [f64; 3],
+        /// Unit normal pointing to the side the slave body lies on.
+        n: [f64; 3],
+        /// Two unit tangents of the plane, orthonormal with `n` (friction's axes).
+        tangents: [[f64; 3]; 2],
+    },
 }
 
 /// One direction of a contact pair: slave nodes that may not cross the master.
@@ -359,6 +373,9 @@ pub struct ContactSide {
     /// The slave's segments (oriented with its body on their left) when the side is
     /// enforced by mortar weighted gaps; empty for node-to-segment.
     pub mortar: Vec<[usize; 2]>,
+    /// A solid's slave faces, when the slave is a face set: the tributary areas of
+    /// its nodes for the contact pressure; empty otherwise.
+    pub faces: Vec<[usize; 4]>,
 }
 
 /// How a deformable pair's impenetrability is written (`theory/contact.md`).

@@ -118,7 +118,9 @@ pub struct MeshingSpec {
 
 /// `[[contact]]`: a slave node or edge set against a master edge set of another body
 /// (mortar or node-to-segment, with Coulomb friction `mu`), or against a rigid line
-/// (a unilateral support: it resists motion into it and lets the body lift off).
+/// (a unilateral support: it resists motion into it and lets the body lift off). In
+/// a solid: a slave node or face set against a master face set (node to face) or a
+/// rigid plane.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
@@ -126,13 +128,18 @@ pub struct ContactSpec {
     pub name: String,
     /// The slave side: a node set or an edge set (its nodes) of one body.
     pub slave: String,
-    /// The master side: an edge set of another body. Give this or `rigid_line`.
+    /// The master side: an edge set of another body (a face set in a solid). Give
+    /// this, `rigid_line` (plane) or `rigid_plane` (solid).
     #[serde(default)]
     pub master: Option<String>,
     /// A rigid line `[[x0, y0], [x1, y1]]` the slave nodes may not cross (a unilateral
     /// support). Its side is the one the slave body lies on.
     #[serde(default, deserialize_with = "exact::option_segment")]
     pub rigid_line: Option<[[f64; 2]; 2]>,
+    /// A solid's rigid plane the slave nodes may not cross (unbounded; its side is
+    /// the one the slave body lies on).
+    #[serde(default)]
+    pub rigid_plane: Option<RigidPlaneSpec>,
     /// Also check the master's nodes against the slave's edges (the slave must be an
     /// edge set). Default false: slave nodes against master segments only.
     #[serde(default)]
@@ -154,6 +161,17 @@ pub struct ContactSpec {
     /// or `node_to_segment`. Rigid lines and the explicit path are node to segment.
     #[serde(default)]
     pub formulation: Option<crate::model::Formulation>,
+}
+
+/// `contact.rigid_plane`: a point of the plane and its normal (either sense: the
+/// side of the slave body is kept).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidPlaneSpec {
+    /// A point of the plane `[x, y, z]`.
+    pub point: Vec<f64>,
+    /// A normal of the plane `[x, y, z]` (any length but zero).
+    pub normal: Vec<f64>,
 }
 
 fn default_vtk_every() -> usize {

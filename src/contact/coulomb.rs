@@ -34,17 +34,19 @@ pub const SHIFT_TOLERANCE: f64 = 1e-8;
 
 /// Solves Coulomb's law for the rows: `w` column-major `m x m`, `c` the predicted
 /// gaps then slips, the first `n` rows normal, `cones[k] = (j, μ)` the normal row
-/// `j` and coefficient of tangential row `n + k`. Writes the forces into `lambda`
-/// and returns the Clarabel iterations summed over the shift iterations.
+/// `j` and coefficient of the tangential rows `n + tdim k + i`, `i < tdim` (one
+/// tangent in the plane, two in a solid: the cone `|λ_T| ≤ μ λ_N` of dimension
+/// `tdim + 1`). Writes the forces into `lambda` and returns the Clarabel iterations
+/// summed over the shift iterations.
 pub(crate) fn solve(
     w: &[f64],
     c: &[f64],
-    n: usize,
+    (n, tdim): (usize, usize),
     cones: &[(usize, f64)],
     lambda: &mut Vec<f64>,
 ) -> Result<QpStats, String> {
     let m = c.len();
-    debug_assert_eq!(m, n + cones.len());
+    debug_assert_eq!(m, n + tdim * cones.len());
     lambda.clear();
     lambda.resize(m, 0.0);
     // No force when no gap would close: Λ = 0 with σ = μ|c_T| satisfies the law.
@@ -76,8 +78,10 @@ pub(crate) fn solve(
     let free = row;
     for (k, &(j, mu)) in cones.iter().enumerate() {
         entries.push((row, j, -mu));
-        entries.push((row + 1, n + k, -1.0));
-        row += 2;
+        for i in 0..tdim {
+            entries.push((row + 1 + i, n + tdim * k + i, -1.0));
+        }
+        row += 1 + tdim;
     }
     let a = csc(row, m, &mut entries);
     let b = vec![0.0; row];
@@ -85,7 +89,11 @@ pub(crate) fn solve(
     if free > 0 {
         kinds.push(SupportedConeT::NonnegativeConeT(free));
     }
-    kinds.extend(cones.iter().map(|_| SupportedConeT::SecondOrderConeT(2)));
+    kinds.extend(
+        cones
+            .iter()
+            .map(|_| SupportedConeT::SecondOrderConeT(1 + tdim)),
+    );
     let mut shift = vec![0.0; cones.len()];
     let mut q: Vec<f64> = c.iter().map(|x| x / ell).collect();
     let mut solver = DefaultSolver::new(&p, &q, &a, &b, &kinds, settings())
@@ -104,9 +112,16 @@ pub(crate) fn solve(
         // The slips of the solution, and the shift they ask for.
         let mut moved: f64 = 0.0;
         for (k, &(j, mu)) in cones.iter().enumerate() {
-            let t = n + k;
-            let slip = c[t] + (0..m).map(|i| w[t + i * m] * lambda[i]).sum::<f64>();
-            let s = mu * slip.abs();
+            let slip = |t: usize| c[t] + (0..m).map(|i| w[t + i * m] * lambda[i]).sum::<f64>();
+            let size = if tdim == 1 {
+                slip(n + k).abs()
+            } else {
+                (0..tdim)
+                    .map(|i| slip(n + tdim * k + i).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            };
+            let s = mu * size;
             moved = moved.max((s - shift[k]).abs());
             shift[k] = s;
             q[j] = (c[j] + s) / ell;
@@ -156,7 +171,7 @@ mod tests {
         let (wn, wt) = (2.0e-9, 3.0e-9);
         let w = [wn, 0.0, 0.0, wt];
         let mut l = Vec::new();
-        solve(&w, &[c_n, c_t], 1, &[(0, mu)], &mut l).unwrap();
+        solve(&w, &[c_n, c_t], (1, 1), &[(0, mu)], &mut l).unwrap();
         let slip = c_t + wt * l[1];
         (l[0], l[1], slip)
     }
@@ -198,7 +213,7 @@ mod tests {
         let c = [-2.0e-3, -1.0e-3, 3.0e-4, -1.0e-5];
         let cones = [(0, 0.1), (1, 0.5)];
         let mut reference = Vec::new();
-        solve(&w, &c, 2, &cones, &mut reference).unwrap();
+        solve(&w, &c, (2, 1), &cones, &mut reference).unwrap();
         let status = |k: usize| {
             let (ln, lt, mu) = (reference[cones[k].0], reference[2 + k], cones[k].1);
             if lt.abs() < (1.0 - 1e-6) * mu * ln {

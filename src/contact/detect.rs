@@ -412,6 +412,8 @@ where
                         }
                     }
                 }
+                // A solid's masters: [`super::faces`].
+                Master::Faces(_) | Master::Plane { .. } => {}
             }
         }
     }
@@ -440,6 +442,7 @@ mod tests {
                 slaves: vec![3, 4, 5],
                 master: Master::Segments(vec![[0, 1], [1, 2]]),
                 mortar: Vec::new(),
+                faces: Vec::new(),
             }],
             radius: 1.0,
             friction: 0.0,
@@ -496,6 +499,7 @@ mod tests {
                 slaves,
                 master: Master::Segments(segments),
                 mortar: Vec::new(),
+                faces: Vec::new(),
             }],
             radius: 1.0,
             friction: 0.0,
@@ -550,6 +554,7 @@ mod tests {
                     n: [0.0, 1.0],
                 },
                 mortar: Vec::new(),
+                faces: Vec::new(),
             }],
             radius: 0.1,
             friction: 0.0,

@@ -302,6 +302,8 @@ impl<'m> KinematicContact<'m> {
                             }
                         }
                     }
+                    // Validation keeps the explicit path to the plane.
+                    Master::Faces(_) | Master::Plane { .. } => {}
                 }
             }
         }
@@ -441,7 +443,7 @@ impl<'m> KinematicContact<'m> {
         let cones: Vec<(usize, f64)> = frictional.iter().map(|&i| (i, self.rows[i].mu)).collect();
         let mut q = Vec::new();
         self.step.clarabel += 1;
-        super::coulomb::solve(&w, &c, m, &cones, &mut q).map_err(|e| {
+        super::coulomb::solve(&w, &c, (m, 1), &cones, &mut q).map_err(|e| {
             Error::Stepping(format!(
                 "the impact impulses of the kinematic contact with friction: {e}"
             ))

@@ -18,6 +18,7 @@ pub mod collision;
 mod compliance;
 pub(crate) mod coulomb;
 pub mod detect;
+pub mod faces;
 pub mod implicit;
 pub mod kinematic;
 pub mod mortar;
@@ -30,11 +31,63 @@ pub use implicit::ContactCorrection;
 pub use rows::{gap_matrix, Candidate, Contactee};
 pub use state::{ContactState, PairRecord};
 
+/// The candidates of every pair at displacements `u` (all dofs), by the detection
+/// of the model's dimension: segments and rigid lines in the plane
+/// ([`detect::detect`]), faces and rigid planes in a solid ([`faces::detect`]).
+pub fn candidates(model: &crate::model::Model, u: &[f64], out: &mut Vec<Candidate>) {
+    let coords = &model.mesh.coords;
+    if model.mesh.dim == 3 {
+        faces::detect(
+            &model.contacts,
+            |n| {
+                let c = coords[n];
+                [c[0] + u[3 * n], c[1] + u[3 * n + 1], c[2] + u[3 * n + 2]]
+            },
+            out,
+        );
+    } else {
+        detect::detect(
+            &model.contacts,
+            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+            out,
+        );
+    }
+}
+
 /// The tributary area (length × thickness) of every node as a slave, for contact
-/// pressures: half of every element edge joining two slave nodes of a side.
+/// pressures: half of every element edge joining two slave nodes of a side. In a
+/// solid, the share of the slave faces' areas (a third of a triangle, a quarter of a
+/// quadrilateral: the integrals of its shape functions over a parallelogram); zero
+/// on a slave node set, which has no faces.
 pub fn tributary_areas(model: &crate::model::Model) -> Vec<f64> {
     let mesh = &model.mesh;
     let mut area = vec![0.0; mesh.n_nodes()];
+    if mesh.dim == 3 {
+        for side in model.contacts.iter().flat_map(|p| &p.sides) {
+            for f in &side.faces {
+                let c = faces::corners(f);
+                let x = |k: usize| mesh.coords[c[k % c.len()]];
+                let d = |a: [f64; 3], b: [f64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                // Half the cross product of the diagonals (of two edges for a
+                // triangle).
+                let (p, q) = if c.len() == 3 {
+                    (d(x(0), x(1)), d(x(0), x(2)))
+                } else {
+                    (d(x(0), x(2)), d(x(1), x(3)))
+                };
+                let n = [
+                    p[1] * q[2] - p[2] * q[1],
+                    p[2] * q[0] - p[0] * q[2],
+                    p[0] * q[1] - p[1] * q[0],
+                ];
+                let a = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                for &v in c {
+                    area[v] += a / c.len() as f64;
+                }
+            }
+        }
+        return area;
+    }
     for pair in &model.contacts {
         for side in &pair.sides {
             let mut is_slave = vec![false; mesh.n_nodes()];

@@ -1,7 +1,9 @@
 //! The rows of contact: what every formulation hands to the QP. A row is a gap
 //! `g = n · Σ_k w_k x_k` over a few nodes `k` with weights `w_k` (slave weights
-//! summing to 1, master ones to −1) along a normal `n`, and its tangential twin along
-//! `t = (n_y, −n_x)`; node to segment ([`super::detect`]) and mortar
+//! summing to 1, master ones to −1) along a normal `n`, and its tangential twins
+//! along the tangents of the contact plane: in the plane the one `t = (n_y, −n_x)`,
+//! in a solid two orthonormal `t₁, t₂` ([`super::faces`]). Node to segment
+//! ([`super::detect`]), node to face ([`super::faces`]) and mortar
 //! ([`super::mortar`]) build them, the implicit correction, friction and the ledger
 //! read them the same way. Here too the sparse gap matrices of a set of rows.
 
@@ -15,7 +17,15 @@ pub enum Contactee {
         /// End nodes.
         nodes: [usize; 2],
     },
-    /// The rigid line of the pair's side.
+    /// Face `index` of the side's master (a solid's triangle or quadrilateral),
+    /// its nodes (a triangle's fourth `usize::MAX`).
+    Face {
+        /// Index among the side's master faces.
+        index: usize,
+        /// Corner nodes.
+        nodes: [usize; 4],
+    },
+    /// The rigid line (plane: rigid plane) of the pair's side.
     Rigid,
     /// The master segments the slave node's shape function sees (mortar: the
     /// weighted gap of the node, [`super::mortar`]).
@@ -104,8 +114,13 @@ pub struct Candidate {
     /// Gap along the normal (m): positive open, negative penetrating.
     pub gap: f64,
     /// Unit outward normal of the master (mortar: opposite to the slave's nodal
-    /// normal).
-    pub normal: [f64; 2],
+    /// normal); `z = 0` in the plane.
+    pub normal: [f64; 3],
+    /// The unit tangents of the contact plane: in the plane the one
+    /// `(n_y, −n_x, 0)` (the second zero), in a solid two, orthonormal with `n`.
+    pub tangents: [[f64; 3]; 2],
+    /// The spatial dimension of the row (2 or 3): dofs `dim · node + i`.
+    pub dim: u8,
     /// The row's nodes and weights.
     pub weights: Weights,
     /// The length (m) the row's gap stands for: the slave's tributary length, the
@@ -123,7 +138,7 @@ impl Candidate {
     /// for a mortar row).
     pub fn key(&self) -> (usize, usize, usize, usize) {
         let master = match self.master {
-            Contactee::Segment { index, .. } => index,
+            Contactee::Segment { index, .. } | Contactee::Face { index, .. } => index,
             Contactee::Rigid => usize::MAX,
             Contactee::Mortar => MORTAR_KEY,
         };
@@ -135,10 +150,15 @@ impl Candidate {
         (self.pair, self.side, self.slave)
     }
 
-    /// The unit tangent `t = (n_y, −n_x)`: the direction of the tangential row and of
-    /// the friction force on the slave.
+    /// The unit tangent `t = (n_y, −n_x)` of a plane row: the direction of its
+    /// tangential row and of the friction force on the slave.
     pub fn tangent(&self) -> [f64; 2] {
         [self.normal[1], -self.normal[0]]
+    }
+
+    /// The number of tangential rows: 1 in the plane, 2 in a solid.
+    pub fn n_tangents(&self) -> usize {
+        self.dim as usize - 1
     }
 
     /// The nonzeros `(dof, coefficient)` of the linearised gap row (all dofs).
@@ -146,25 +166,46 @@ impl Candidate {
         self.along(self.normal)
     }
 
-    /// The nonzeros of the tangential row: the relative tangential displacement of
-    /// the slave and its master, `t · Σ w_k δ_k`.
-    pub fn tangent_row(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
-        self.along(self.tangent())
+    /// The nonzeros of tangential row `j`: the relative tangential displacement of
+    /// the slave and its master along `t_j`, `t_j · Σ w_k δ_k`.
+    pub fn tangent_row(&self, j: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        self.along(self.tangents[j])
     }
 
-    /// `d · Σ w_k δ_k` as `(dof, coefficient)`.
-    fn along(&self, d: [f64; 2]) -> impl Iterator<Item = (usize, f64)> + '_ {
+    /// `d · Σ w_k δ_k` as `(dof, coefficient)`, `dim` per node.
+    fn along(&self, d: [f64; 3]) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let dim = self.dim as usize;
         self.weights
             .iter()
-            .flat_map(move |(n, w)| [(2 * n, w * d[0]), (2 * n + 1, w * d[1])])
+            .flat_map(move |(n, w)| (0..dim).map(move |i| (dim * n + i, w * d[i])))
     }
 
     /// `Σ w_k p_k` of the nodal vectors `p(node)`.
-    pub fn combine(&self, p: impl Fn(usize) -> [f64; 2]) -> [f64; 2] {
-        self.weights.iter().fold([0.0, 0.0], |a, (n, w)| {
+    pub fn combine<const D: usize>(&self, p: impl Fn(usize) -> [f64; D]) -> [f64; D] {
+        self.weights.iter().fold([0.0; D], |mut a, (n, w)| {
             let q = p(n);
-            [a[0] + w * q[0], a[1] + w * q[1]]
+            for (ai, qi) in a.iter_mut().zip(q) {
+                *ai += w * qi;
+            }
+            a
         })
+    }
+
+    /// The tangential components `t_j · Σ w_k p_k` of the nodal vectors `p(node)`
+    /// (`dim` components each; the second zero in the plane).
+    pub fn tangential(&self, p: impl Fn(usize, usize) -> f64) -> [f64; 2] {
+        let dim = self.dim as usize;
+        let mut d = [0.0; 3];
+        for (n, w) in self.weights.iter() {
+            for (i, di) in d.iter_mut().enumerate().take(dim) {
+                *di += w * p(n, i);
+            }
+        }
+        let mut out = [0.0; 2];
+        for (j, o) in out.iter_mut().enumerate().take(self.n_tangents()) {
+            *o = (0..dim).map(|i| d[i] * self.tangents[j][i]).sum();
+        }
+        out
     }
 
     /// A node-to-segment or rigid-line candidate: the weights `+1` on the slave and
@@ -189,7 +230,9 @@ impl Candidate {
             master,
             xi,
             gap,
-            normal,
+            normal: [normal[0], normal[1], 0.0],
+            tangents: [[normal[1], -normal[0], 0.0], [0.0; 3]],
+            dim: 2,
             weights,
             length: 0.0,
         }
@@ -207,8 +250,9 @@ pub fn gap_matrix(
     rows_matrix(cands, columns, ncols, false)
 }
 
-/// The gap rows of `cands` followed by their tangential rows (rows `cands.len() + i`),
-/// as [`gap_matrix`].
+/// The gap rows of `cands` followed by their tangential rows (rows
+/// `cands.len() + (dim − 1) i + j` for tangent `j` of candidate `i`), as
+/// [`gap_matrix`].
 pub fn gap_and_tangent_matrix(
     cands: &[Candidate],
     columns: &[usize],
@@ -224,7 +268,8 @@ fn rows_matrix(
     ncols: usize,
     tangents: bool,
 ) -> nalgebra_sparse::CsrMatrix<f64> {
-    let n = if tangents { 2 } else { 1 } * cands.len();
+    let per = cands.first().map_or(1, |c| c.dim as usize);
+    let n = if tangents { per } else { 1 } * cands.len();
     let mut offsets = Vec::with_capacity(n + 1);
     let mut cols = Vec::with_capacity(6 * n);
     let mut values = Vec::with_capacity(6 * n);
@@ -235,8 +280,10 @@ fn rows_matrix(
     }
     if tangents {
         for c in cands {
-            gap_row(c.tangent_row(), columns, &mut cols, &mut values);
-            offsets.push(cols.len());
+            for j in 0..c.n_tangents() {
+                gap_row(c.tangent_row(j), columns, &mut cols, &mut values);
+                offsets.push(cols.len());
+            }
         }
     }
     nalgebra_sparse::CsrMatrix::try_from_unsorted_csr_data(n, ncols, offsets, cols, values)

@@ -3,7 +3,6 @@
 //! `history.csv` and `summary.json` read, and the nodal fields of the VTK output
 //! (gap, pressure, friction traction, slip path).
 
-use super::detect::detect;
 use crate::model::Model;
 
 /// Key of a constraint across re-linearisations: pair, side, slave node, master
@@ -46,8 +45,10 @@ pub struct ContactState {
     pub gap: Vec<f64>,
     /// Contact pressure at each node (Pa): its force over its tributary area.
     pub pressure: Vec<f64>,
-    /// The tangential multipliers (N) of the frictional rows, by key.
-    pub tangential: Vec<(Key, f64)>,
+    /// The tangential multipliers (N) of the frictional rows, by key: along the
+    /// row's tangent in the plane (the second zero), along its two tangents in a
+    /// solid.
+    pub tangential: Vec<(Key, [f64; 2])>,
     /// Tangential traction at each node (Pa), along its row's tangent.
     pub traction: Vec<f64>,
     /// Slip path of each node (m): the sum of the magnitudes of its relative
@@ -66,13 +67,8 @@ impl ContactState {
         if model.contacts.is_empty() {
             return out;
         }
-        let coords = &model.mesh.coords;
         let mut cands = Vec::new();
-        detect(
-            &model.contacts,
-            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            &mut cands,
-        );
+        super::candidates(model, u, &mut cands);
         out.gap = vec![f64::NAN; model.mesh.n_nodes()];
         out.pressure = vec![0.0; model.mesh.n_nodes()];
         for c in &cands {

@@ -135,6 +135,8 @@ pub fn crossed<X0, X1>(
                         }
                     }
                 }
+                // A solid's masters are swept by [`super::faces`].
+                Master::Faces(_) | Master::Plane { .. } => {}
             }
         }
     }

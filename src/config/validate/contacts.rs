@@ -131,6 +131,7 @@ pub(super) fn contacts(
             slave,
             master,
             rigid_line,
+            rigid_plane,
             both_ways,
             friction,
             position_weight,
@@ -192,6 +193,26 @@ pub(super) fn contacts(
             return Err(Error::config(
                 format!("{field}.name"),
                 format!("`{name}` is a probe name too: the history columns would clash"),
+            ));
+        }
+        if mesh.dim == 3 {
+            let (sides, radius, short) = super::solid_contacts::sides(mesh, &field, c, explicit)?;
+            shortest = shortest.min(short);
+            pairs.push(ContactPair {
+                name: name.clone(),
+                sides,
+                radius,
+                friction,
+                mu,
+                formulation: Formulation::NodeToSegment,
+                position_weight,
+            });
+            continue;
+        }
+        if rigid_plane.is_some() {
+            return Err(Error::config(
+                format!("{field}.rigid_plane"),
+                "a rigid plane is a solid's support; a plane model's is `rigid_line`",
             ));
         }
         let slaves = slave_nodes(mesh, &format!("{field}.slave"), slave)?;
@@ -264,6 +285,7 @@ pub(super) fn contacts(
                     slaves: slaves.clone(),
                     master: Master::Segments(edges.clone()),
                     mortar: mortar.clone().unwrap_or_default(),
+                    faces: Vec::new(),
                 });
                 if *both_ways {
                     let back =
@@ -285,6 +307,7 @@ pub(super) fn contacts(
                         slaves: nodes,
                         master: Master::Segments(back),
                         mortar: Vec::new(),
+                        faces: Vec::new(),
                     });
                 }
             }
@@ -332,6 +355,7 @@ pub(super) fn contacts(
                     slaves,
                     master: Master::Rigid { a: *a, b: *b, n },
                     mortar: Vec::new(),
+                    faces: Vec::new(),
                 });
             }
             _ => {

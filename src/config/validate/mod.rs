@@ -11,6 +11,7 @@ mod constraints;
 mod contacts;
 mod materials;
 mod meshes;
+mod solid_contacts;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -139,10 +140,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     meshes::add_bars(s, &mut mesh, &bodies, &materials, &find_material)?;
     let names: Vec<String> = bodies.iter().map(|b| b.name.clone()).collect();
     mesh.check_elements(&names)?;
-    let dim = mesh.dim;
-    if dim == 3 {
-        solid_scope(s)?;
-    }
+    let solid = mesh.dim == 3;
     let gravity = match &a.gravity {
         Some(g) => Some(constraints::dimensioned(mesh.dim, "analysis.gravity", g)?),
         None => None,
@@ -179,7 +177,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let mut model = Model {
         mesh,
         materials,
-        plane: if dim == 3 { Plane::Solid } else { a.plane },
+        plane: if solid { Plane::Solid } else { a.plane },
         bodies,
         constraints,
         loads,
@@ -238,8 +236,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
 /// report an infeasible step far from the cause.)
 fn initial_overlap(model: &Model) -> Result<()> {
     let mut cands = Vec::new();
-    let coords = &model.mesh.coords;
-    crate::contact::detect::detect(&model.contacts, |n| crate::mesh::xy(coords[n]), &mut cands);
+    crate::contact::candidates(model, &vec![0.0; model.mesh.n_dofs()], &mut cands);
     let tol = model.analysis.contact.tolerance;
     let deepest = cands
         .iter()
@@ -256,6 +253,14 @@ fn initial_overlap(model: &Model) -> Result<()> {
             format!("the master segment of nodes {} and {}", nodes[0], nodes[1])
         }
         crate::contact::rows::Contactee::Mortar => "the master surface (mortar)".to_string(),
+        crate::contact::rows::Contactee::Face { nodes, .. } => format!(
+            "the master face of nodes {}",
+            crate::contact::faces::corners(&nodes)
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     };
     Err(Error::config(
         format!("contact[{}]", c.pair),
@@ -269,21 +274,6 @@ fn initial_overlap(model: &Model) -> Result<()> {
             if count == 1 { "" } else { "s" },
         ),
     ))
-}
-
-/// What a solid model can hold so far: every material model (nonlocal averaging
-/// included), bars, supports, loads, gravity and probes under statics, backward
-/// Euler and central differences; no contact (three-dimensional contact is its own
-/// work), refused naming the field.
-fn solid_scope(s: &Scenario) -> Result<()> {
-    if !s.contact.is_empty() {
-        return Err(Error::config(
-            "contact[0]",
-            "contact between solids is not available yet: three-dimensional models run \
-             without contact",
-        ));
-    }
-    Ok(())
 }
 
 /// A body's thickness times its material's stiffness and density (and times its

@@ -96,8 +96,11 @@ pub struct ContactCorrection<'m> {
     cands: Vec<Candidate>,
     /// Current multipliers by key (positive ones only).
     lambda: BTreeMap<Key, f64>,
-    /// Current tangential multipliers by key (frictional rows).
-    lambda_t: BTreeMap<Key, f64>,
+    /// Current tangential multipliers by key (frictional rows), along the row's
+    /// tangents (one in the plane, the second zero).
+    lambda_t: BTreeMap<Key, [f64; 2]>,
+    /// The spatial dimension (dofs per node).
+    dim: usize,
     /// Whether any pair has friction.
     frictional: bool,
     /// The friction part of `f_c`.
@@ -168,6 +171,7 @@ impl<'m> ContactCorrection<'m> {
             cands: Vec::new(),
             lambda: BTreeMap::new(),
             lambda_t: BTreeMap::new(),
+            dim: mesh.dim,
             frictional: model.contacts.iter().any(|p| p.mu > 0.0),
             f_t: vec![0.0; n],
             u0: Vec::new(),
@@ -213,19 +217,22 @@ impl<'m> ContactCorrection<'m> {
         let coords = &self.model.mesh.coords;
         // The geometry at the start of the step: a slave's motion from it is swept
         // for crossings ([`super::sweep::crossed`]).
+        let dim = self.dim;
         self.x0.clear();
         self.x0.extend(
             coords
                 .iter()
                 .enumerate()
-                .flat_map(|(n, c)| [c[0] + u[2 * n], c[1] + u[2 * n + 1]]),
+                .flat_map(|(n, c)| (0..dim).map(move |i| c[i] + u[dim * n + i])),
         );
-        self.rigid.beneath = super::detect::beneath_rigid(
-            self.pairs,
-            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            super::detect::RIGID_DEPTH_TOLERANCES * self.tol,
-            &self.rigid.beneath,
-        );
+        if dim == 2 {
+            self.rigid.beneath = super::detect::beneath_rigid(
+                self.pairs,
+                |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+                super::detect::RIGID_DEPTH_TOLERANCES * self.tol,
+                &self.rigid.beneath,
+            );
+        }
         // The displacement h v the step is expected to make, by which the first
         // correction is linearised ahead (zero on the constrained dofs).
         self.lead.clear();
@@ -300,20 +307,24 @@ impl<'m> ContactCorrection<'m> {
                 }
                 let mu = self.pairs[c.pair].mu;
                 if mu > 0.0 && l > threshold {
-                    let lt = self.lambda_t.get(&c.key()).copied().unwrap_or(0.0);
-                    rec.tangential_force += lt;
-                    rec.tangential_magnitude += lt.abs();
+                    let lt = self.lambda_t.get(&c.key()).copied().unwrap_or([0.0; 2]);
+                    // In the plane the signed force along the tangent; in a solid,
+                    // whose rows' tangents differ, its magnitude.
+                    let size = lt[0].hypot(lt[1]);
+                    let signed = if self.dim == 2 { lt[0] } else { size };
+                    rec.tangential_force += signed;
+                    rec.tangential_magnitude += size;
                     if area > 0.0 {
-                        out.traction[c.slave] += lt / area;
+                        out.traction[c.slave] += signed / area;
                     }
-                    if lt.abs() < (1.0 - STICK_MARGIN) * mu * l {
+                    if size < (1.0 - STICK_MARGIN) * mu * l {
                         rec.sticking += 1;
                     } else {
                         rec.slipping += 1;
                     }
-                    let t = c.tangent();
-                    let d = c.combine(|n| [du[2 * n], du[2 * n + 1]]);
-                    out.slip[c.slave] += (d[0] * t[0] + d[1] * t[1]).abs();
+                    let dim = self.dim;
+                    let d = c.tangential(|n, i| du[dim * n + i]);
+                    out.slip[c.slave] += d[0].hypot(d[1]);
                     rec.max_slip = rec.max_slip.max(out.slip[c.slave]);
                 }
             }
@@ -344,11 +355,22 @@ impl<'m> ContactCorrection<'m> {
     fn detect_at(&mut self, u: &[f64]) {
         let t = Instant::now();
         let coords = &self.model.mesh.coords;
+        let dim = self.dim;
         for (n, c) in coords.iter().enumerate() {
-            self.x[2 * n] = c[0] + u[2 * n];
-            self.x[2 * n + 1] = c[1] + u[2 * n + 1];
+            for i in 0..dim {
+                self.x[dim * n + i] = c[i] + u[dim * n + i];
+            }
         }
         let x = &self.x;
+        if dim == 3 {
+            super::faces::detect(
+                self.pairs,
+                |n| [x[3 * n], x[3 * n + 1], x[3 * n + 2]],
+                &mut self.cands,
+            );
+            self.stats.detect_s += t.elapsed().as_secs_f64();
+            return;
+        }
         super::detect::detect_except(
             self.pairs,
             |n| [x[2 * n], x[2 * n + 1]],
@@ -380,8 +402,10 @@ impl<'m> ContactCorrection<'m> {
                 }
             }
             if let Some(&l) = self.lambda_t.get(&c.key()) {
-                for (d, v) in c.tangent_row() {
-                    self.f_t[d] += l * v;
+                for (j, lj) in l.iter().enumerate().take(c.n_tangents()) {
+                    for (d, v) in c.tangent_row(j) {
+                        self.f_t[d] += lj * v;
+                    }
                 }
             }
         }
@@ -391,11 +415,15 @@ impl<'m> ContactCorrection<'m> {
     }
 
     /// The relative tangential displacement of a row since the start of the step at
-    /// displacements `u`: `t · Σ w_k (u_k − u0_k)`.
-    fn slip(&self, c: &Candidate, u: &[f64]) -> f64 {
-        let t = c.tangent();
-        let d = c.combine(|n| [u[2 * n] - self.u0[2 * n], u[2 * n + 1] - self.u0[2 * n + 1]]);
-        d[0] * t[0] + d[1] * t[1]
+    /// displacements `u`: `t_j · Σ w_k (u_k − u0_k)` along each tangent.
+    fn slip(&self, c: &Candidate, u: &[f64]) -> [f64; 2] {
+        if self.dim == 2 {
+            let t = c.tangent();
+            let d = c.combine(|n| [u[2 * n] - self.u0[2 * n], u[2 * n + 1] - self.u0[2 * n + 1]]);
+            return [d[0] * t[0] + d[1] * t[1], 0.0];
+        }
+        let dim = self.dim;
+        c.tangential(|n, i| u[dim * n + i] - self.u0[dim * n + i])
     }
 
     /// The threshold below which a multiplier counts as zero: a millionth of the
@@ -441,7 +469,9 @@ impl Correction for ContactCorrection<'_> {
             let slave = (k.0, k.1, k.2);
             let at = self.cands.partition_point(|c| c.slave_key() < slave);
             if let Some(c) = self.cands.get(at).filter(|c| c.slave_key() == slave) {
-                *self.lambda_t.entry(c.key()).or_insert(0.0) += l;
+                let e = self.lambda_t.entry(c.key()).or_insert([0.0; 2]);
+                e[0] += l[0];
+                e[1] += l[1];
             }
         }
         for &(k, l) in &self.moved {
@@ -548,8 +578,10 @@ impl Correction for ContactCorrection<'_> {
                 self.c.push(predicted);
             }
         }
-        // The tangential rows of the frictional pairs' rows, after the normal ones:
-        // the slip since the start of the step, predicted.
+        // The tangential rows of the frictional pairs' rows, after the normal ones
+        // (one per tangent, `dim − 1`): the slip since the start of the step,
+        // predicted.
+        let tdim = self.dim - 1;
         self.normal_rows = self.rows.len();
         self.pressed.clear();
         self.guess_t.clear();
@@ -563,25 +595,27 @@ impl Correction for ContactCorrection<'_> {
                 let c = &self.cands[i];
                 let mu = self.pairs[c.pair].mu;
                 if mu > 0.0 {
-                    let row = g.row(n_cands + i);
-                    let moved: f64 = row
-                        .col_indices()
-                        .iter()
-                        .zip(row.values())
-                        .map(|(&e, v)| v * self.delta0[e])
-                        .sum();
-                    let slip = self.slip(c, u) + moved;
-                    self.rows.push(n_cands + i);
-                    self.c.push(slip);
+                    let slip = self.slip(c, u);
+                    for (t, s) in slip.iter().enumerate().take(tdim) {
+                        let row = g.row(n_cands + tdim * i + t);
+                        let moved: f64 = row
+                            .col_indices()
+                            .iter()
+                            .zip(row.values())
+                            .map(|(&e, v)| v * self.delta0[e])
+                            .sum();
+                        self.rows.push(n_cands + tdim * i + t);
+                        self.c.push(s + moved);
+                    }
                     self.cones.push((j, mu));
                     let key = c.key();
                     let ln = self.lambda.get(&key).copied().unwrap_or(0.0);
-                    let lt = self.lambda_t.get(&key).copied().unwrap_or(0.0);
+                    let lt = self.lambda_t.get(&key).copied().unwrap_or([0.0; 2]);
                     self.guess_t
-                        .push(if lt.abs() < (1.0 - STICK_MARGIN) * mu * ln {
+                        .push(if lt[0].hypot(lt[1]) < (1.0 - STICK_MARGIN) * mu * ln {
                             super::coulomb::Guess::Stick
                         } else {
-                            super::coulomb::Guess::Slip(lt.signum())
+                            super::coulomb::Guess::Slip(lt[0].signum())
                         });
                 }
             }
@@ -618,7 +652,10 @@ impl Correction for ContactCorrection<'_> {
                 let mut p: Vec<usize> = self
                     .rows
                     .iter()
-                    .map(|&i| self.cands[i % n_cands].pair)
+                    .map(|&i| {
+                        let c = if i < n_cands { i } else { (i - n_cands) / tdim };
+                        self.cands[c].pair
+                    })
                     .collect();
                 p.sort_unstable();
                 p.dedup();
@@ -644,9 +681,11 @@ impl Correction for ContactCorrection<'_> {
                 self.current.push(key);
             }
         }
+        let tdim = self.dim - 1;
         for (k, &(j, _)) in self.cones.iter().enumerate() {
-            let l = self.lambda_rows[nr + k];
-            if l != 0.0 && self.lambda_rows[j] > 0.0 {
+            let mut l = [0.0; 2];
+            l[..tdim].copy_from_slice(&self.lambda_rows[nr + tdim * k..nr + tdim * (k + 1)]);
+            if l != [0.0; 2] && self.lambda_rows[j] > 0.0 {
                 self.lambda_t.insert(self.cands[self.rows[j]].key(), l);
             }
         }

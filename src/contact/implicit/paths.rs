@@ -87,7 +87,9 @@ impl ContactCorrection<'_> {
         }
         let gap_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let slip_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        // The guess of the statuses is written for the plane's one tangent.
         let r = if !self.cones.is_empty()
+            && self.dim == 2
             && crate::contact::coulomb::solve_by_guess(
                 &self.w,
                 &self.c,
@@ -106,7 +108,7 @@ impl ContactCorrection<'_> {
             let r = crate::contact::coulomb::solve(
                 &self.w,
                 &self.c,
-                self.normal_rows,
+                (self.normal_rows, self.dim - 1),
                 &self.cones,
                 &mut self.lambda_rows,
             );

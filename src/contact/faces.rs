@@ -1,0 +1,630 @@
+//! Contact detection in a solid: slave nodes against the faces of another solid
+//! (triangles and bilinear quadrilaterals) or a rigid plane, in the current
+//! geometry. Geometry only, as [`super::detect`] in the plane.
+//!
+//! Broad phase: an R-tree (`rstar`) of the faces' bounding boxes, queried with the
+//! box of the pair's search radius about each slave. Narrow phase: the closest point
+//! of each face in reach (a triangle's by its Voronoi regions, a quadrilateral's by
+//! Gauss-Newton on its bilinear map, clamped to its edges); the nearest face wins
+//! (an interior projection over one on the face's boundary on a tie).
+//!
+//! The row of a slave is that of its nearest face: the gap along the surface's
+//! normal at the closest point, the weights `+1` on the slave and `−N_k(ξ, η)` on
+//! the face's corners (its own shape functions, so the linearised gap moves with the
+//! face as the elements do). The normal is the surface's smoothed one: the nodal
+//! normals (the normalised sum of the unit normals of the faces meeting at a node)
+//! interpolated with the same shape functions, so it is continuous over edges and
+//! corners and a slave over an edge does not flip between two faces' normals from
+//! one iteration to the next; on a flat surface it is the surface's own. Where a
+//! neighbouring face rises out of the plane of the nearest one by more than
+//! [`VALLEY_SINE`] (a valley) and the slave lies within [`NEAR_EDGE`] of their
+//! common boundary, both faces hold it, each as the half-space of its own plane, as
+//! the plane's notches are (`theory/contact3d.md`).
+
+use std::collections::HashMap;
+
+use rstar::primitives::{GeomWithData, Rectangle};
+use rstar::{RTree, AABB};
+
+use super::rows::{Candidate, Contactee, Weights};
+use crate::model::{ContactPair, Master};
+
+/// How close (in the face's local coordinates, relative to its size) to an edge a
+/// slave's closest point must be for a face rising beyond that edge to hold it too:
+/// a thousandth, as [`super::detect::NEAR_VERTEX`] in the plane.
+pub const NEAR_EDGE: f64 = 1e-3;
+
+/// How steeply (the sine of the angle) a neighbouring face must rise out of the
+/// plane of the nearest one for a slave at their common edge to be held by both: a
+/// hundredth (about 0.6°). Below it the valley is flat enough for one row along the
+/// edge's normal: the normals of the faces differ by less than the angle, so a slave
+/// passing from one to the other moves the row by as little; above it, two half-spaces
+/// hold the slave where one row would flip between the faces. Without a threshold a
+/// slave over a vertex of a flat surface pressed in by round-off would get four
+/// nearly equal rows, which make the condensed matrix singular.
+pub const VALLEY_SINE: f64 = 1e-2;
+
+type V3 = [f64; 3];
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn unit(a: V3) -> Option<V3> {
+    let l = dot(a, a).sqrt();
+    (l > 0.0 && l.is_finite()).then(|| [a[0] / l, a[1] / l, a[2] / l])
+}
+
+/// The corners of a face: three for a triangle (fourth node `usize::MAX`), else
+/// four.
+pub fn corners(face: &[usize; 4]) -> &[usize] {
+    if face[3] == usize::MAX {
+        &face[..3]
+    } else {
+        &face[..]
+    }
+}
+
+/// Where on a face its closest point to a slave lies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Region {
+    /// Inside; `margin` the local distance to the nearest edge (0 on it).
+    Interior {
+        /// Distance to the nearest edge in local coordinates (a triangle's smallest
+        /// barycentric coordinate, a quadrilateral's `1 − max(|ξ|, |η|)`).
+        margin: f64,
+    },
+    /// On the edge from corner `i` to corner `i + 1` (cyclically).
+    Edge(usize),
+    /// At corner `i`.
+    Corner(usize),
+}
+
+/// The closest point of a face to a slave: the corners' weights (the face's shape
+/// functions there, summing to 1), the point, where it lies, and the face's unit
+/// normal there.
+#[derive(Clone, Copy, Debug)]
+pub struct Projection {
+    /// Shape function of each corner at the point (the fourth 0 on a triangle).
+    pub weights: [f64; 4],
+    /// The closest point.
+    pub point: V3,
+    /// Distance² from the slave.
+    pub d2: f64,
+    /// Where it lies.
+    pub region: Region,
+    /// The face's unit outward normal at the point.
+    pub normal: V3,
+}
+
+/// The closest point of triangle `a, b, c` to `p` (Voronoi regions of the corners,
+/// edges and the inside).
+fn triangle(p: V3, [a, b, c]: [V3; 3]) -> Option<Projection> {
+    let normal = unit(cross(sub(b, a), sub(c, a)))?;
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    let done = |w: [f64; 3], region| {
+        let q = [
+            w[0] * a[0] + w[1] * b[0] + w[2] * c[0],
+            w[0] * a[1] + w[1] * b[1] + w[2] * c[1],
+            w[0] * a[2] + w[1] * b[2] + w[2] * c[2],
+        ];
+        let d = sub(p, q);
+        Some(Projection {
+            weights: [w[0], w[1], w[2], 0.0],
+            point: q,
+            d2: dot(d, d),
+            region,
+            normal,
+        })
+    };
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return done([1.0, 0.0, 0.0], Region::Corner(0));
+    }
+    let bp = sub(p, b);
+    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return done([0.0, 1.0, 0.0], Region::Corner(1));
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return done([1.0 - v, v, 0.0], Region::Edge(0));
+    }
+    let cp = sub(p, c);
+    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return done([0.0, 0.0, 1.0], Region::Corner(2));
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return done([1.0 - w, 0.0, w], Region::Edge(2));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return done([0.0, 1.0 - w, w], Region::Edge(1));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    let u = 1.0 - v - w;
+    done(
+        [u, v, w],
+        Region::Interior {
+            margin: u.min(v).min(w),
+        },
+    )
+}
+
+/// Shape functions of the bilinear quadrilateral at `(ξ, η)` and their derivatives.
+fn bilinear(xi: f64, eta: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let (sx, sy) = ([-1.0, 1.0, 1.0, -1.0], [-1.0, -1.0, 1.0, 1.0]);
+    let mut n = [0.0; 4];
+    let mut dx = [0.0; 4];
+    let mut dy = [0.0; 4];
+    for k in 0..4 {
+        n[k] = 0.25 * (1.0 + sx[k] * xi) * (1.0 + sy[k] * eta);
+        dx[k] = 0.25 * sx[k] * (1.0 + sy[k] * eta);
+        dy[k] = 0.25 * sy[k] * (1.0 + sx[k] * xi);
+    }
+    (n, dx, dy)
+}
+
+fn combine4(w: [f64; 4], x: &[V3; 4]) -> V3 {
+    let mut q = [0.0; 3];
+    for k in 0..4 {
+        for i in 0..3 {
+            q[i] += w[k] * x[k][i];
+        }
+    }
+    q
+}
+
+/// The closest point of the bilinear quadrilateral with corners `x` to `p`:
+/// Gauss-Newton on `(ξ, η)` from the centre; outside `[−1, 1]²` the nearest point
+/// of its four edges.
+fn quadrilateral(p: V3, x: [V3; 4]) -> Option<Projection> {
+    let (mut xi, mut eta) = (0.0f64, 0.0f64);
+    for _ in 0..20 {
+        let (n, dx, dy) = bilinear(xi, eta);
+        let (q, tx, ty) = (combine4(n, &x), combine4(dx, &x), combine4(dy, &x));
+        let r = sub(p, q);
+        let (a, b, c) = (dot(tx, tx), dot(tx, ty), dot(ty, ty));
+        let det = a * c - b * b;
+        if !(det > 0.0) {
+            return None;
+        }
+        let (gx, gy) = (dot(tx, r), dot(ty, r));
+        let (sx, sy) = ((c * gx - b * gy) / det, (a * gy - b * gx) / det);
+        xi = (xi + sx).clamp(-2.0, 2.0);
+        eta = (eta + sy).clamp(-2.0, 2.0);
+        if sx.abs().max(sy.abs()) < 1e-14 {
+            break;
+        }
+    }
+    if xi.abs() <= 1.0 && eta.abs() <= 1.0 {
+        let (n, dx, dy) = bilinear(xi, eta);
+        let q = combine4(n, &x);
+        let normal = unit(cross(combine4(dx, &x), combine4(dy, &x)))?;
+        let d = sub(p, q);
+        return Some(Projection {
+            weights: n,
+            point: q,
+            d2: dot(d, d),
+            region: Region::Interior {
+                margin: 1.0 - xi.abs().max(eta.abs()),
+            },
+            normal,
+        });
+    }
+    // The nearest point of the edges, the normal at the centre (where a convex
+    // ridge's own normal does not replace it).
+    let (_, dx, dy) = bilinear(0.0, 0.0);
+    let normal = unit(cross(combine4(dx, &x), combine4(dy, &x)))?;
+    let mut best: Option<Projection> = None;
+    for e in 0..4 {
+        let (a, b) = (x[e], x[(e + 1) % 4]);
+        let d = sub(b, a);
+        let l2 = dot(d, d);
+        let s = if l2 > 0.0 {
+            (dot(sub(p, a), d) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let q = [a[0] + s * d[0], a[1] + s * d[1], a[2] + s * d[2]];
+        let r = sub(p, q);
+        let d2 = dot(r, r);
+        if best.is_none_or(|b| d2 < b.d2) {
+            let mut weights = [0.0; 4];
+            weights[e] = 1.0 - s;
+            weights[(e + 1) % 4] = s;
+            let region = if s <= 0.0 {
+                Region::Corner(e)
+            } else if s >= 1.0 {
+                Region::Corner((e + 1) % 4)
+            } else {
+                Region::Edge(e)
+            };
+            best = Some(Projection {
+                weights,
+                point: q,
+                d2,
+                region,
+                normal,
+            });
+        }
+    }
+    best
+}
+
+/// The closest point of `face` (corner positions from `x`) to `p`; `None` for a
+/// degenerate face.
+pub fn project<X: Fn(usize) -> V3>(p: V3, face: &[usize; 4], x: &X) -> Option<Projection> {
+    if face[3] == usize::MAX {
+        triangle(p, [x(face[0]), x(face[1]), x(face[2])])
+    } else {
+        quadrilateral(p, [x(face[0]), x(face[1]), x(face[2]), x(face[3])])
+    }
+}
+
+/// The faces' unit normals at their centres and the nodal normals of the surface:
+/// at each node the normalised sum of the unit normals of the faces meeting there.
+struct Surface {
+    normal: Vec<V3>,
+    at_node: HashMap<usize, V3>,
+}
+
+impl Surface {
+    fn new<X: Fn(usize) -> V3>(faces: &[[usize; 4]], x: &X) -> Surface {
+        let mut normal = Vec::with_capacity(faces.len());
+        let mut at_node: HashMap<usize, V3> = HashMap::with_capacity(faces.len());
+        for f in faces {
+            let c = corners(f);
+            let n = if c.len() == 3 {
+                cross(sub(x(c[1]), x(c[0])), sub(x(c[2]), x(c[0])))
+            } else {
+                cross(sub(x(c[2]), x(c[0])), sub(x(c[3]), x(c[1])))
+            };
+            let n = unit(n).unwrap_or([0.0; 3]);
+            normal.push(n);
+            for &v in c {
+                let e = at_node.entry(v).or_insert([0.0; 3]);
+                for i in 0..3 {
+                    e[i] += n[i];
+                }
+            }
+        }
+        for v in at_node.values_mut() {
+            *v = unit(*v).unwrap_or([0.0; 3]);
+        }
+        Surface { normal, at_node }
+    }
+
+    /// The row's normal at a projection on `face`: the nodal normals interpolated
+    /// with the face's shape functions there, normalised. Continuous over the whole
+    /// surface (two faces sharing an edge interpolate the same two nodal normals
+    /// along it), so a slave passing from a face to its neighbour, or lying over
+    /// their edge, meets one normal from either side and does not flip between the
+    /// faces' own from one iteration to the next; on a flat surface it is the
+    /// surface's normal. Over a convex ridge or corner it is the ridge's or corner's
+    /// mean normal.
+    fn normal(&self, face: &[usize; 4], pr: &Projection) -> V3 {
+        let mut n = [0.0; 3];
+        for (k, &v) in corners(face).iter().enumerate() {
+            if let Some(m) = self.at_node.get(&v) {
+                for i in 0..3 {
+                    n[i] += pr.weights[k] * m[i];
+                }
+            }
+        }
+        unit(n).unwrap_or(pr.normal)
+    }
+}
+
+/// The two unit tangents of a face's row: the face's first edge projected on the
+/// plane normal to `n`, and `n ×` it (so they follow the face as it moves, the same
+/// at every iteration while the slave stays on it).
+fn tangents_of(n: V3, edge: V3) -> [V3; 2] {
+    let e = sub(
+        edge,
+        [
+            n[0] * dot(edge, n),
+            n[1] * dot(edge, n),
+            n[2] * dot(edge, n),
+        ],
+    );
+    let t1 = unit(e).unwrap_or_else(|| plane_tangents(n)[0]);
+    [t1, cross(n, t1)]
+}
+
+/// Two unit tangents orthonormal with the unit vector `n`, continuous in `n` away
+/// from the boundaries between its largest components (a rigid plane's are fixed at
+/// validation).
+pub fn plane_tangents(n: V3) -> [V3; 2] {
+    let k = (0..3)
+        .min_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .unwrap_or(0);
+    let mut e = [0.0; 3];
+    e[k] = 1.0;
+    let t1 = unit(cross(e, n)).unwrap_or([1.0, 0.0, 0.0]);
+    [t1, cross(n, t1)]
+}
+
+/// The row of slave `key.2` against master face `index` at its projection `pr`,
+/// along `normal`.
+fn face_candidate<X: Fn(usize) -> V3>(
+    key: (usize, usize, usize),
+    index: usize,
+    face: &[usize; 4],
+    pr: &Projection,
+    normal: V3,
+    x: &X,
+) -> Candidate {
+    let mut weights = Weights::EMPTY;
+    weights.add(key.2, 1.0);
+    for (k, &v) in corners(face).iter().enumerate() {
+        weights.add(v, -pr.weights[k]);
+    }
+    let c = corners(face);
+    let tangents = tangents_of(normal, sub(x(c[1]), x(c[0])));
+    Candidate {
+        pair: key.0,
+        side: key.1,
+        slave: key.2,
+        master: Contactee::Face {
+            index,
+            nodes: *face,
+        },
+        xi: 0.0,
+        gap: dot(sub(x(key.2), pr.point), normal),
+        normal,
+        tangents,
+        dim: 3,
+        weights,
+        length: 0.0,
+    }
+}
+
+/// Candidates of every pair of a solid at the geometry `x(node)`, appended to `out`
+/// (cleared first), ordered by pair, side and slave node (a slave in a valley gives
+/// one per face holding it, by face).
+pub fn detect<X>(pairs: &[ContactPair], x: X, out: &mut Vec<Candidate>)
+where
+    X: Fn(usize) -> V3,
+{
+    out.clear();
+    for (pi, pair) in pairs.iter().enumerate() {
+        let r = pair.radius;
+        for (si, side) in pair.sides.iter().enumerate() {
+            match &side.master {
+                Master::Faces(faces) => {
+                    faces_side((pi, si), &side.slaves, faces, r, &x, out);
+                }
+                Master::Plane { point, n, tangents } => {
+                    for &s in &side.slaves {
+                        let gap = dot(sub(x(s), *point), *n);
+                        if gap * gap <= r * r {
+                            let mut weights = Weights::EMPTY;
+                            weights.add(s, 1.0);
+                            out.push(Candidate {
+                                pair: pi,
+                                side: si,
+                                slave: s,
+                                master: Contactee::Rigid,
+                                xi: 0.0,
+                                gap,
+                                normal: *n,
+                                tangents: *tangents,
+                                dim: 3,
+                                weights,
+                                length: 0.0,
+                            });
+                        }
+                    }
+                }
+                Master::Segments(_) | Master::Rigid { .. } => {}
+            }
+        }
+    }
+}
+
+/// The candidates of one side with a deformable master.
+fn faces_side<X: Fn(usize) -> V3>(
+    (pi, si): (usize, usize),
+    slaves: &[usize],
+    faces: &[[usize; 4]],
+    r: f64,
+    x: &X,
+    out: &mut Vec<Candidate>,
+) {
+    let surface = Surface::new(faces, x);
+    let tree = RTree::bulk_load(
+        faces
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for &v in corners(f) {
+                    let p = x(v);
+                    for i in 0..3 {
+                        lo[i] = lo[i].min(p[i]);
+                        hi[i] = hi[i].max(p[i]);
+                    }
+                }
+                GeomWithData::new(Rectangle::from_corners(lo, hi), k)
+            })
+            .collect(),
+    );
+    let mut near: Vec<(usize, Projection)> = Vec::new();
+    for &s in slaves {
+        let p = x(s);
+        let reach = AABB::from_corners(
+            [p[0] - r, p[1] - r, p[2] - r],
+            [p[0] + r, p[1] + r, p[2] + r],
+        );
+        near.clear();
+        for hit in tree.locate_in_envelope_intersecting(reach) {
+            let f = &faces[hit.data];
+            if corners(f).contains(&s) {
+                continue;
+            }
+            if let Some(pr) = project(p, f, x) {
+                if pr.d2 <= r * r {
+                    near.push((hit.data, pr));
+                }
+            }
+        }
+        // The nearest face (interior over boundary on a tie, then by index, so the
+        // choice does not depend on the tree's order).
+        let rank = |(k, pr): &(usize, Projection)| {
+            (pr.d2, !matches!(pr.region, Region::Interior { .. }), *k)
+        };
+        let Some(best) = near
+            .iter()
+            .min_by(|a, b| {
+                let (ra, rb) = (rank(a), rank(b));
+                if ra.0 < rb.0 * (1.0 - 1e-12) {
+                    std::cmp::Ordering::Less
+                } else if rb.0 < ra.0 * (1.0 - 1e-12) {
+                    std::cmp::Ordering::Greater
+                } else {
+                    (ra.1, ra.2).cmp(&(rb.1, rb.2))
+                }
+            })
+            .copied()
+        else {
+            continue;
+        };
+        let (k, pr) = best;
+        let key = (pi, si, s);
+        // Faces rising beyond the edge or corner the point is at (or near): a
+        // valley, each face its own half-space.
+        let on_boundary = match pr.region {
+            Region::Interior { margin } => margin <= NEAR_EDGE,
+            _ => true,
+        };
+        let mut held: Vec<usize> = Vec::new();
+        if on_boundary {
+            let nk = surface.normal[k];
+            let shared = |f: usize| {
+                corners(&faces[f])
+                    .iter()
+                    .any(|v| corners(&faces[k]).contains(v))
+            };
+            for (f, prf) in &near {
+                if *f == k || !shared(*f) {
+                    continue;
+                }
+                let inside = match prf.region {
+                    Region::Interior { .. } => true,
+                    _ => prf.d2 <= pr.d2 * (1.0 + 1e-9) + f64::MIN_POSITIVE,
+                };
+                let rises = corners(&faces[*f]).iter().any(|&v| {
+                    let d = sub(x(v), pr.point);
+                    dot(d, nk) > VALLEY_SINE * dot(d, d).sqrt()
+                });
+                if inside && rises {
+                    held.push(*f);
+                }
+            }
+        }
+        if held.is_empty() {
+            let normal = surface.normal(&faces[k], &pr);
+            out.push(face_candidate(key, k, &faces[k], &pr, normal, x));
+        } else {
+            held.push(k);
+            held.sort_unstable();
+            for f in held {
+                let prf = near.iter().find(|(g, _)| *g == f).map(|(_, p)| *p);
+                if let Some(prf) = prf {
+                    out.push(face_candidate(key, f, &faces[f], &prf, prf.normal, x));
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_triangle_and_a_quadrilateral_project_a_point_inside_and_beyond() {
+        let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let pr = triangle([0.25, 0.25, 0.5], tri).unwrap();
+        assert!(matches!(pr.region, Region::Interior { .. }));
+        assert!((pr.d2 - 0.25).abs() < 1e-15 && pr.normal == [0.0, 0.0, 1.0]);
+        assert!((pr.weights[0] - 0.5).abs() < 1e-15 && (pr.weights[1] - 0.25).abs() < 1e-15);
+        let pr = triangle([1.0, 1.0, 0.0], tri).unwrap();
+        assert_eq!(pr.region, Region::Edge(1));
+        assert!((pr.weights[1] - 0.5).abs() < 1e-15 && (pr.d2 - 0.5).abs() < 1e-15);
+        assert_eq!(
+            triangle([-1.0, -1.0, 1.0], tri).unwrap().region,
+            Region::Corner(0)
+        );
+        // A warped quadrilateral: the projection is where the bilinear map's
+        // tangents are normal to the distance.
+        let quad = [
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.1],
+            [2.0, 1.0, 0.0],
+            [0.0, 1.0, 0.2],
+        ];
+        let p = [0.7, 0.4, 0.8];
+        let pr = quadrilateral(p, quad).unwrap();
+        let Region::Interior { .. } = pr.region else {
+            panic!("{pr:?}")
+        };
+        let sum: f64 = pr.weights.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-14);
+        let d = sub(p, pr.point);
+        let (_, dx, dy) = {
+            // local coordinates back from the weights
+            let xi = pr.weights[1] + pr.weights[2] - pr.weights[0] - pr.weights[3];
+            let eta = pr.weights[2] + pr.weights[3] - pr.weights[0] - pr.weights[1];
+            bilinear(xi, eta)
+        };
+        assert!(dot(d, combine4(dx, &quad)).abs() < 1e-12);
+        assert!(dot(d, combine4(dy, &quad)).abs() < 1e-12);
+        // d is along the normal there.
+        let c = cross(d, pr.normal);
+        assert!(dot(c, c).sqrt() < 1e-12 * dot(d, d).sqrt());
+        // Beyond an edge.
+        let pr = quadrilateral([3.0, 0.5, 0.0], quad).unwrap();
+        assert_eq!(pr.region, Region::Edge(1));
+    }
+
+    #[test]
+    fn tangents_are_orthonormal_with_the_normal() {
+        for n in [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [1.0, 0.0, 0.0],
+            [0.3, -0.2, 0.9327379053088815],
+        ] {
+            let n = unit(n).unwrap();
+            for t in [plane_tangents(n), tangents_of(n, [1.0, 0.3, 0.2])] {
+                assert!(dot(t[0], n).abs() < 1e-15 && dot(t[1], n).abs() < 1e-15);
+                assert!(dot(t[0], t[1]).abs() < 1e-15);
+                assert!((dot(t[0], t[0]) - 1.0).abs() < 1e-15);
+                assert!((dot(t[1], t[1]) - 1.0).abs() < 1e-15);
+                // Right-handed: t1 × t2 = n.
+                let c = cross(t[0], t[1]);
+                assert!(dot(sub(c, n), sub(c, n)) < 1e-28);
+            }
+        }
+    }
+}
