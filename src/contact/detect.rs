@@ -462,7 +462,7 @@ mod tests {
             }
         );
         assert!((c3.xi - 0.5).abs() < 1e-14 && (c3.gap - 0.3).abs() < 1e-14);
-        assert_eq!(c3.normal, [0.0, 1.0]);
+        assert_eq!(c3.normal, [0.0, 1.0, 0.0]);
         let c4 = out.iter().find(|c| c.slave == 4).unwrap();
         assert_eq!(
             c4.master,

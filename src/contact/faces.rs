@@ -627,4 +627,59 @@ mod tests {
             }
         }
     }
+
+    fn side(slaves: Vec<usize>, faces: Vec<[usize; 4]>) -> ContactPair {
+        ContactPair {
+            name: "p".into(),
+            sides: vec![crate::model::ContactSide {
+                slaves,
+                master: Master::Faces(faces),
+                mortar: Vec::new(),
+                faces: Vec::new(),
+            }],
+            radius: 1.0,
+            friction: 0.0,
+            mu: 0.0,
+            formulation: crate::model::Formulation::NodeToSegment,
+            position_weight: 0.5,
+        }
+    }
+
+    #[test]
+    fn a_slave_in_a_valley_is_held_by_both_faces_and_one_over_a_ridge_by_one() {
+        // Two quadrilaterals meeting along the z axis (nodes 0, 1), rising to
+        // either side by `rise` over a unit run: a valley for rise > 0, a ridge for
+        // rise < 0 (outward normals up).
+        let geometry = |rise: f64| {
+            vec![
+                [0.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, rise, 1.0],
+                [1.0, rise, 0.0],
+                [-1.0, rise, 0.0],
+                [-1.0, rise, 1.0],
+                [0.0, 1e-9, 0.5], // slave over the common edge
+            ]
+        };
+        let faces = vec![[0, 1, 2, 3], [1, 0, 4, 5]];
+        let mut out = Vec::new();
+        let x = geometry(0.2);
+        detect(&[side(vec![6], faces.clone())], |n| x[n], &mut out);
+        assert_eq!(out.len(), 2, "{out:?}");
+        for c in &out {
+            // Each along its own face's normal (leaning away from the other face).
+            assert!(c.normal[1] > 0.9 && c.normal[0].abs() > 0.1, "{c:?}");
+        }
+        assert!(out[0].normal[0] * out[1].normal[0] < 0.0);
+        // A ridge: one row along the ridge's mean normal (straight up).
+        let x = geometry(-0.2);
+        detect(&[side(vec![6], faces.clone())], |n| x[n], &mut out);
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!(out[0].normal[0].abs() < 1e-12 && (out[0].normal[1] - 1.0).abs() < 1e-12);
+        // A nearly flat valley (below VALLEY_SINE): one row, continuous normal.
+        let x = geometry(1e-4);
+        detect(&[side(vec![6], faces)], |n| x[n], &mut out);
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!(out[0].normal[0].abs() < 1e-12);
+    }
 }

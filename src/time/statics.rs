@@ -132,45 +132,75 @@ pub const STATIC_SEAT: f64 = 1e-8;
 /// rotation) that its supports and prescribed displacements do not hold.
 fn held_by_contact_only(model: &Model) -> bool {
     let mesh = &model.mesh;
+    let dim = mesh.dim;
     let mut in_contact = vec![false; model.bodies.len()];
     for p in &model.contacts {
         for side in &p.sides {
             for &n in &side.slaves {
                 in_contact[mesh.node_body[n]] = true;
             }
-            if let crate::model::Master::Segments(segs) = &side.master {
-                for &n in segs.iter().flatten() {
-                    in_contact[mesh.node_body[n]] = true;
-                }
+            let master: Vec<usize> = match &side.master {
+                crate::model::Master::Segments(segs) => segs.iter().flatten().copied().collect(),
+                crate::model::Master::Faces(faces) => faces
+                    .iter()
+                    .flat_map(|f| crate::contact::faces::corners(f).iter().copied())
+                    .collect(),
+                _ => Vec::new(),
+            };
+            for n in master {
+                in_contact[mesh.node_body[n]] = true;
             }
         }
     }
+    // Rigid modes: the translations, then the rotations (one in the plane, about z;
+    // three in a solid).
+    let modes = if dim == 3 { 6 } else { 3 };
     (0..model.bodies.len()).filter(|&b| in_contact[b]).any(|b| {
-        // Gram matrix of the rigid modes (x, y, rotation about the body's centroid)
-        // on the body's constrained dofs: singular when a mode is free.
+        // Gram matrix of the rigid modes about the body's centroid on the body's
+        // constrained dofs: singular when a mode is free.
         let nodes: Vec<usize> = (0..mesh.n_nodes())
             .filter(|&n| mesh.node_body[n] == b)
             .collect();
-        let c = nodes.iter().fold([0.0, 0.0], |a, &n| {
-            [a[0] + mesh.coords[n][0], a[1] + mesh.coords[n][1]]
-        });
-        let c = [c[0] / nodes.len() as f64, c[1] / nodes.len() as f64];
-        let mut g = [[0.0f64; 3]; 3];
+        let mut c = [0.0; 3];
+        for &n in &nodes {
+            for i in 0..dim {
+                c[i] += mesh.coords[n][i] / nodes.len() as f64;
+            }
+        }
+        let mut g = [[0.0f64; 6]; 6];
         let mut size: f64 = 0.0;
         for con in &model.constraints {
-            let n = con.dof / 2;
+            let (n, comp) = (con.dof / dim, con.dof % dim);
             if mesh.node_body[n] != b {
                 continue;
             }
-            let [x, y] = [mesh.coords[n][0] - c[0], mesh.coords[n][1] - c[1]];
-            size = size.max(x.abs()).max(y.abs());
-            let row = if con.dof % 2 == 0 {
-                [1.0, 0.0, -y]
-            } else {
-                [0.0, 1.0, x]
+            let mut r = [0.0; 3];
+            for i in 0..dim {
+                r[i] = mesh.coords[n][i] - c[i];
+                size = size.max(r[i].abs());
+            }
+            // The dof's component of each mode: e_comp for the translations,
+            // (e_a × r)_comp for the rotations about axis a.
+            let mut row = [0.0; 6];
+            row[comp] = 1.0;
+            let rot = |a: usize| match (a, comp) {
+                (0, 1) => -r[2],
+                (0, 2) => r[1],
+                (1, 0) => r[2],
+                (1, 2) => -r[0],
+                (2, 0) => -r[1],
+                (2, 1) => r[0],
+                _ => 0.0,
             };
-            for i in 0..3 {
-                for j in 0..3 {
+            if dim == 3 {
+                for a in 0..3 {
+                    row[3 + a] = rot(a);
+                }
+            } else {
+                row[2] = rot(2);
+            }
+            for i in 0..modes {
+                for j in 0..modes {
                     g[i][j] += row[i] * row[j];
                 }
             }
@@ -178,17 +208,28 @@ fn held_by_contact_only(model: &Model) -> bool {
         if size == 0.0 {
             return true;
         }
-        for row in &mut g {
-            row[2] /= size;
+        // Rotations in units of the body's size, then a Cholesky factorisation:
+        // a pivot below 1e-10 of the largest diagonal is a free mode.
+        for (i, row) in g.iter_mut().enumerate().take(modes) {
+            for (j, v) in row.iter_mut().enumerate().take(modes) {
+                let f = |k: usize| if k >= dim { size } else { 1.0 };
+                *v /= f(i) * f(j);
+            }
         }
-        for j in 0..3 {
-            g[2][j] /= size;
+        let scale = (0..modes).fold(0.0f64, |a, i| a.max(g[i][i]));
+        for k in 0..modes {
+            let p = g[k][k];
+            if p <= 1e-10 * scale {
+                return true;
+            }
+            for i in k + 1..modes {
+                let f = g[i][k] / p;
+                for j in k..modes {
+                    g[i][j] -= f * g[k][j];
+                }
+            }
         }
-        let det = g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1])
-            - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
-            + g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0]);
-        let scale = g[0][0].max(g[1][1]).max(g[2][2]);
-        det <= 1e-10 * scale * scale * scale
+        false
     })
 }
 
@@ -204,12 +245,13 @@ pub(crate) fn seat(
         return 0.0;
     }
     let (mut tk, mut tm) = (0.0, 0.0);
+    let dim = model.mesh.dim;
     for n in 0..model.mesh.n_nodes() {
-        for c in 0..2 {
+        for c in 0..dim {
             tk += k[pattern.position(n, c, n, c)];
             tm += match mass {
                 crate::assembly::Mass::Consistent(m) => m[pattern.position(n, c, n, c)],
-                crate::assembly::Mass::Lumped(m) => m[2 * n + c],
+                crate::assembly::Mass::Lumped(m) => m[dim * n + c],
             };
         }
     }

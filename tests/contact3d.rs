@@ -1,0 +1,636 @@
+//! Contact between solids in the implicit path (node to face, rigid planes, Coulomb
+//! cones): two bars colliding head on against 1D wave theory, a block on an
+//! incline sloping in a direction off the axes against the closed forms, the
+//! patch test on non-matching meshes, Hertz's sphere on a half-space, the ledger
+//! with every material model, and the validation of a solid's pairs
+//! (`theory/contact3d.md`).
+
+use std::path::Path;
+
+use rothe::linsolve::Backend;
+use rothe::model::Model;
+use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::march::{march, Marched, StepControl};
+use rothe::time::{Integrator, State};
+
+fn model(text: &str) -> Model {
+    rothe::config::from_str(text, Path::new(".")).unwrap()
+}
+
+fn refusal(text: &str) -> String {
+    rothe::config::from_str(text, Path::new("."))
+        .err()
+        .expect("refused")
+        .to_string()
+}
+
+/// Momentum of body `b` along `dir` and its mass (lumped row sums of the mass).
+fn momentum(m: &Model, s: &State, b: usize, mass: &[f64], dir: usize) -> (f64, f64) {
+    let (mut p, mut mm) = (0.0, 0.0);
+    for n in (0..m.mesh.n_nodes()).filter(|&n| m.mesh.node_body[n] == b) {
+        p += mass[3 * n + dir] * s.v[3 * n + dir];
+        mm += mass[3 * n + dir];
+    }
+    (p, mm)
+}
+
+/// Two equal steel-like bars (ν = 0, c = 5000 m/s) 1 m long, 0.05 x 0.1 m², the
+/// striker at 1 m/s along x, 1 mm apart.
+fn bars(h: f64) -> String {
+    format!(
+        r#"
+[analysis]
+t_end = 6.0e-4
+dt = {h:e}
+vtk_every = 0
+[materials.bar]
+model = "elastic"
+E = 2.0e11
+nu = 0.0
+rho = 8000.0
+[[bodies]]
+name = "striker"
+material = "bar"
+velocity = [1.0, 0.0, 0.0]
+mesh = {{ kind = "box", origin = [-1.0, 0.0, 0.0], size = [1.0, 0.05, 0.1], divisions = [50, 1, 2] }}
+[[bodies]]
+name = "target"
+material = "bar"
+mesh = {{ kind = "box", origin = [1.0e-4, 0.0, 0.0], size = [1.0, 0.05, 0.1], divisions = [40, 1, 2] }}
+[[contact]]
+name = "impact"
+slave = "striker.right"
+master = "target.left"
+"#
+    )
+}
+
+#[test]
+fn two_solid_bars_collide_as_1d_wave_theory_says() {
+    // 1D waves: contact lasts 2L/c = 0.4 ms at the force ρcAv/2 = 1e5 N; the
+    // meshes do not match along the bars (50 and 40 elements) and the end faces
+    // match. Momentum is conserved at every step to solver tolerance, and no node
+    // penetrates beyond the tolerance.
+    let h = 2e-6;
+    let m = model(&bars(h));
+    let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+    let mass = be.mass().row_sums(&be.assembler().pattern);
+    let mut s = be.initial_state();
+    let total = |s: &State| momentum(&m, s, 0, &mass, 0).0 + momentum(&m, s, 1, &mass, 0).0;
+    let p0 = total(&s);
+    let (mut t_on, mut t_off, mut plateau, mut count) = (None, None, 0.0, 0);
+    let mut dp: f64 = 0.0;
+    let tol = m.analysis.contact.tolerance;
+    for _ in 0..m.analysis.n_steps() {
+        be.step_accepted(&mut s).unwrap();
+        let rec = s.contact.pairs[0];
+        dp = dp.max((total(&s) - p0).abs() / p0);
+        // Transverse momentum stays zero (the contact force is along x).
+        for dir in [1, 2] {
+            let q = momentum(&m, &s, 0, &mass, dir).0 + momentum(&m, &s, 1, &mass, dir).0;
+            assert!(q.abs() < 1e-9 * p0, "momentum along {dir}: {q}");
+        }
+        assert!(rec.penetration <= tol, "penetration {}", rec.penetration);
+        if rec.force > 0.0 {
+            t_on.get_or_insert(s.t - h);
+            t_off = Some(s.t);
+            if s.t > 1.5e-4 && s.t < 3.5e-4 {
+                plateau += rec.force;
+                count += 1;
+            }
+        }
+    }
+    let duration = t_off.unwrap() - t_on.unwrap();
+    let plateau = plateau / count as f64;
+    let force = 8000.0 * 5000.0 * 0.005 / 2.0;
+    let (vs, vt) = (
+        momentum(&m, &s, 0, &mass, 0).0 / momentum(&m, &s, 0, &mass, 0).1,
+        momentum(&m, &s, 1, &mass, 0).0 / momentum(&m, &s, 1, &mass, 0).1,
+    );
+    eprintln!(
+        "solid bars: duration {duration:.4e} s (2L/c = 4e-4), plateau {plateau:.6e} N (ρcAv/2 = {force:e}), striker {vs:.3e} m/s, target {vt:.3e} m/s, momentum drift {dp:.1e}"
+    );
+    assert!(dp < 1e-9, "momentum drift {dp}");
+    assert!((duration - 4e-4).abs() <= 2.0 * h, "duration {duration}");
+    assert!((plateau - force).abs() < 1e-3 * force, "plateau {plateau}");
+    assert!(vs.abs() < 0.15 && (vt - 1.0).abs() < 0.15, "{vs} {vt}");
+}
+
+const G: f64 = 9.81;
+
+/// A steel block 0.1 m a side on the rigid plane y = 0, gravity tilted by `theta`
+/// from the plane's normal towards the direction at `phi` from x in the plane (a
+/// slope off the axes), Coulomb's `mu`.
+fn incline(theta: f64, phi: f64, mu: f64) -> String {
+    let g = [
+        G * theta.sin() * phi.cos(),
+        -G * theta.cos(),
+        G * theta.sin() * phi.sin(),
+    ];
+    format!(
+        r#"
+[analysis]
+t_end = 0.1
+dt = 1.0e-3
+gravity = [{:e}, {:e}, {:e}]
+vtk_every = 0
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "block"
+material = "steel"
+mesh = {{ kind = "box", size = [0.1, 0.1, 0.1], divisions = [3, 3, 3] }}
+[[contact]]
+name = "incline"
+slave = "block.bottom"
+rigid_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 2.0, 0.0] }}
+mu = {mu:e}
+"#,
+        g[0], g[1], g[2]
+    )
+}
+
+/// The block's mean velocity and displacement in the plane (x, z).
+fn mean_xz(m: &Model, s: &State) -> ([f64; 2], [f64; 2]) {
+    let n = m.mesh.n_nodes() as f64;
+    let mean = |f: &[f64], d: usize| (0..m.mesh.n_nodes()).map(|i| f[3 * i + d]).sum::<f64>() / n;
+    (
+        [mean(&s.v, 0), mean(&s.v, 2)],
+        [mean(&s.u, 0), mean(&s.u, 2)],
+    )
+}
+
+fn run_incline(theta: f64, phi: f64, mu: f64) -> (Model, State) {
+    let m = model(&incline(theta, phi, mu));
+    let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+    let mut s = be.initial_state();
+    for _ in 0..m.analysis.n_steps() {
+        be.step_accepted(&mut s).unwrap();
+        let rec = s.contact.pairs[0];
+        // The friction force within the cone, the friction line nonnegative, the
+        // ledger closed.
+        assert!(
+            rec.tangential_magnitude <= mu * rec.force * (1.0 + 1e-6),
+            "{rec:?}"
+        );
+        let l = &s.ledger;
+        assert!(l.dissipated().friction >= -1e-12 * l.scale());
+        assert!(
+            l.residual().abs() <= 1e-8 * l.scale(),
+            "ledger residual {} of {}",
+            l.residual(),
+            l.scale()
+        );
+    }
+    (m, s)
+}
+
+#[test]
+fn a_solid_block_on_an_incline_sliding_off_the_axes_follows_the_closed_forms() {
+    let (theta, phi) = (30f64.to_radians(), 35f64.to_radians());
+    // Above the friction angle: it slides down the slope (direction phi) with
+    // a = g (sin θ − μ cos θ), every pressed node slipping.
+    let mu = 0.3;
+    let (m, s) = run_incline(theta, phi, mu);
+    let (v, u) = mean_xz(&m, &s);
+    let speed = v[0].hypot(v[1]);
+    let a = speed / s.t;
+    let expect = G * (theta.sin() - mu * theta.cos());
+    let heading = v[1].atan2(v[0]);
+    eprintln!(
+        "slide: a = {a:.6} m/s² against {expect:.6}; heading {:.4}° (slope {:.1}°); u = {u:?}",
+        heading.to_degrees(),
+        phi.to_degrees()
+    );
+    assert!(
+        (a - expect).abs() < 0.01 * expect,
+        "a = {a}, expected {expect}"
+    );
+    assert!((heading - phi).abs() < 1e-6, "heading {heading}");
+    let rec = s.contact.pairs[0];
+    assert!(rec.slipping > 0 && rec.sticking == 0, "{rec:?}");
+    // The friction line equals μ N times the slip: μ m g cos θ · |u|.
+    let mass = 7850.0 * 1e-3;
+    let d = s.ledger.dissipated().friction;
+    let expect_d = mu * mass * G * theta.cos() * u[0].hypot(u[1]);
+    eprintln!("D_friction {d:.6e} J against μ m g cos θ |u| = {expect_d:.6e} J");
+    assert!((d - expect_d).abs() < 0.01 * expect_d, "{d} vs {expect_d}");
+    // Below it: the block sticks (drifts no more than its elastic shear).
+    let (m, s) = run_incline(theta, phi, 0.7);
+    let (v, u) = mean_xz(&m, &s);
+    eprintln!("stick: v = {v:?}, u = {u:?}");
+    assert!(
+        v[0].hypot(v[1]) < 1e-6 && u[0].hypot(u[1]) < 1e-7,
+        "{v:?} {u:?}"
+    );
+    let rec = s.contact.pairs[0];
+    assert!(rec.sticking > 0 && rec.slipping == 0, "{rec:?}");
+}
+
+/// A block 0.4 x 0.2 x 0.4 m pressed by a uniform traction `p` on its top onto
+/// a base of the same material; the two meshes' divisions in x and z.
+fn patch(upper: [usize; 2], lower: [usize; 2], p: f64) -> String {
+    format!(
+        r#"
+[analysis]
+kind = "static"
+t_end = 1.0
+dt = 1.0
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "base"
+material = "steel"
+mesh = {{ kind = "box", size = [0.4, 0.2, 0.4], divisions = [{}, 2, {}] }}
+[[bodies]]
+name = "block"
+material = "steel"
+mesh = {{ kind = "box", origin = [0.0, 0.2, 0.0], size = [0.4, 0.2, 0.4], divisions = [{}, 2, {}] }}
+[[supports]]
+set = "base.bottom"
+fix = ["y"]
+[[supports]]
+set = "base.left"
+fix = ["x"]
+[[supports]]
+set = "block.left"
+fix = ["x"]
+[[supports]]
+set = "base.back"
+fix = ["z"]
+[[supports]]
+set = "block.back"
+fix = ["z"]
+[[loads]]
+kind = "traction"
+set = "block.top"
+value = [0.0, {:e}, 0.0]
+function = {{ kind = "ramp", t0 = 0.0, t1 = 1.0 }}
+[[contact]]
+name = "patch"
+slave = "block.bottom"
+master = "base.top"
+"#,
+        lower[0], lower[1], upper[0], upper[1], -p
+    )
+}
+
+/// The contact force and the largest relative deviation of the slaves' pressures
+/// from `p`.
+fn patch_pressure(upper: [usize; 2], lower: [usize; 2]) -> (f64, f64) {
+    let p = 1.0e6;
+    let m = model(&patch(upper, lower, p));
+    let mut st = rothe::time::statics::Statics::new(&m, Backend::Faer).unwrap();
+    let mut s = st.initial_state();
+    st.step_accepted(&mut s).unwrap();
+    let rec = s.contact.pairs[0];
+    let slaves = &m.contacts[0].sides[0].slaves;
+    let worst = slaves
+        .iter()
+        .map(|&n| (s.contact.pressure[n] - p).abs() / p)
+        .fold(0.0f64, f64::max);
+    assert!(rec.penetration <= m.analysis.contact.tolerance);
+    (rec.force, worst)
+}
+
+#[test]
+fn the_solid_patch_test_transmits_the_load_and_reports_the_pressure_error() {
+    // Equilibrium: the contact force equals the load p A on any meshes. Matching
+    // meshes pass the patch test exactly; node to face on non-matching ones does not
+    // (its error is the formulation's, written in theory/contact3d.md).
+    let load = 1.0e6 * 0.16;
+    let (f, worst) = patch_pressure([4, 4], [4, 4]);
+    eprintln!("matching: force {f:.9e} N (p A = {load:e}), pressure error {worst:.2e}");
+    assert!((f - load).abs() < 1e-8 * load, "{f}");
+    assert!(worst < 1e-6, "matching meshes: pressure error {worst}");
+    let (f, worst) = patch_pressure([5, 3], [4, 4]);
+    eprintln!("non-matching (slave 5x3 on master 4x4): force {f:.9e} N, pressure error {worst:.3}");
+    assert!((f - load).abs() < 1e-8 * load, "{f}");
+    assert!(worst < 0.5, "pressure error {worst}");
+}
+
+/// The grid of a graded axis: `n0` equal cells of `h0` from 0, then cells growing
+/// by `q` to the length `l` (the last stretched to end there).
+fn graded(h0: f64, n0: usize, q: f64, l: f64) -> Vec<f64> {
+    let mut x = vec![0.0];
+    let mut h = h0;
+    for _ in 0..n0 {
+        x.push(x.last().unwrap() + h0);
+    }
+    while *x.last().unwrap() < l - 1e-12 {
+        h *= q;
+        let next = x.last().unwrap() + h;
+        if next + h * q > l {
+            x.push(l);
+        } else {
+            x.push(next);
+        }
+    }
+    x
+}
+
+#[test]
+fn hertz_sphere_on_a_half_space_has_the_closed_form_radius_and_peak_pressure() {
+    // A quarter of a body whose bottom is the paraboloid y = (x² + z²)/(2R) (Hertz's
+    // sphere near its pole), pressed onto a rigid plane by a prescribed
+    // displacement of its top; symmetry planes x = 0 and z = 0. Hertz (rigid flat,
+    // E* = E/(1 − ν²)): a = (3FR/(4E*))^(1/3), p₀ = 3F/(2πa²), the pressure
+    // p = p₀ √(1 − r²/a²): p² is linear in r², so a least-squares line through the
+    // pressed nodes' p² against r² gives p₀² at r = 0 and a² where it vanishes.
+    let (e, nu, r_sphere) = (200.0e9, 0.3, 1.0);
+    let a_target = 0.03;
+    let l = 0.3;
+    let xs = graded(a_target / 8.0, 12, 1.25, l);
+    let n = xs.len() - 1;
+    let text = format!(
+        r#"
+[analysis]
+kind = "static"
+t_end = 1.0
+dt = 1.0
+[materials.steel]
+model = "elastic"
+E = {e:e}
+nu = {nu}
+rho = 7850.0
+[[bodies]]
+name = "ball"
+material = "steel"
+mesh = {{ kind = "box", size = [1.0, 1.0, 1.0], divisions = [{n}, {n}, {n}] }}
+[[supports]]
+set = "ball.left"
+fix = ["x"]
+[[supports]]
+set = "ball.back"
+fix = ["z"]
+[[contact]]
+name = "hertz"
+slave = "ball.bottom"
+rigid_plane = {{ point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }}
+"#
+    );
+    let mut m = model(&text);
+    // Grade the unit box onto the graded grid, then lift the bottom onto the
+    // paraboloid (fading to nothing at the top).
+    let index = |s: f64| (s * n as f64).round() as usize;
+    for c in m.mesh.coords.iter_mut() {
+        let (x, z) = (xs[index(c[0])], xs[index(c[2])]);
+        let y = xs[index(c[1])];
+        let lift = (x * x + z * z) / (2.0 * r_sphere);
+        *c = [x, y + lift * (1.0 - y / l), z];
+    }
+    // The top pushed down by the indentation a²/R plus the body's own compression
+    // (estimated, it only sets the load level).
+    let delta = a_target * a_target / r_sphere;
+    let top: Vec<usize> = m.mesh.node_sets["ball.top"].clone();
+    for &t in &top {
+        m.constraints.push(rothe::model::Constraint {
+            dof: 3 * t + 1,
+            value: -1.6 * delta,
+            function: rothe::model::TimeFunction::Ramp { t0: 0.0, t1: 1.0 },
+        });
+    }
+    m.constraints.sort_by_key(|c| c.dof);
+    m.constraints.dedup_by_key(|c| c.dof);
+    // Tributary areas of the graded bottom (validation computed them on the box).
+    let mut st = rothe::time::statics::Statics::new(&m, Backend::Faer).unwrap();
+    let mut s = st.initial_state();
+    st.step_accepted(&mut s).unwrap();
+    let f = 4.0 * s.contact.pairs[0].force;
+    let e_star = e / (1.0 - nu * nu);
+    let a = (3.0 * f * r_sphere / (4.0 * e_star)).cbrt();
+    let p0 = 3.0 * f / (2.0 * std::f64::consts::PI * a * a);
+    let slaves = &m.contacts[0].sides[0].slaves;
+    let pressed: Vec<(f64, f64)> = slaves
+        .iter()
+        .filter(|&&k| s.contact.pressure[k] > 0.0)
+        .map(|&k| {
+            let c = m.mesh.coords[k];
+            (c[0] * c[0] + c[2] * c[2], s.contact.pressure[k])
+        })
+        .collect();
+    let r_max = pressed.iter().fold(0.0f64, |x, p| x.max(p.0)).sqrt();
+    let fit: Vec<(f64, f64)> = pressed
+        .iter()
+        .filter(|p| p.0.sqrt() < 0.8 * r_max)
+        .map(|p| (p.0, p.1 * p.1))
+        .collect();
+    let k = fit.len() as f64;
+    let (sx, sy) = fit.iter().fold((0.0, 0.0), |s, p| (s.0 + p.0, s.1 + p.1));
+    let (mx, my) = (sx / k, sy / k);
+    let (sxx, sxy) = fit.iter().fold((0.0, 0.0), |s, p| {
+        (s.0 + (p.0 - mx).powi(2), s.1 + (p.0 - mx) * (p.1 - my))
+    });
+    let slope = sxy / sxx;
+    let p0_fit = (my - slope * mx).sqrt();
+    let a_fit = (-(my - slope * mx) / slope).sqrt();
+    eprintln!(
+        "Hertz: F = {f:.4e} N, {} pressed nodes ({} fitted); a = {a_fit:.5} m against {a:.5} ({:+.2} %), p0 = {p0_fit:.4e} Pa against {p0:.4e} ({:+.2} %)",
+        pressed.len(),
+        fit.len(),
+        100.0 * (a_fit / a - 1.0),
+        100.0 * (p0_fit / p0 - 1.0)
+    );
+    assert!(
+        (a_fit / a - 1.0).abs() < 0.03,
+        "contact radius {a_fit} vs {a}"
+    );
+    assert!(
+        (p0_fit / p0 - 1.0).abs() < 0.03,
+        "peak pressure {p0_fit} vs {p0}"
+    );
+    assert!(s.contact.pairs[0].penetration <= m.analysis.contact.tolerance);
+}
+
+/// A steel block dropped at 2 m/s onto a concrete block of model `material`.
+fn drop_on(material: &str) -> String {
+    format!(
+        r#"
+[analysis]
+t_end = 1.2e-3
+dt = 2.0e-5
+vtk_every = 0
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[materials.concrete]
+E = 33e9
+nu = 0.2
+rho = 2400.0
+{material}
+[[bodies]]
+name = "base"
+material = "concrete"
+mesh = {{ kind = "box", size = [0.6, 0.3, 0.4], divisions = [6, 3, 4] }}
+[[bodies]]
+name = "block"
+material = "steel"
+velocity = [0.0, -2.0, 0.0]
+mesh = {{ kind = "box", origin = [0.15, 0.301, 0.1], size = [0.3, 0.3, 0.2], divisions = [4, 4, 3] }}
+[[supports]]
+set = "base.bottom"
+fix = ["x", "y", "z"]
+[[contact]]
+name = "impact"
+slave = "block.bottom"
+master = "base.top"
+"#
+    )
+}
+
+#[test]
+fn solid_contact_ledgers_close_with_every_material_model() {
+    for (name, lines) in [
+        ("elastic", "model = \"elastic\""),
+        ("kelvin_voigt", "model = \"kelvin_voigt\"\nbeta = 1.0e6"),
+        ("sls", "model = \"sls\"\nalpha = 0.5\nbeta = 1.0e-4"),
+        ("maxwell", "model = \"maxwell\"\nbeta = 1.0e-3"),
+        (
+            "mazars",
+            "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3",
+        ),
+        (
+            "rankine_hill",
+            "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }",
+        ),
+    ] {
+        let m = model(&drop_on(lines));
+        let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let mut prev = *s.ledger.dissipated();
+        let mut max_force: f64 = 0.0;
+        let mut cuts = 0;
+        march(&mut be, &mut s, StepControl::of(&m), |_, s, marched| {
+            if let Marched::Cut { .. } = marched {
+                cuts += 1;
+                return Ok(());
+            }
+            let l = &s.ledger;
+            assert!(
+                l.residual().abs() <= 1e-6 * l.scale(),
+                "{name} at t = {}: residual {} of {}",
+                s.t,
+                l.residual(),
+                l.scale()
+            );
+            let d = l.dissipated();
+            // The material lines never fall (the contact line may by the
+            // linearisation of the gaps over a step, theory/contact.md).
+            for ((line, now), (_, before)) in d.lines().iter().zip(prev.lines()).take(5) {
+                if *line != "contact" {
+                    assert!(
+                        *now >= before - 1e-9 * l.scale(),
+                        "{name}: {line} fell from {before} to {now}"
+                    );
+                }
+            }
+            prev = *d;
+            max_force = max_force.max(s.contact.pairs[0].force);
+            assert!(s.contact.pairs[0].penetration <= m.analysis.contact.tolerance);
+            Ok(())
+        })
+        .unwrap();
+        assert!(max_force > 0.0, "{name}: the blocks met");
+        eprintln!(
+            "{name}: E_kin0 {:.3} J, D_contact {:.3e} J, D_num {:.3} J, material {:.3e} J, max force {max_force:.3e} N, {cuts} cuts",
+            s.ledger.kinetic_0(),
+            s.ledger.dissipated().contact,
+            s.ledger.dissipated().numerical,
+            s.ledger.dissipated().material()
+        );
+    }
+}
+
+#[test]
+fn a_solid_contact_pair_is_validated() {
+    let text = drop_on("model = \"elastic\"");
+    let with = |from: &str, to: &str| {
+        assert!(text.contains(from), "{from}");
+        text.replace(from, to)
+    };
+    let e = refusal(&with("master = \"base.top\"", "master = \"base.nope\""));
+    assert!(
+        e.contains("contact[0].master") && e.contains("unknown face set"),
+        "{e}"
+    );
+    let e = refusal(&with(
+        "master = \"base.top\"",
+        "rigid_plane = { point = [0.0, 0.0], normal = [0.0, 1.0, 0.0] }",
+    ));
+    assert!(
+        e.contains("contact[0].rigid_plane.point") && e.contains("expected 3"),
+        "{e}"
+    );
+    let e = refusal(&with(
+        "master = \"base.top\"",
+        "rigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 0.0] }",
+    ));
+    assert!(e.contains("contact[0].rigid_plane.normal"), "{e}");
+    let e = refusal(&with(
+        "master = \"base.top\"",
+        "master = \"base.top\"\nrigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }",
+    ));
+    assert!(e.contains("exactly one"), "{e}");
+    let e = refusal(&with(
+        "master = \"base.top\"",
+        "rigid_line = [[0.0, 0.0], [1.0, 0.0]]",
+    ));
+    assert!(
+        e.contains("contact[0].rigid_line") && e.contains("rigid_plane"),
+        "{e}"
+    );
+    let e = refusal(&with(
+        "master = \"base.top\"",
+        "master = \"base.top\"\nformulation = \"mortar\"",
+    ));
+    assert!(
+        e.contains("contact[0].formulation") && e.contains("node to face"),
+        "{e}"
+    );
+    let e = refusal(&with("master = \"base.top\"", "master = \"block.top\""));
+    assert!(e.contains("self-contact"), "{e}");
+    let e = refusal(&with(
+        "dt = 2.0e-5",
+        "dt = 2.0e-5\nscheme = \"central_difference\"",
+    ));
+    assert!(e.contains("contact[0]") && e.contains("explicit"), "{e}");
+    // Overlapping at the start: the block sunk 5 mm into the base.
+    let e = refusal(&with(
+        "origin = [0.15, 0.301, 0.1]",
+        "origin = [0.15, 0.295, 0.1]",
+    ));
+    assert!(e.contains("overlap") && e.contains("master face"), "{e}");
+    // In the plane a rigid plane is refused naming it.
+    let plane = r#"
+[analysis]
+t_end = 1.0e-3
+dt = 1.0e-5
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "b"
+material = "steel"
+thickness = 0.1
+mesh = { kind = "rectangle", size = [1.0, 1.0], divisions = [2, 2] }
+[[contact]]
+name = "c"
+slave = "b.bottom"
+rigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
+"#;
+    let e = refusal(plane);
+    assert!(
+        e.contains("contact[0].rigid_plane") && e.contains("rigid_line"),
+        "{e}"
+    );
+}
