@@ -222,19 +222,21 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
 /// gaps and its friction.
 fn contact_line(p: &crate::model::ContactPair) -> String {
     use crate::model::{Formulation, Master};
-    let rigid = p
+    let faces = p
         .sides
         .iter()
-        .any(|s| matches!(s.master, Master::Rigid { .. }));
-    let master = if rigid {
-        "a rigid line"
-    } else if p.sides.len() == 2 {
-        "segments, both ways"
-    } else {
-        "segments"
+        .any(|s| matches!(s.master, Master::Faces(_) | Master::Plane { .. }));
+    let master = match p.sides.first().map(|s| &s.master) {
+        Some(Master::Rigid { .. }) => "a rigid line",
+        Some(Master::Plane { .. }) => "a rigid plane",
+        Some(Master::Faces(_)) if p.sides.len() == 2 => "faces, both ways",
+        Some(Master::Faces(_)) => "faces",
+        _ if p.sides.len() == 2 => "segments, both ways",
+        _ => "segments",
     };
     let formulation = match p.formulation {
         Formulation::Mortar => "mortar (one weighted gap per slave node)",
+        Formulation::NodeToSegment if faces => "node to face",
         Formulation::NodeToSegment => "node to segment",
     };
     let friction = if p.mu > 0.0 {

@@ -1,0 +1,124 @@
+//! Criterion bench of contact between solids: benchmark 1's two blocks as boxes
+//! (`examples/benchmarks/two_blocks_solid.toml`, both elastic, `h = 1e-6` s, the
+//! example's step) at
+//! the mesh sizes 0.1 m and 0.05 m: one backward-Euler step in persistent contact
+//! (node to face, condensed QP), the same with Coulomb friction (μ = 0.4, the
+//! steel's corner edges free), and the same step of the same state without contact.
+//! The steel falls from the example's gap of 0.01 m and is marched into contact
+//! (2650 steps) before the timed steps, each of which starts from that state.
+
+use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion};
+use rothe::linsolve::Backend;
+use rothe::model::Model;
+use rothe::time::backward_euler::BackwardEuler;
+use rothe::time::{Integrator, State};
+
+/// Steps marched before the timed ones: 2.65 ms, 50 µs into the contact.
+const WARM_UP: usize = 2650;
+
+/// `Some(μ)`: contact with Coulomb's `μ`; `None`: no contact.
+fn scenario(size: f64, contact: Option<f64>) -> Model {
+    let pair = match contact {
+        Some(mu) => format!(
+            "[[contact]]\nname = \"impact\"\nslave = \"steel.bottom\"\nmaster = \"concrete.top\"\nmu = {mu:e}\n"
+        ),
+        None => String::new(),
+    };
+    let corners = if contact.is_some_and(|mu| mu > 0.0) {
+        ""
+    } else {
+        r#"
+[[supports]]
+set = "steel.bottom_left"
+fix = ["x"]
+[[supports]]
+set = "steel.bottom_right"
+fix = ["x"]
+"#
+    };
+    let text = format!(
+        r#"
+[analysis]
+t_end = 1.0
+dt = 1.0e-6
+gravity = [0.0, -9.81, 0.0]
+vtk_every = 0
+[meshing]
+element_size = {size:e}
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[materials.concrete]
+model = "elastic"
+E = 33e9
+nu = 0.2
+rho = 2400.0
+[[bodies]]
+name = "concrete"
+material = "concrete"
+mesh = {{ kind = "box", size = [1.2, 0.6, 0.4], x_lines = [0.3, 0.9], z_lines = [0.1, 0.3] }}
+[[bodies]]
+name = "steel"
+material = "steel"
+velocity = [0.0, -3.836, 0.0]
+mesh = {{ kind = "box", origin = [0.3, 0.61, 0.1], size = [0.6, 0.6, 0.2] }}
+[[supports]]
+set = "concrete.bottom"
+fix = ["x", "y", "z"]
+{corners}
+{pair}
+"#
+    );
+    rothe::config::from_str(&text, std::path::Path::new(".")).expect("valid scenario")
+}
+
+/// The state after the warm-up, in persistent contact.
+fn in_contact(model: &Model) -> State {
+    let mut be = BackwardEuler::new(model, Backend::Faer).unwrap();
+    let mut s = be.initial_state();
+    for _ in 0..WARM_UP {
+        be.step_accepted(&mut s).unwrap();
+    }
+    assert!(
+        s.contact.pairs[0].force > 0.0,
+        "in contact after the warm-up"
+    );
+    s
+}
+
+fn steps(c: &mut Criterion) {
+    let mut g = c.benchmark_group("solid_contact_step");
+    g.sample_size(10);
+    for (size, label) in [(0.1, "0.1m"), (0.05, "0.05m")] {
+        let mut state = None;
+        for (name, enforced) in [
+            ("node_to_face", Some(0.0)),
+            ("without_contact", None),
+            ("node_to_face_friction", Some(0.4)),
+        ] {
+            let model = scenario(size, enforced);
+            // The step without contact starts from the frictionless state.
+            if enforced.is_some() {
+                state = Some(in_contact(&model));
+            }
+            let state = state.clone().expect("frictionless first");
+            let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
+            g.bench_with_input(BenchmarkId::new(name, label), &size, |b, _| {
+                b.iter_batched(
+                    || state.clone(),
+                    |mut s| {
+                        be.step_accepted(&mut s).unwrap();
+                        s
+                    },
+                    BatchSize::LargeInput,
+                )
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, steps);
+criterion_main!(benches);
