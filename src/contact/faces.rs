@@ -532,10 +532,17 @@ fn faces_side<X: Fn(usize) -> V3>(
                     Region::Interior { .. } => true,
                     _ => prf.d2 <= pr.d2 * (1.0 + 1e-9) + f64::MIN_POSITIVE,
                 };
-                let rises = corners(&faces[*f]).iter().any(|&v| {
-                    let d = sub(x(v), pr.point);
-                    dot(d, nk) > VALLEY_SINE * dot(d, d).sqrt()
-                });
+                // The corners of the neighbour it does not share with the nearest
+                // face (a shared one lies on the boundary, where round-off decides
+                // the sign).
+                let own = corners(&faces[k]);
+                let rises = corners(&faces[*f])
+                    .iter()
+                    .filter(|v| !own.contains(v))
+                    .any(|&v| {
+                        let d = sub(x(v), pr.point);
+                        dot(d, nk) > VALLEY_SINE * dot(d, d).sqrt()
+                    });
                 if inside && rises {
                     held.push(*f);
                 }
