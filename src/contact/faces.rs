@@ -334,32 +334,21 @@ impl Surface {
     }
 }
 
-/// The two unit tangents of a face's row: the face's first edge projected on the
-/// plane normal to `n`, and `n ×` it (so they follow the face as it moves, the same
-/// at every iteration while the slave stays on it).
-fn tangents_of(n: V3, edge: V3) -> [V3; 2] {
-    let e = sub(
-        edge,
-        [
-            n[0] * dot(edge, n),
-            n[1] * dot(edge, n),
-            n[2] * dot(edge, n),
-        ],
-    );
-    let t1 = unit(e).unwrap_or_else(|| plane_tangents(n)[0]);
-    [t1, cross(n, t1)]
-}
-
-/// Two unit tangents orthonormal with the unit vector `n`, continuous in `n` away
-/// from the boundaries between its largest components (a rigid plane's are fixed at
-/// validation).
+/// Two unit tangents orthonormal with the unit vector `n`: the coordinate axis
+/// after `n`'s largest component (cyclically) projected on the plane normal to `n`,
+/// and `n ×` it. A function of the normal alone, continuous while the largest
+/// component stays the same (normals within 45° of an axis), so the tangents of a
+/// slave passing from a face to its neighbour (the interpolated normal is
+/// continuous there) are the same and its tangential forces keep their meaning.
+/// Rigid planes take them at validation.
 pub fn plane_tangents(n: V3) -> [V3; 2] {
     let k = (0..3)
-        .min_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
         .unwrap_or(0);
-    let mut e = [0.0; 3];
-    e[k] = 1.0;
-    let t1 = unit(cross(e, n)).unwrap_or([1.0, 0.0, 0.0]);
+    let mut a = [0.0; 3];
+    a[(k + 1) % 3] = 1.0;
+    let an = dot(a, n);
+    let t1 = unit(sub(a, [an * n[0], an * n[1], an * n[2]])).unwrap_or([1.0, 0.0, 0.0]);
     [t1, cross(n, t1)]
 }
 
@@ -378,8 +367,7 @@ fn face_candidate<X: Fn(usize) -> V3>(
     for (k, &v) in corners(face).iter().enumerate() {
         weights.add(v, -pr.weights[k]);
     }
-    let c = corners(face);
-    let tangents = tangents_of(normal, sub(x(c[1]), x(c[0])));
+    let tangents = plane_tangents(normal);
     Candidate {
         pair: key.0,
         side: key.1,
@@ -623,7 +611,8 @@ mod tests {
             [0.3, -0.2, 0.9327379053088815],
         ] {
             let n = unit(n).unwrap();
-            for t in [plane_tangents(n), tangents_of(n, [1.0, 0.3, 0.2])] {
+            {
+                let t = plane_tangents(n);
                 assert!(dot(t[0], n).abs() < 1e-15 && dot(t[1], n).abs() < 1e-15);
                 assert!(dot(t[0], t[1]).abs() < 1e-15);
                 assert!((dot(t[0], t[0]) - 1.0).abs() < 1e-15);
