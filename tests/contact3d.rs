@@ -19,8 +19,7 @@ fn model(text: &str) -> Model {
 
 fn refusal(text: &str) -> String {
     rothe::config::from_str(text, Path::new("."))
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string()
 }
 

@@ -204,7 +204,8 @@ fn quadrilateral(p: V3, x: [V3; 4]) -> Option<Projection> {
         let r = sub(p, q);
         let (a, b, c) = (dot(tx, tx), dot(tx, ty), dot(ty, ty));
         let det = a * c - b * b;
-        if !(det > 0.0) {
+        // A degenerate face (NaN counts as one).
+        if det.is_nan() || det <= 0.0 {
             return None;
         }
         let (gx, gy) = (dot(tx, r), dot(ty, r));
