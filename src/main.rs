@@ -72,7 +72,7 @@ enum Command {
     /// Run the paper's two benchmarks (every model and mesh, implicit and explicit)
     /// and write report.md with tables and plots.
     Report {
-        /// Directory holding two_blocks.toml and rc_beam_punch.toml.
+        /// Directory holding two_blocks.toml, two_blocks_solid.toml and rc_beam_punch.toml.
         #[arg(long, default_value = "examples/benchmarks")]
         benchmarks: PathBuf,
         /// Benchmark 1's mesh sizes (m).

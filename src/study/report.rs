@@ -28,13 +28,17 @@ pub const BENCHMARK1_MODELS: [&str; 6] = [
 pub const BENCHMARK1_MESHES: [f64; 5] = [0.2, 0.15, 0.1, 0.05, 0.025];
 /// The damage models run on `ReportOptions::damage_meshes` too.
 pub const DAMAGE_MODELS: [&str; 2] = ["mazars", "mazars_local"];
+/// The concrete models of benchmark 1 run as solids too
+/// (`two_blocks_solid.toml`, at the comparison mesh), against plane stress.
+pub const SOLID_MODELS: [&str; 3] = ["elastic", "mazars", "rankine_hill"];
 /// The concrete models of benchmark 2.
 pub const BENCHMARK2_MODELS: [&str; 4] = ["mazars", "mazars_local", "rankine_hill", "kelvin_voigt"];
 
 /// What the report runs.
 #[derive(Clone, Debug)]
 pub struct ReportOptions {
-    /// Directory holding `two_blocks.toml` and `rc_beam_punch.toml`.
+    /// Directory holding `two_blocks.toml`, `two_blocks_solid.toml` and
+    /// `rc_beam_punch.toml`.
     pub benchmarks: PathBuf,
     /// Benchmark 1's meshes.
     pub meshes: Vec<f64>,
@@ -78,7 +82,8 @@ fn size(s: f64) -> Overrides {
 pub fn plan(o: &ReportOptions) -> Result<Plan> {
     let b1 = o.benchmarks.join("two_blocks.toml");
     let b2 = o.benchmarks.join("rc_beam_punch.toml");
-    for f in [&b1, &b2] {
+    let b1_solid = o.benchmarks.join("two_blocks_solid.toml");
+    for f in [&b1, &b2, &b1_solid] {
         if !f.is_file() {
             return Err(Error::config(
                 "--benchmarks",
@@ -120,6 +125,18 @@ pub fn plan(o: &ReportOptions) -> Result<Plan> {
         runs.push(PlannedRun {
             label: format!("{m}, {} m, explicit", o.compare_mesh),
             ..explicit[1].clone()
+        });
+    }
+    // Benchmark 1 as solids at the comparison mesh (theory/contact3d.md).
+    let abs_solid = super::plan::absolute(&b1_solid)?;
+    for m in SOLID_MODELS {
+        runs.push(PlannedRun {
+            id: format!("b1solid_{m}_{}", o.compare_mesh),
+            scenario: abs_solid.clone(),
+            overrides: o.base.then(&variant(m)).then(&size(o.compare_mesh)),
+            param: o.compare_mesh,
+            label: format!("{m}, {} m, solid", o.compare_mesh),
+            record_fields: false,
         });
     }
     for m in BENCHMARK2_MODELS {
@@ -179,6 +196,100 @@ fn run_lifts_off(r: &RunData, support: &str) -> bool {
         &r.column(&format!("{support}_force")),
         &r.column("impact_force"),
     )
+}
+
+/// Benchmark 1 as solids against plane stress: peak probe deflection, dissipation
+/// by mechanism, the contact force's peak and duration, and the force histories.
+fn solid_against_plane(runs: &[RunData], plots: &Path) -> Result<String> {
+    let pairs: Vec<(&str, &RunData, &RunData)> = SOLID_MODELS
+        .iter()
+        .filter_map(|m| {
+            let solid = runs
+                .iter()
+                .find(|r| r.run.id.starts_with(&format!("b1solid_{m}_")) && r.completed())?;
+            let plane = find(runs, &format!("b1_{m}_{}", solid.run.param))?;
+            Some((*m, plane, solid))
+        })
+        .collect();
+    if pairs.is_empty() {
+        return Ok(String::new());
+    }
+    let mut md = String::from(
+        "\n## Benchmark 1 as solids against plane stress\n\nThe blocks as boxes with the \
+         plane model's thicknesses as depths (`two_blocks_solid.toml`), the same data, \
+         mesh size and step; energies over E_kin⁰, the contact force's peak (its first \
+         step) and the time it acts (theory/contact3d.md).\n\n",
+    );
+    let mut t = Table::new(&[
+        "model",
+        "run",
+        "peak probe [mm]",
+        "D_material / E_kin0",
+        "D_num / E_kin0",
+        "D_contact / E_kin0",
+        "peak force [MN]",
+        "contact [ms]",
+    ]);
+    for (m, plane, solid) in &pairs {
+        for (what, r) in [("plane stress", plane), ("solid", solid)] {
+            let k0 = r.kinetic_0();
+            let force = r.column("impact_force");
+            let time = r.column("t");
+            let pressed: Vec<f64> = time
+                .iter()
+                .zip(&force)
+                .filter(|(_, f)| **f > 0.0)
+                .map(|(t, _)| *t)
+                .collect();
+            let duration = match (pressed.first(), pressed.last()) {
+                (Some(a), Some(b)) => Some(1e3 * (b - a)),
+                _ => None,
+            };
+            t.push(vec![
+                m.to_string(),
+                what.into(),
+                num(Some(1e3 * r.probe_min("probe"))),
+                num(Some(r.dissipated_material() / k0)),
+                num(Some(r.dissipated("numerical") / k0)),
+                num(Some(r.dissipated("contact") / k0)),
+                num(Some(1e-6 * force.iter().fold(0.0f64, |a, f| a.max(*f)))),
+                num(duration),
+            ]);
+        }
+    }
+    md.push_str(&t.markdown());
+    let mut fig = Figure::new(
+        "Benchmark 1: contact force, plane stress and solid",
+        "t [ms]",
+        "F [MN]",
+    );
+    // From the second step in contact on: the first step's force (the bottom
+    // layer's momentum stopped in one step, in the table) would flatten the rest.
+    let after_touch = |r: &RunData| {
+        let points = r.series("impact_force", 1e-6);
+        let first = points.iter().position(|p| p.1 > 0.0).unwrap_or(0);
+        points[(first + 1).min(points.len())..].to_vec()
+    };
+    for (m, plane, solid) in &pairs {
+        fig = fig
+            .with(Series::new(
+                format!("{m}, plane"),
+                after_touch(plane),
+                Style::Line,
+            ))
+            .with(Series::new(
+                format!("{m}, solid"),
+                after_touch(solid),
+                Style::Line,
+            ));
+    }
+    draw(&fig, &plots.join("b1_solid_force"))?;
+    md.push_str(
+        "\n![benchmark 1 contact force, plane and solid](plots/b1_solid_force.png)\n\n\
+         The force from the second step in contact on (the first step's is the table's \
+         peak).\n",
+    );
+    Ok(md)
 }
 
 /// Writes the report's tables and plots into `dir`; returns the Markdown.
@@ -373,6 +484,8 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
             "![benchmark 2 energies, {m}](plots/b2_energies_{m}.png)\n"
         ));
     }
+
+    md.push_str(&solid_against_plane(runs, &plots)?);
 
     md.push_str("\n## Implicit against explicit\n\n");
     for m in BENCHMARK1_MODELS {
