@@ -21,7 +21,7 @@
 use rstar::primitives::{GeomWithData, Line};
 use rstar::RTree;
 
-use super::collision::node_segment;
+use super::collision::{node_segment, node_triangle};
 use super::qp::{on_active_set, solve_by_active_set, DualQp};
 use super::rows::Candidate;
 use super::state::{ContactState, Key, PairRecord};
@@ -31,28 +31,35 @@ use crate::model::{Master, Model};
 /// Sweeps of the end-of-step projection.
 const PROJECTION_SWEEPS: usize = 4;
 
+/// The most dofs of a row: the slave and a solid's quadrilateral face, three each.
+const ROW_DOFS: usize = 15;
+
+/// The dofs and coefficients of a row, and how many are used.
+type Dofs = ([(usize, f64); ROW_DOFS], usize);
+
 /// One colliding pair of a step.
 #[derive(Clone, Copy, Debug)]
 struct Row {
     key: Key,
     /// Time of impact within the step.
     t_c: f64,
-    /// Dofs and coefficients of the normal row (slave `+n`, segment `−(1−ξ)n, −ξn`).
-    normal: ([(usize, f64); 6], usize),
-    /// The same with the tangent `(n_y, −n_x)` (the implicit path's, [`Candidate::tangent`]).
-    tangent: ([(usize, f64); 6], usize),
+    /// Dofs and coefficients of the normal row (slave `+n`, segment `−(1−ξ)n, −ξn`;
+    /// a face's corners `−N_k n`).
+    normal: Dofs,
+    /// The same with the tangents: in the plane the one `(n_y, −n_x)` (the implicit
+    /// path's, [`Candidate::tangent`]), in a solid two ([`super::faces::plane_tangents`]).
+    tangents: [Dofs; 2],
+    /// Tangents used: 1 in the plane, 2 in a solid.
+    n_tangents: usize,
     /// Friction interpolation, Coulomb coefficient and position weight of the pair.
     beta: f64,
     mu: f64,
     weight: f64,
 }
 
-fn row_of(
-    slave: usize,
-    master: Option<([usize; 2], f64)>,
-    d: [f64; 2],
-) -> ([(usize, f64); 6], usize) {
-    let mut r = [(0usize, 0.0f64); 6];
+/// A plane row along `d`: the slave and, against a segment, its ends.
+fn row_of(slave: usize, master: Option<([usize; 2], f64)>, d: [f64; 2]) -> Dofs {
+    let mut r = [(0usize, 0.0f64); ROW_DOFS];
     r[0] = (2 * slave, d[0]);
     r[1] = (2 * slave + 1, d[1]);
     match master {
@@ -67,12 +74,70 @@ fn row_of(
     }
 }
 
-fn dot_row(row: &([(usize, f64); 6], usize), x: &[f64]) -> f64 {
+/// A solid's row along `d`: `+d` on the slave, `−w_k d` on the corners `nodes`.
+fn row_of_face(slave: usize, nodes: &[(usize, f64)], d: [f64; 3]) -> Dofs {
+    let mut r = ([(0usize, 0.0f64); ROW_DOFS], 0);
+    let mut push = |node: usize, w: f64| {
+        for (i, di) in d.iter().enumerate() {
+            r.0[r.1] = (3 * node + i, w * di);
+            r.1 += 1;
+        }
+    };
+    push(slave, 1.0);
+    for &(node, w) in nodes {
+        push(node, -w);
+    }
+    r
+}
+
+/// A slave's earliest impact in a solid: when, on which face (`usize::MAX`: the
+/// rigid plane) at which corners and weights, along which normal.
+#[derive(Clone, Copy, Debug)]
+struct SolidHit {
+    slave: usize,
+    t_c: f64,
+    face: usize,
+    /// The triangle's corners and their barycentric weights (none on a plane).
+    corners: [(usize, f64); 3],
+    n_corners: usize,
+    normal: [f64; 3],
+}
+
+/// The rows of a plane impact along the normal `n`: the normal one and the tangent
+/// `(n_y, −n_x)`.
+fn plane_rows(
+    slave: usize,
+    master: Option<([usize; 2], f64)>,
+    n: [f64; 2],
+) -> (Dofs, [Dofs; 2], usize) {
+    let empty = ([(0usize, 0.0f64); ROW_DOFS], 0);
+    (
+        row_of(slave, master, n),
+        [row_of(slave, master, [n[1], -n[0]]), empty],
+        1,
+    )
+}
+
+/// The rows of a solid's impact along the normal `n`: the normal one and its two
+/// tangents.
+fn solid_rows(slave: usize, nodes: &[(usize, f64)], n: [f64; 3]) -> (Dofs, [Dofs; 2], usize) {
+    let t = super::faces::plane_tangents(n);
+    (
+        row_of_face(slave, nodes, n),
+        [
+            row_of_face(slave, nodes, t[0]),
+            row_of_face(slave, nodes, t[1]),
+        ],
+        2,
+    )
+}
+
+fn dot_row(row: &Dofs, x: &[f64]) -> f64 {
     row.0[..row.1].iter().map(|&(d, c)| c * x[d]).sum()
 }
 
 /// `Σ_d a_d b_d / m_d` of two rows.
-fn coupling(a: &([(usize, f64); 6], usize), b: &([(usize, f64); 6], usize), m_inv: &[f64]) -> f64 {
+fn coupling(a: &Dofs, b: &Dofs, m_inv: &[f64]) -> f64 {
     let mut w = 0.0;
     for &(da, ca) in &a.0[..a.1] {
         for &(db, cb) in &b.0[..b.1] {
@@ -177,22 +242,26 @@ impl<'m> KinematicContact<'m> {
         self.impulses.clear();
         self.tangential.fill(0.0);
         self.magnitude.fill(0.0);
-        // Slaves that came around the end of a rigid line pass beside it.
+        // Slaves that came around the end of a rigid line pass beside it (the
+        // plane's; a solid's rigid planes are unbounded).
         let coords = &self.model.mesh.coords;
-        self.rigid.beneath = super::detect::beneath_rigid(
-            &self.model.contacts,
-            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
-            &self.rigid.beneath,
-        );
-        // Slaves on a rigid line stay on it a little past its ends.
-        let previous = std::mem::take(&mut self.rigid.held);
-        self.rigid.held = super::detect::held_rigid(
-            &self.model.contacts,
-            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
-            &previous,
-        );
+        let plane = self.model.mesh.dim == 2;
+        if plane {
+            self.rigid.beneath = super::detect::beneath_rigid(
+                &self.model.contacts,
+                |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+                super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
+                &self.rigid.beneath,
+            );
+            // Slaves on a rigid line stay on it a little past its ends.
+            let previous = std::mem::take(&mut self.rigid.held);
+            self.rigid.held = super::detect::held_rigid(
+                &self.model.contacts,
+                |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
+                super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
+                &previous,
+            );
+        }
         self.collisions(u, v, h);
         if !self.rows.is_empty() {
             self.v_pre.clear();
@@ -210,6 +279,10 @@ impl<'m> KinematicContact<'m> {
     /// The earliest collision of every slave node within the step.
     fn collisions(&mut self, u: &[f64], v: &[f64], h: f64) {
         self.rows.clear();
+        if self.model.mesh.dim == 3 {
+            self.solid_collisions(u, v, h);
+            return;
+        }
         let coords = &self.model.mesh.coords;
         let at = |n: usize| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]];
         let vel = |n: usize| [v[2 * n], v[2 * n + 1]];
@@ -252,11 +325,14 @@ impl<'m> KinematicContact<'m> {
                                     [pa[0] + t_c * va[0], pa[1] + t_c * va[1]],
                                     [pb[0] + t_c * vb[0], pb[1] + t_c * vb[1]],
                                 );
+                                let (normal, tangents, n_tangents) =
+                                    plane_rows(s, Some(([a, b], xi)), n);
                                 self.rows.push(Row {
                                     key: (pi, si, s, k),
                                     t_c,
-                                    normal: row_of(s, Some(([a, b], xi)), n),
-                                    tangent: row_of(s, Some(([a, b], xi)), [n[1], -n[0]]),
+                                    normal,
+                                    tangents,
+                                    n_tangents,
                                     beta: pair.friction,
                                     mu: pair.mu,
                                     weight: pair.position_weight,
@@ -290,11 +366,13 @@ impl<'m> KinematicContact<'m> {
                             if let Some(c) =
                                 node_segment(at(s), vel(s), a, [0.0; 2], b, [0.0; 2], h)
                             {
+                                let (normal, tangents, n_tangents) = plane_rows(s, None, *n);
                                 self.rows.push(Row {
                                     key: (pi, si, s, usize::MAX),
                                     t_c: c.t,
-                                    normal: row_of(s, None, *n),
-                                    tangent: row_of(s, None, [n[1], -n[0]]),
+                                    normal,
+                                    tangents,
+                                    n_tangents,
                                     beta: pair.friction,
                                     mu: pair.mu,
                                     weight: pair.position_weight,
@@ -304,6 +382,147 @@ impl<'m> KinematicContact<'m> {
                     }
                     // Validation keeps the explicit path to the plane.
                     Master::Faces(_) | Master::Plane { .. } => {}
+                }
+            }
+        }
+    }
+
+    /// The earliest collision of every slave node of a solid within the step: the
+    /// paper's cubic of a node against a moving triangle (a quadrilateral face as
+    /// its two triangles), or the time it reaches a rigid plane.
+    fn solid_collisions(&mut self, u: &[f64], v: &[f64], h: f64) {
+        let coords = &self.model.mesh.coords;
+        let at = |n: usize| {
+            let c = coords[n];
+            [c[0] + u[3 * n], c[1] + u[3 * n + 1], c[2] + u[3 * n + 2]]
+        };
+        let vel = |n: usize| [v[3 * n], v[3 * n + 1], v[3 * n + 2]];
+        for (pi, pair) in self.model.contacts.iter().enumerate() {
+            for (si, side) in pair.sides.iter().enumerate() {
+                let mut hits: Vec<SolidHit> = Vec::new();
+                match &side.master {
+                    Master::Faces(faces) => {
+                        let r = pair.radius;
+                        let tree = rstar::RTree::bulk_load(
+                            faces
+                                .iter()
+                                .enumerate()
+                                .map(|(k, f)| {
+                                    let (mut lo, mut hi) =
+                                        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                                    for &n in super::faces::corners(f) {
+                                        let p = at(n);
+                                        for i in 0..3 {
+                                            lo[i] = lo[i].min(p[i] - r);
+                                            hi[i] = hi[i].max(p[i] + r);
+                                        }
+                                    }
+                                    GeomWithData::new(
+                                        rstar::primitives::Rectangle::from_corners(lo, hi),
+                                        k,
+                                    )
+                                })
+                                .collect(),
+                        );
+                        for &s in &side.slaves {
+                            let p = at(s);
+                            let mut best: Option<SolidHit> = None;
+                            for hit in tree.locate_all_at_point(p) {
+                                let f = &faces[hit.data];
+                                let c = super::faces::corners(f);
+                                if c.contains(&s) {
+                                    continue;
+                                }
+                                let triangles: &[[usize; 3]] = if c.len() == 3 {
+                                    &[[0, 1, 2]]
+                                } else {
+                                    &[[0, 1, 2], [0, 2, 3]]
+                                };
+                                for tri in triangles {
+                                    let [a, b, cc] = tri.map(|i| c[i]);
+                                    let Some(t) = node_triangle(
+                                        p,
+                                        vel(s),
+                                        at(a),
+                                        vel(a),
+                                        at(b),
+                                        vel(b),
+                                        at(cc),
+                                        vel(cc),
+                                        h,
+                                    ) else {
+                                        continue;
+                                    };
+                                    if best.as_ref().is_some_and(|b| b.t_c <= t.t) {
+                                        continue;
+                                    }
+                                    // The triangle's outward normal at the impact.
+                                    let x = |n: usize| {
+                                        let (q, w) = (at(n), vel(n));
+                                        [q[0] + t.t * w[0], q[1] + t.t * w[1], q[2] + t.t * w[2]]
+                                    };
+                                    let (xa, xb, xc) = (x(a), x(b), x(cc));
+                                    let (e1, e2) = (
+                                        [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]],
+                                        [xc[0] - xa[0], xc[1] - xa[1], xc[2] - xa[2]],
+                                    );
+                                    let nn = [
+                                        e1[1] * e2[2] - e1[2] * e2[1],
+                                        e1[2] * e2[0] - e1[0] * e2[2],
+                                        e1[0] * e2[1] - e1[1] * e2[0],
+                                    ];
+                                    let l = (nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]).sqrt();
+                                    // A degenerate triangle (NaN counts as one).
+                                    if l.is_nan() || l <= 0.0 {
+                                        continue;
+                                    }
+                                    best = Some(SolidHit {
+                                        slave: s,
+                                        t_c: t.t,
+                                        face: hit.data,
+                                        corners: [(a, t.bary[0]), (b, t.bary[1]), (cc, t.bary[2])],
+                                        n_corners: 3,
+                                        normal: [nn[0] / l, nn[1] / l, nn[2] / l],
+                                    });
+                                }
+                            }
+                            hits.extend(best);
+                        }
+                    }
+                    Master::Plane { point, n, .. } => {
+                        for &s in &side.slaves {
+                            let (p, w) = (at(s), vel(s));
+                            let g0: f64 = (0..3).map(|i| (p[i] - point[i]) * n[i]).sum();
+                            let vn: f64 = (0..3).map(|i| w[i] * n[i]).sum();
+                            // Reaching the plane from its side within the step (a node
+                            // on it at the start and moving in meets it at once).
+                            if g0 >= 0.0 && vn < 0.0 && g0 + h * vn <= 0.0 {
+                                hits.push(SolidHit {
+                                    slave: s,
+                                    t_c: g0 / -vn,
+                                    face: usize::MAX,
+                                    corners: [(0, 0.0); 3],
+                                    n_corners: 0,
+                                    normal: *n,
+                                });
+                            }
+                        }
+                    }
+                    Master::Segments(_) | Master::Rigid { .. } => {}
+                }
+                for hit in hits {
+                    let (normal, tangents, n_tangents) =
+                        solid_rows(hit.slave, &hit.corners[..hit.n_corners], hit.normal);
+                    self.rows.push(Row {
+                        key: (pi, si, hit.slave, hit.face),
+                        t_c: hit.t_c,
+                        normal,
+                        tangents,
+                        n_tangents,
+                        beta: pair.friction,
+                        mu: pair.mu,
+                        weight: pair.position_weight,
+                    });
                 }
             }
         }
@@ -356,19 +575,24 @@ impl<'m> KinematicContact<'m> {
                 })?;
         }
         let mut normal = self.p.clone();
-        let mut tangential = vec![0.0; m];
+        let mut tangential = vec![[0.0; 2]; m];
         // Sticking impacts where friction asks for them: the relative velocity of
         // every impacting row (normal and tangential) zero.
         let sticking: Vec<usize> = (0..m)
             .filter(|&i| self.p[i] > 0.0 && self.rows[i].beta > 0.0)
             .collect();
         if !sticking.is_empty() {
-            let k = 2 * sticking.len();
-            let rows: Vec<&([(usize, f64); 6], usize)> = sticking
+            // The sticking rows' normal rows, then their tangential rows (one or two
+            // each).
+            let rows: Vec<&Dofs> = sticking
                 .iter()
                 .map(|&i| &self.rows[i].normal)
-                .chain(sticking.iter().map(|&i| &self.rows[i].tangent))
+                .chain(sticking.iter().flat_map(|&i| {
+                    let r = &self.rows[i];
+                    r.tangents[..r.n_tangents].iter()
+                }))
                 .collect();
+            let k = rows.len();
             // Rows that press without friction stay as they are in both solutions.
             let mut w2 = vec![0.0; k * k];
             let mut c2 = vec![0.0; k];
@@ -395,10 +619,14 @@ impl<'m> KinematicContact<'m> {
             // A sticking impact that would pull is no impact: friction is left out
             // for this step (the frictionless impulses stand).
             if solved {
+                let mut next = sticking.len();
                 for (a, &i) in sticking.iter().enumerate() {
                     let beta = self.rows[i].beta;
                     normal[i] = (1.0 - beta) * self.p[i] + beta * q[a];
-                    tangential[i] = beta * q[sticking.len() + a];
+                    for j in 0..self.rows[i].n_tangents {
+                        tangential[i][j] = beta * q[next];
+                        next += 1;
+                    }
                 }
             }
         }
@@ -417,11 +645,17 @@ impl<'m> KinematicContact<'m> {
         let frictional: Vec<usize> = (0..m)
             .filter(|&i| movable[i] && self.rows[i].mu > 0.0)
             .collect();
-        let rows: Vec<&([(usize, f64); 6], usize)> = self
+        // The tangents per row: one in the plane, two in a solid (every row alike).
+        let tdim = self.rows.first().map_or(1, |r| r.n_tangents);
+        let rows: Vec<&Dofs> = self
             .rows
             .iter()
             .map(|r| &r.normal)
-            .chain(frictional.iter().map(|&i| &self.rows[i].tangent))
+            .chain(
+                frictional
+                    .iter()
+                    .flat_map(|&i| self.rows[i].tangents[..tdim].iter()),
+            )
             .collect();
         let k = rows.len();
         let mut w = vec![0.0; k * k];
@@ -443,15 +677,17 @@ impl<'m> KinematicContact<'m> {
         let cones: Vec<(usize, f64)> = frictional.iter().map(|&i| (i, self.rows[i].mu)).collect();
         let mut q = Vec::new();
         self.step.clarabel += 1;
-        super::coulomb::solve(&w, &c, (m, 1), &cones, &mut q).map_err(|e| {
+        super::coulomb::solve(&w, &c, (m, tdim), &cones, &mut q).map_err(|e| {
             Error::Stepping(format!(
                 "the impact impulses of the kinematic contact with friction: {e}"
             ))
         })?;
         let normal = q[..m].to_vec();
-        let mut tangential = vec![0.0; m];
+        let mut tangential = vec![[0.0; 2]; m];
         for (a, &i) in frictional.iter().enumerate() {
-            tangential[i] = q[m + a];
+            for j in 0..tdim {
+                tangential[i][j] = q[m + tdim * a + j];
+            }
         }
         self.apply(v, m_inv, movable, normal, &tangential);
         Ok(())
@@ -465,13 +701,18 @@ impl<'m> KinematicContact<'m> {
         m_inv: &[f64],
         movable: &[bool],
         normal: Vec<f64>,
-        tangential: &[f64],
+        tangential: &[[f64; 2]],
     ) {
         for (i, r) in self.rows.iter().enumerate() {
             if !movable[i] {
                 continue;
             }
-            for (row, p) in [(&r.normal, normal[i]), (&r.tangent, tangential[i])] {
+            let along = std::iter::once((&r.normal, normal[i])).chain(
+                r.tangents[..r.n_tangents]
+                    .iter()
+                    .zip(tangential[i].iter().copied()),
+            );
+            for (row, p) in along {
                 if p != 0.0 {
                     for &(d, cf) in &row.0[..row.1] {
                         v[d] += m_inv[d] * cf * p;
@@ -482,20 +723,25 @@ impl<'m> KinematicContact<'m> {
                 self.step.impacts += 1;
                 self.impulses.push((r.key, normal[i]));
             }
-            self.tangential[r.key.0] += tangential[i];
-            self.magnitude[r.key.0] += tangential[i].abs();
+            // In the plane the signed impulse along the tangent; in a solid, whose
+            // rows' tangents differ, its magnitude.
+            let [a, b] = tangential[i];
+            let size = a.hypot(b);
+            self.tangential[r.key.0] += if r.n_tangents == 1 { a } else { size };
+            self.magnitude[r.key.0] += if r.n_tangents == 1 { a.abs() } else { size };
         }
         self.p = normal;
     }
 
     /// The paper's position update over the step for the nodes of the impacts.
     fn positions(&mut self, v: &[f64], du: &mut [f64], h: f64) {
+        let dim = self.model.mesh.dim;
         for (i, r) in self.rows.iter().enumerate() {
             if self.p[i] <= 0.0 {
                 continue;
             }
             for &(d, cf) in &r.normal.0[..r.normal.1] {
-                let n = d / 2;
+                let n = d / dim;
                 if cf != 0.0 && r.t_c < self.node_tc[n] {
                     self.node_tc[n] = r.t_c;
                     self.node_weight[n] = r.weight;
@@ -505,7 +751,7 @@ impl<'m> KinematicContact<'m> {
         for (n, t_c) in self.node_tc.iter_mut().enumerate() {
             if t_c.is_finite() {
                 let w = self.node_weight[n];
-                for d in [2 * n, 2 * n + 1] {
+                for d in dim * n..dim * (n + 1) {
                     du[d] = h * v[d] + w * *t_c * (self.v_pre[d] - v[d]);
                 }
                 *t_c = f64::INFINITY;
@@ -529,9 +775,10 @@ impl<'m> KinematicContact<'m> {
                 if c.gap >= 0.0 {
                     continue;
                 }
-                // The explicit path's candidates are node to segment (three nodes).
-                let mut row = ([(0usize, 0.0f64); 6], 0usize);
-                for (e, x) in c.row().take(6) {
+                // The explicit path's candidates are node to segment (three nodes) or
+                // node to face (five at most).
+                let mut row: Dofs = ([(0usize, 0.0f64); ROW_DOFS], 0);
+                for (e, x) in c.row().take(ROW_DOFS) {
                     row.0[row.1] = (e, x);
                     row.1 += 1;
                 }
@@ -562,6 +809,18 @@ impl<'m> KinematicContact<'m> {
     /// Candidates at the geometry `u + du`.
     fn end_geometry(&mut self, u: &[f64], du: &[f64]) {
         let coords = &self.model.mesh.coords;
+        if self.model.mesh.dim == 3 {
+            super::faces::detect(
+                &self.model.contacts,
+                |n| {
+                    let c = coords[n];
+                    let d = |i: usize| u[3 * n + i] + du[3 * n + i];
+                    [c[0] + d(0), c[1] + d(1), c[2] + d(2)]
+                },
+                &mut self.cands,
+            );
+            return;
+        }
         super::detect::detect_except(
             &self.model.contacts,
             |n| {

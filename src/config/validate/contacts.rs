@@ -196,7 +196,7 @@ pub(super) fn contacts(
             ));
         }
         if mesh.dim == 3 {
-            let (sides, radius, short) = super::solid_contacts::sides(mesh, &field, c, explicit)?;
+            let (sides, radius, short) = super::solid_contacts::sides(mesh, &field, c)?;
             shortest = shortest.min(short);
             pairs.push(ContactPair {
                 name: name.clone(),

@@ -13,15 +13,7 @@ pub(super) fn sides(
     mesh: &Mesh,
     field: &str,
     c: &ContactSpec,
-    explicit: bool,
 ) -> Result<(Vec<ContactSide>, f64, f64)> {
-    if explicit {
-        return Err(Error::config(
-            field,
-            "the explicit kinematic contact runs in the plane only; a solid's contact \
-             belongs to the implicit schemes (analysis.scheme = \"backward_euler\")",
-        ));
-    }
     if c.formulation == Some(Formulation::Mortar) {
         return Err(Error::config(
             format!("{field}.formulation"),
