@@ -745,3 +745,87 @@ rigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }
         "{e}"
     );
 }
+
+/// A light block (ρ = 1) thrown at 2e5 m/s onto a steel target or a rigid plane:
+/// at h = 1 µs it travels 0.2 m a step, four times the gap and three times the search
+/// radius (an element) beyond it.
+fn tunnelling(rigid: bool) -> String {
+    let (target, master) = if rigid {
+        (
+            String::new(),
+            "rigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }",
+        )
+    } else {
+        (
+            "[[bodies]]\nname = \"target\"\nmaterial = \"steel\"\n\
+             mesh = { kind = \"box\", origin = [-0.2, -0.2, -0.2], size = [0.4, 0.2, 0.4], divisions = [8, 4, 8] }\n\
+             [[supports]]\nset = \"target.bottom\"\nfix = [\"x\", \"y\", \"z\"]\n"
+                .to_string(),
+            "master = \"target.top\"",
+        )
+    };
+    format!(
+        r#"
+[analysis]
+t_end = 2.0e-5
+dt = 1.0e-6
+vtk_every = 0
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[materials.light]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 1.0
+[[bodies]]
+name = "striker"
+material = "light"
+velocity = [0.0, -2.0e5, 0.0]
+mesh = {{ kind = "box", origin = [-0.05, 0.05, -0.05], size = [0.1, 0.1, 0.1], divisions = [2, 2, 2] }}
+{target}
+[[contact]]
+name = "hit"
+slave = "striker.bottom"
+{master}
+"#
+    )
+}
+
+#[test]
+fn a_solid_crossing_a_face_or_a_plane_within_one_step_is_caught() {
+    for rigid in [true, false] {
+        let m = model(&tunnelling(rigid));
+        let striker: Vec<usize> = m.contacts[0].sides[0].slaves.clone();
+        let top: Vec<usize> = (0..m.mesh.n_nodes())
+            .filter(|&n| m.mesh.node_body[n] == 1 && m.mesh.coords[n][1] == 0.0)
+            .collect();
+        let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let mut touched = false;
+        march(&mut be, &mut s, StepControl::of(&m), |_, s, marched| {
+            if let Marched::Cut { .. } = marched {
+                return Ok(());
+            }
+            let y = |n: usize| m.mesh.coords[n][1] + s.u[3 * n + 1];
+            let lowest = striker.iter().map(|&n| y(n)).fold(f64::INFINITY, f64::min);
+            let floor = if rigid {
+                0.0
+            } else {
+                top.iter().map(|&n| y(n)).fold(f64::INFINITY, f64::min)
+            } - 1e-3;
+            assert!(
+                lowest >= floor,
+                "rigid {rigid}, t = {}: a slave at y = {lowest}: it passed through",
+                s.t
+            );
+            assert!(s.contact.pairs[0].penetration <= m.analysis.contact.tolerance);
+            touched |= s.contact.pairs[0].force > 0.0;
+            Ok(())
+        })
+        .unwrap();
+        assert!(touched, "rigid {rigid}: the striker was stopped by contact");
+    }
+}

@@ -363,11 +363,17 @@ impl<'m> ContactCorrection<'m> {
         }
         let x = &self.x;
         if dim == 3 {
-            super::faces::detect(
-                self.pairs,
-                |n| [x[3 * n], x[3 * n + 1], x[3 * n + 2]],
-                &mut self.cands,
-            );
+            let at = |n: usize| [x[3 * n], x[3 * n + 1], x[3 * n + 2]];
+            super::faces::detect(self.pairs, at, &mut self.cands);
+            if !self.x0.is_empty() {
+                let x0 = &self.x0;
+                super::faces::crossed(
+                    self.pairs,
+                    |n| [x0[3 * n], x0[3 * n + 1], x0[3 * n + 2]],
+                    at,
+                    &mut self.cands,
+                );
+            }
             self.stats.detect_s += t.elapsed().as_secs_f64();
             return;
         }
