@@ -77,6 +77,40 @@ pub fn corners(face: &[usize; 4]) -> &[usize] {
     }
 }
 
+/// The box of `points` grown by `pad` on every side.
+pub(super) fn bounding_box(points: impl Iterator<Item = V3>, pad: f64) -> AABB<V3> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in points {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i] - pad);
+            hi[i] = hi[i].max(p[i] + pad);
+        }
+    }
+    AABB::from_corners(lo, hi)
+}
+
+/// An R-tree of the faces, each by the box of the points `at(node)` yields for its
+/// corners (one geometry, or the start and end of a step), grown by `pad`.
+pub(super) type FaceTree = RTree<GeomWithData<Rectangle<V3>, usize>>;
+
+/// See [`FaceTree`].
+pub(super) fn face_tree<I: Iterator<Item = V3>>(
+    faces: &[[usize; 4]],
+    at: impl Fn(usize) -> I,
+    pad: f64,
+) -> FaceTree {
+    RTree::bulk_load(
+        faces
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let b = bounding_box(corners(f).iter().flat_map(|&n| at(n)), pad);
+                GeomWithData::new(Rectangle::from_aabb(b), k)
+            })
+            .collect(),
+    )
+}
+
 /// Where on a face its closest point to a slave lies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Region {
@@ -440,23 +474,7 @@ fn faces_side<X: Fn(usize) -> V3>(
     out: &mut Vec<Candidate>,
 ) {
     let surface = Surface::new(faces, x);
-    let tree = RTree::bulk_load(
-        faces
-            .iter()
-            .enumerate()
-            .map(|(k, f)| {
-                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-                for &v in corners(f) {
-                    let p = x(v);
-                    for i in 0..3 {
-                        lo[i] = lo[i].min(p[i]);
-                        hi[i] = hi[i].max(p[i]);
-                    }
-                }
-                GeomWithData::new(Rectangle::from_corners(lo, hi), k)
-            })
-            .collect(),
-    );
+    let tree = face_tree(faces, |n| std::iter::once(x(n)), 0.0);
     let mut near: Vec<(usize, Projection)> = Vec::new();
     for &s in slaves {
         let p = x(s);
@@ -596,29 +614,10 @@ where
                         continue;
                     }
                     let surface = Surface::new(faces, &x1);
-                    let boxed = |points: &mut dyn Iterator<Item = V3>| {
-                        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-                        for p in points {
-                            for i in 0..3 {
-                                lo[i] = lo[i].min(p[i]);
-                                hi[i] = hi[i].max(p[i]);
-                            }
-                        }
-                        AABB::from_corners(lo, hi)
-                    };
-                    let tree = RTree::bulk_load(
-                        faces
-                            .iter()
-                            .enumerate()
-                            .map(|(k, f)| {
-                                let b = boxed(&mut corners(f).iter().flat_map(|&n| [x0(n), x1(n)]));
-                                GeomWithData::new(Rectangle::from_aabb(b), k)
-                            })
-                            .collect(),
-                    );
+                    let tree = face_tree(faces, |n| [x0(n), x1(n)].into_iter(), 0.0);
                     for s in movers {
                         let (p0, p1) = (x0(s), x1(s));
-                        let reach = boxed(&mut [p0, p1].into_iter());
+                        let reach = bounding_box([p0, p1].into_iter(), 0.0);
                         let mut first: Option<(f64, usize)> = None;
                         for hit in tree.locate_in_envelope_intersecting(reach) {
                             let f = &faces[hit.data];

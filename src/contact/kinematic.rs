@@ -403,27 +403,8 @@ impl<'m> KinematicContact<'m> {
                 match &side.master {
                     Master::Faces(faces) => {
                         let r = pair.radius;
-                        let tree = rstar::RTree::bulk_load(
-                            faces
-                                .iter()
-                                .enumerate()
-                                .map(|(k, f)| {
-                                    let (mut lo, mut hi) =
-                                        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-                                    for &n in super::faces::corners(f) {
-                                        let p = at(n);
-                                        for i in 0..3 {
-                                            lo[i] = lo[i].min(p[i] - r);
-                                            hi[i] = hi[i].max(p[i] + r);
-                                        }
-                                    }
-                                    GeomWithData::new(
-                                        rstar::primitives::Rectangle::from_corners(lo, hi),
-                                        k,
-                                    )
-                                })
-                                .collect(),
-                        );
+                        // Reach: the faces' boxes grown by the pair's radius.
+                        let tree = super::faces::face_tree(faces, |n| std::iter::once(at(n)), r);
                         for &s in &side.slaves {
                             let p = at(s);
                             let mut best: Option<SolidHit> = None;
