@@ -44,13 +44,13 @@ pub const NEAR_EDGE: f64 = 1e-3;
 /// nearly equal rows, which make the condensed matrix singular.
 pub const VALLEY_SINE: f64 = 1e-2;
 
-type V3 = [f64; 3];
+pub(super) type V3 = [f64; 3];
 
-fn sub(a: V3, b: V3) -> V3 {
+pub(super) fn sub(a: V3, b: V3) -> V3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn dot(a: V3, b: V3) -> f64 {
+pub(super) fn dot(a: V3, b: V3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
@@ -317,13 +317,13 @@ pub fn project<X: Fn(usize) -> V3>(p: V3, face: &[usize; 4], x: &X) -> Option<Pr
 
 /// The faces' unit normals at their centres and the nodal normals of the surface:
 /// at each node the normalised sum of the unit normals of the faces meeting there.
-struct Surface {
+pub(super) struct Surface {
     normal: Vec<V3>,
     at_node: HashMap<usize, V3>,
 }
 
 impl Surface {
-    fn new<X: Fn(usize) -> V3>(faces: &[[usize; 4]], x: &X) -> Surface {
+    pub(super) fn new<X: Fn(usize) -> V3>(faces: &[[usize; 4]], x: &X) -> Surface {
         let mut normal = Vec::with_capacity(faces.len());
         let mut at_node: HashMap<usize, V3> = HashMap::with_capacity(faces.len());
         for f in faces {
@@ -356,7 +356,7 @@ impl Surface {
     /// faces' own from one iteration to the next; on a flat surface it is the
     /// surface's normal. Over a convex ridge or corner it is the ridge's or corner's
     /// mean normal.
-    fn normal(&self, face: &[usize; 4], pr: &Projection) -> V3 {
+    pub(super) fn normal(&self, face: &[usize; 4], pr: &Projection) -> V3 {
         let mut n = [0.0; 3];
         for (k, &v) in corners(face).iter().enumerate() {
             if let Some(m) = self.at_node.get(&v) {
@@ -389,7 +389,7 @@ pub fn plane_tangents(n: V3) -> [V3; 2] {
 
 /// The row of slave `key.2` against master face `index` at its projection `pr`,
 /// along `normal`.
-fn face_candidate<X: Fn(usize) -> V3>(
+pub(super) fn face_candidate<X: Fn(usize) -> V3>(
     key: (usize, usize, usize),
     index: usize,
     face: &[usize; 4],
@@ -568,132 +568,6 @@ fn faces_side<X: Fn(usize) -> V3>(
                 }
             }
         }
-    }
-}
-
-/// Slaves whose motion over the step, from the geometry `x0(node)` to `x1(node)`,
-/// carries them through a master face or rigid plane the search at `x1` does not
-/// reach (they moved farther relative to it than the pair's radius), appended to
-/// `out` as candidates at `x1` (behind the master), as the plane's
-/// [`super::sweep::crossed`]: a face is swept with the node-triangle collision
-/// cubic ([`super::collision::node_triangle`], the motion over the step taken as
-/// linear, a quadrilateral as its two triangles), a plane by the gap changing sign.
-/// Slaves that already have a candidate are skipped. `out` stays ordered by pair,
-/// side and slave.
-pub fn crossed<X0, X1>(pairs: &[ContactPair], x0: X0, x1: X1, out: &mut Vec<Candidate>)
-where
-    X0: Fn(usize) -> V3,
-    X1: Fn(usize) -> V3,
-{
-    let before = out.len();
-    let known = |out: &[Candidate], key: (usize, usize, usize)| {
-        out[..before]
-            .binary_search_by_key(&key, Candidate::slave_key)
-            .is_ok()
-    };
-    let dist = |a: V3, b: V3| dot(sub(a, b), sub(a, b)).sqrt();
-    for (pi, pair) in pairs.iter().enumerate() {
-        for (si, side) in pair.sides.iter().enumerate() {
-            match &side.master {
-                Master::Faces(faces) => {
-                    let master_travel = faces
-                        .iter()
-                        .flat_map(|f| corners(f).iter())
-                        .map(|&n| dist(x0(n), x1(n)))
-                        .fold(0.0, f64::max);
-                    let movers: Vec<usize> = side
-                        .slaves
-                        .iter()
-                        .copied()
-                        .filter(|&s| {
-                            dist(x0(s), x1(s)) + master_travel > 0.5 * pair.radius
-                                && !known(out, (pi, si, s))
-                        })
-                        .collect();
-                    if movers.is_empty() {
-                        continue;
-                    }
-                    let surface = Surface::new(faces, &x1);
-                    let tree = face_tree(faces, |n| [x0(n), x1(n)].into_iter(), 0.0);
-                    for s in movers {
-                        let (p0, p1) = (x0(s), x1(s));
-                        let reach = bounding_box([p0, p1].into_iter(), 0.0);
-                        let mut first: Option<(f64, usize)> = None;
-                        for hit in tree.locate_in_envelope_intersecting(reach) {
-                            let f = &faces[hit.data];
-                            let c = corners(f);
-                            if c.contains(&s) {
-                                continue;
-                            }
-                            let triangles: &[[usize; 3]] = if c.len() == 3 {
-                                &[[0, 1, 2]]
-                            } else {
-                                &[[0, 1, 2], [0, 2, 3]]
-                            };
-                            let motion = |n: usize| (x0(n), sub(x1(n), x0(n)));
-                            for tri in triangles {
-                                let [(a, va), (b, vb), (cc, vc)] = tri.map(|i| motion(c[i]));
-                                let t = super::collision::node_triangle(
-                                    p0,
-                                    sub(p1, p0),
-                                    a,
-                                    va,
-                                    b,
-                                    vb,
-                                    cc,
-                                    vc,
-                                    1.0,
-                                );
-                                if let Some(t) = t {
-                                    if first.is_none_or(|(t0, _)| t.t < t0) {
-                                        first = Some((t.t, hit.data));
-                                    }
-                                }
-                            }
-                        }
-                        if let Some((_, k)) = first {
-                            if let Some(pr) = project(p1, &faces[k], &x1) {
-                                let normal = surface.normal(&faces[k], &pr);
-                                out.push(face_candidate(
-                                    (pi, si, s),
-                                    k,
-                                    &faces[k],
-                                    &pr,
-                                    normal,
-                                    &x1,
-                                ));
-                            }
-                        }
-                    }
-                }
-                Master::Plane { point, n, tangents } => {
-                    for &s in &side.slaves {
-                        let (g0, g1) = (dot(sub(x0(s), *point), *n), dot(sub(x1(s), *point), *n));
-                        if g0 >= 0.0 && g1 < 0.0 && !known(out, (pi, si, s)) {
-                            let mut weights = Weights::EMPTY;
-                            weights.add(s, 1.0);
-                            out.push(Candidate {
-                                pair: pi,
-                                side: si,
-                                slave: s,
-                                master: Contactee::Rigid,
-                                xi: 0.0,
-                                gap: g1,
-                                normal: *n,
-                                tangents: *tangents,
-                                dim: 3,
-                                weights,
-                                length: 0.0,
-                            });
-                        }
-                    }
-                }
-                Master::Segments(_) | Master::Rigid { .. } => {}
-            }
-        }
-    }
-    if out.len() > before {
-        out.sort_by_key(Candidate::slave_key);
     }
 }
 

@@ -1,12 +1,16 @@
 //! The sweep of a step for crossings (implicit path): slaves whose motion over the
 //! step carries them through a master farther than the radius search of
-//! [`super::detect`] reaches (theory/contact.md, "Nothing crosses unseen").
+//! [`super::detect`] (or [`super::faces`] in a solid) reaches (theory/contact.md,
+//! "Nothing crosses unseen"; theory/contact3d.md).
 
 use rstar::primitives::GeomWithData;
 use rstar::{RTree, RTreeObject};
 
 use super::detect::{closest, segment_candidate, within_ends, Chain, RigidHistory};
-use super::rows::{Candidate, Contactee};
+use super::faces::{
+    bounding_box, corners, dot, face_candidate, face_tree, project, sub, Surface, V3,
+};
+use super::rows::{Candidate, Contactee, Weights};
 use crate::model::{ContactPair, Master};
 
 /// Slaves whose motion over the step, from the geometry `x0(node)` to `x1(node)`,
@@ -156,4 +160,130 @@ fn swept_box(points: &[[f64; 2]]) -> rstar::primitives::Rectangle<[f64; 2]> {
         }
     }
     rstar::primitives::Rectangle::from_corners(lo, hi)
+}
+
+/// Slaves whose motion over the step, from the geometry `x0(node)` to `x1(node)`,
+/// carries them through a master face or rigid plane the search at `x1` does not
+/// reach (they moved farther relative to it than the pair's radius), appended to
+/// `out` as candidates at `x1` (behind the master), as [`crossed`] in the plane: a
+/// face is swept with the node-triangle collision cubic
+/// ([`super::collision::node_triangle`], the motion over the step taken as linear, a
+/// quadrilateral as its two triangles), a plane by the gap changing sign.
+/// Slaves that already have a candidate are skipped. `out` stays ordered by pair,
+/// side and slave.
+pub fn crossed_faces<X0, X1>(pairs: &[ContactPair], x0: X0, x1: X1, out: &mut Vec<Candidate>)
+where
+    X0: Fn(usize) -> V3,
+    X1: Fn(usize) -> V3,
+{
+    let before = out.len();
+    let known = |out: &[Candidate], key: (usize, usize, usize)| {
+        out[..before]
+            .binary_search_by_key(&key, Candidate::slave_key)
+            .is_ok()
+    };
+    let dist = |a: V3, b: V3| dot(sub(a, b), sub(a, b)).sqrt();
+    for (pi, pair) in pairs.iter().enumerate() {
+        for (si, side) in pair.sides.iter().enumerate() {
+            match &side.master {
+                Master::Faces(faces) => {
+                    let master_travel = faces
+                        .iter()
+                        .flat_map(|f| corners(f).iter())
+                        .map(|&n| dist(x0(n), x1(n)))
+                        .fold(0.0, f64::max);
+                    let movers: Vec<usize> = side
+                        .slaves
+                        .iter()
+                        .copied()
+                        .filter(|&s| {
+                            dist(x0(s), x1(s)) + master_travel > 0.5 * pair.radius
+                                && !known(out, (pi, si, s))
+                        })
+                        .collect();
+                    if movers.is_empty() {
+                        continue;
+                    }
+                    let surface = Surface::new(faces, &x1);
+                    let tree = face_tree(faces, |n| [x0(n), x1(n)].into_iter(), 0.0);
+                    for s in movers {
+                        let (p0, p1) = (x0(s), x1(s));
+                        let reach = bounding_box([p0, p1].into_iter(), 0.0);
+                        let mut first: Option<(f64, usize)> = None;
+                        for hit in tree.locate_in_envelope_intersecting(reach) {
+                            let f = &faces[hit.data];
+                            let c = corners(f);
+                            if c.contains(&s) {
+                                continue;
+                            }
+                            let triangles: &[[usize; 3]] = if c.len() == 3 {
+                                &[[0, 1, 2]]
+                            } else {
+                                &[[0, 1, 2], [0, 2, 3]]
+                            };
+                            let motion = |n: usize| (x0(n), sub(x1(n), x0(n)));
+                            for tri in triangles {
+                                let [(a, va), (b, vb), (cc, vc)] = tri.map(|i| motion(c[i]));
+                                let t = super::collision::node_triangle(
+                                    p0,
+                                    sub(p1, p0),
+                                    a,
+                                    va,
+                                    b,
+                                    vb,
+                                    cc,
+                                    vc,
+                                    1.0,
+                                );
+                                if let Some(t) = t {
+                                    if first.is_none_or(|(t0, _)| t.t < t0) {
+                                        first = Some((t.t, hit.data));
+                                    }
+                                }
+                            }
+                        }
+                        if let Some((_, k)) = first {
+                            if let Some(pr) = project(p1, &faces[k], &x1) {
+                                let normal = surface.normal(&faces[k], &pr);
+                                out.push(face_candidate(
+                                    (pi, si, s),
+                                    k,
+                                    &faces[k],
+                                    &pr,
+                                    normal,
+                                    &x1,
+                                ));
+                            }
+                        }
+                    }
+                }
+                Master::Plane { point, n, tangents } => {
+                    for &s in &side.slaves {
+                        let (g0, g1) = (dot(sub(x0(s), *point), *n), dot(sub(x1(s), *point), *n));
+                        if g0 >= 0.0 && g1 < 0.0 && !known(out, (pi, si, s)) {
+                            let mut weights = Weights::EMPTY;
+                            weights.add(s, 1.0);
+                            out.push(Candidate {
+                                pair: pi,
+                                side: si,
+                                slave: s,
+                                master: Contactee::Rigid,
+                                xi: 0.0,
+                                gap: g1,
+                                normal: *n,
+                                tangents: *tangents,
+                                dim: 3,
+                                weights,
+                                length: 0.0,
+                            });
+                        }
+                    }
+                }
+                Master::Segments(_) | Master::Rigid { .. } => {}
+            }
+        }
+    }
+    if out.len() > before {
+        out.sort_by_key(Candidate::slave_key);
+    }
 }

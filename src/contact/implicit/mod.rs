@@ -367,7 +367,7 @@ impl<'m> ContactCorrection<'m> {
             super::faces::detect(self.pairs, at, &mut self.cands);
             if !self.x0.is_empty() {
                 let x0 = &self.x0;
-                super::faces::crossed(
+                super::sweep::crossed_faces(
                     self.pairs,
                     |n| [x0[3 * n], x0[3 * n + 1], x0[3 * n + 2]],
                     at,
