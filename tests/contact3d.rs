@@ -429,7 +429,7 @@ fn the_solid_patch_test_transmits_the_load_and_reports_the_pressure_error() {
     let (f, worst) = patch_pressure([5, 3], [4, 4]);
     eprintln!("non-matching (slave 5x3 on master 4x4): force {f:.9e} N, pressure error {worst:.3}");
     assert!((f - load).abs() < 1e-8 * load, "{f}");
-    assert!(worst < 0.5, "pressure error {worst}");
+    assert!(worst < 0.25, "pressure error {worst}");
 }
 
 /// The grid of a graded axis: `n0` equal cells of `h0` from 0, then cells growing
@@ -672,47 +672,35 @@ fn a_solid_contact_pair_is_validated() {
         assert!(text.contains(from), "{from}");
         text.replace(from, to)
     };
-    let e = refusal(&with("master = \"base.top\"", "master = \"base.nope\""));
-    assert!(
-        e.contains("contact[0].master") && e.contains("unknown face set"),
-        "{e}"
-    );
-    let e = refusal(&with(
-        "master = \"base.top\"",
-        "rigid_plane = { point = [0.0, 0.0], normal = [0.0, 1.0, 0.0] }",
-    ));
-    assert!(
-        e.contains("contact[0].rigid_plane.point") && e.contains("expected 3"),
-        "{e}"
-    );
-    let e = refusal(&with(
-        "master = \"base.top\"",
-        "rigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 0.0, 0.0] }",
-    ));
-    assert!(e.contains("contact[0].rigid_plane.normal"), "{e}");
-    let e = refusal(&with(
-        "master = \"base.top\"",
-        "master = \"base.top\"\nrigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }",
-    ));
-    assert!(e.contains("exactly one"), "{e}");
-    let e = refusal(&with(
-        "master = \"base.top\"",
-        "rigid_line = [[0.0, 0.0], [1.0, 0.0]]",
-    ));
-    assert!(
-        e.contains("contact[0].rigid_line") && e.contains("rigid_plane"),
-        "{e}"
-    );
-    let e = refusal(&with(
-        "master = \"base.top\"",
-        "master = \"base.top\"\nformulation = \"mortar\"",
-    ));
-    assert!(
-        e.contains("contact[0].formulation") && e.contains("node to face"),
-        "{e}"
-    );
-    let e = refusal(&with("master = \"base.top\"", "master = \"block.top\""));
-    assert!(e.contains("self-contact"), "{e}");
+    let master = "master = \"base.top\"";
+    let plane = "rigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }";
+    for (to, words) in [
+        (
+            "master = \"base.nope\"".to_string(),
+            &["contact[0].master", "unknown face set"][..],
+        ),
+        (
+            plane.replace("point = [0.0, 0.0, 0.0]", "point = [0.0, 0.0]"),
+            &["contact[0].rigid_plane.point", "expected 3"],
+        ),
+        (
+            plane.replace("normal = [0.0, 1.0, 0.0]", "normal = [0.0, 0.0, 0.0]"),
+            &["contact[0].rigid_plane.normal"],
+        ),
+        (format!("{master}\n{plane}"), &["exactly one"]),
+        (
+            "rigid_line = [[0.0, 0.0], [1.0, 0.0]]".to_string(),
+            &["contact[0].rigid_line", "rigid_plane"],
+        ),
+        (
+            format!("{master}\nformulation = \"mortar\""),
+            &["contact[0].formulation", "node to face"],
+        ),
+        ("master = \"block.top\"".to_string(), &["self-contact"]),
+    ] {
+        let e = refusal(&with(master, &to));
+        assert!(words.iter().all(|w| e.contains(w)), "{to}: {e}");
+    }
     // Overlapping at the start: the block sunk 5 mm into the base.
     let e = refusal(&with(
         "origin = [0.15, 0.3011, 0.1]",

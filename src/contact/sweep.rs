@@ -13,6 +13,32 @@ use super::faces::{
 use super::rows::{Candidate, Contactee, Weights};
 use crate::model::{ContactPair, Master};
 
+/// Whether slave `key` has a candidate among `found` (ordered by slave key: a binary
+/// search, no set built on this per-iteration path).
+fn known(found: &[Candidate], key: (usize, usize, usize)) -> bool {
+    found
+        .binary_search_by_key(&key, Candidate::slave_key)
+        .is_ok()
+}
+
+/// The slaves that moved, relative to their master (its nodes `master`), more than
+/// half the pair's `radius` over the step (`travel(node)`: how far a node moved),
+/// and are not `known` yet: those the radius search may have missed.
+fn movers(
+    slaves: &[usize],
+    master: impl Iterator<Item = usize>,
+    radius: f64,
+    travel: impl Fn(usize) -> f64,
+    known: impl Fn(usize) -> bool,
+) -> Vec<usize> {
+    let master_travel = master.map(&travel).fold(0.0, f64::max);
+    slaves
+        .iter()
+        .copied()
+        .filter(|&s| travel(s) + master_travel > 0.5 * radius && !known(s))
+        .collect()
+}
+
 /// Slaves whose motion over the step, from the geometry `x0(node)` to `x1(node)`,
 /// crosses a master the search at `x1` does not reach (the slave and the master moved
 /// farther relative to each other than the pair's radius, as at very high speed),
@@ -34,32 +60,18 @@ pub fn crossed<X0, X1>(
     X1: Fn(usize) -> [f64; 2],
 {
     let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
-    // `out` is ordered by slave key: a binary search tells a known slave (and no
-    // set is built on this per-iteration path).
     let before = out.len();
-    let known = |out: &[Candidate], key: (usize, usize, usize)| {
-        out[..before]
-            .binary_search_by_key(&key, Candidate::slave_key)
-            .is_ok()
-    };
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
             match &side.master {
                 Master::Segments(segments) => {
-                    let master_travel = segments
-                        .iter()
-                        .flatten()
-                        .map(|&n| dist(x0(n), x1(n)))
-                        .fold(0.0, f64::max);
-                    let movers: Vec<usize> = side
-                        .slaves
-                        .iter()
-                        .copied()
-                        .filter(|&s| {
-                            dist(x0(s), x1(s)) + master_travel > 0.5 * pair.radius
-                                && !known(out, (pi, si, s))
-                        })
-                        .collect();
+                    let movers = movers(
+                        &side.slaves,
+                        segments.iter().flatten().copied(),
+                        pair.radius,
+                        |n| dist(x0(n), x1(n)),
+                        |s| known(&out[..before], (pi, si, s)),
+                    );
                     if movers.is_empty() {
                         continue;
                     }
@@ -121,7 +133,7 @@ pub fn crossed<X0, X1>(
                         // Moving into the line and behind it at the end (a slave resting
                         // on it starts at a gap of round-off, of either sign).
                         if !(g1 < 0.0 && g1 < g0)
-                            || known(out, (pi, si, s))
+                            || known(&out[..before], (pi, si, s))
                             || rigid.beneath.binary_search(&(pi, si, s)).is_ok()
                         {
                             continue;
@@ -177,30 +189,18 @@ where
     X1: Fn(usize) -> V3,
 {
     let before = out.len();
-    let known = |out: &[Candidate], key: (usize, usize, usize)| {
-        out[..before]
-            .binary_search_by_key(&key, Candidate::slave_key)
-            .is_ok()
-    };
     let dist = |a: V3, b: V3| dot(sub(a, b), sub(a, b)).sqrt();
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
             match &side.master {
                 Master::Faces(faces) => {
-                    let master_travel = faces
-                        .iter()
-                        .flat_map(|f| corners(f).iter())
-                        .map(|&n| dist(x0(n), x1(n)))
-                        .fold(0.0, f64::max);
-                    let movers: Vec<usize> = side
-                        .slaves
-                        .iter()
-                        .copied()
-                        .filter(|&s| {
-                            dist(x0(s), x1(s)) + master_travel > 0.5 * pair.radius
-                                && !known(out, (pi, si, s))
-                        })
-                        .collect();
+                    let movers = movers(
+                        &side.slaves,
+                        faces.iter().flat_map(|f| corners(f).iter().copied()),
+                        pair.radius,
+                        |n| dist(x0(n), x1(n)),
+                        |s| known(&out[..before], (pi, si, s)),
+                    );
                     if movers.is_empty() {
                         continue;
                     }
@@ -260,7 +260,7 @@ where
                 Master::Plane { point, n, tangents } => {
                     for &s in &side.slaves {
                         let (g0, g1) = (dot(sub(x0(s), *point), *n), dot(sub(x1(s), *point), *n));
-                        if g0 >= 0.0 && g1 < 0.0 && !known(out, (pi, si, s)) {
+                        if g0 >= 0.0 && g1 < 0.0 && !known(&out[..before], (pi, si, s)) {
                             let mut weights = Weights::EMPTY;
                             weights.add(s, 1.0);
                             out.push(Candidate {

@@ -423,11 +423,6 @@ impl<'m> ContactCorrection<'m> {
     /// The relative tangential displacement of a row since the start of the step at
     /// displacements `u`: `t_j · Σ w_k (u_k − u0_k)` along each tangent.
     fn slip(&self, c: &Candidate, u: &[f64]) -> [f64; 2] {
-        if self.dim == 2 {
-            let t = c.tangent();
-            let d = c.combine(|n| [u[2 * n] - self.u0[2 * n], u[2 * n + 1] - self.u0[2 * n + 1]]);
-            return [d[0] * t[0] + d[1] * t[1], 0.0];
-        }
         let dim = self.dim;
         c.tangential(|n, i| u[dim * n + i] - self.u0[dim * n + i])
     }
