@@ -220,6 +220,8 @@ pub struct IterationSettings {
     pub refactor_rate: Option<f64>,
     /// Step cuts allowed (each halves `h`) before a run stops.
     pub max_cuts: usize,
+    /// The smallest step a cut may reach (s); below it the run stops as stalled.
+    pub dt_min: f64,
     /// Fill-reducing ordering for the faer backend.
     pub ordering: Ordering,
 }

@@ -195,7 +195,14 @@ impl NonlocalTable {
         // buckets); points past the last cell fall into it, which keeps the bounds
         // conservative.
         let limit = if mesh.dim == 3 { 1 << 7 } else { 1 << 12 };
-        let n = std::array::from_fn(|d| (((hi[d] - lo[d]) / cell).floor() as usize + 1).min(limit));
+        // Clamped as floats: a radius far below the body's size (1e-20 m) gives a
+        // ratio past `usize`, whose saturated cast would wrap on the `+ 1`.
+        let n = std::array::from_fn(|d| {
+            ((hi[d] - lo[d]) / cell)
+                .floor()
+                .clamp(0.0, (limit - 1) as f64) as usize
+                + 1
+        });
         let bucket = points
             .iter()
             .map(|p| {

@@ -201,9 +201,10 @@ pub struct AnalysisSpec {
     /// takes (the paper's `ω`). Default 0.9.
     #[serde(default)]
     pub omega: Option<f64>,
-    /// `stress` (default: the paper's walls) or `strain`.
+    /// `stress` (default: the paper's walls) or `strain`; `solid` names what a
+    /// three-dimensional mesh is anyway (a plane mesh refuses it).
     #[serde(default)]
-    pub plane: Plane,
+    pub plane: Option<Plane>,
     /// `consistent` (default for the implicit schemes: the paper's Galerkin mass) or
     /// `lumped` (the only one central differences take, and their default).
     #[serde(default)]
@@ -248,6 +249,10 @@ pub struct AnalysisSpec {
     /// which the next iterate refactorises with its tangent. Default 0.1.
     #[serde(default)]
     pub refactor_rate: Option<f64>,
+    /// The smallest step a run may cut to (s): below it the run stops as stalled,
+    /// naming what to try. Default `dt / 2²⁰` (about a millionth of the step).
+    #[serde(default)]
+    pub dt_min: Option<f64>,
     /// Step cuts (each halving `h`) allowed before the run stops. Default 8.
     #[serde(default = "default_max_cuts")]
     pub max_cuts: usize,

@@ -349,6 +349,15 @@ where
                         let Some((_, _, k, xi)) = best else {
                             continue;
                         };
+                        // Past an end of the master's chain the slave's projection has
+                        // left the surface: it is beside the master, not on it, and
+                        // no force holds it (a margin of `RIGID_END_MARGIN` keeps a
+                        // slave exactly at the end from flickering on round-off).
+                        let off_end = (xi < 0.0 && chain.prev[k].is_none())
+                            || (xi > 1.0 && chain.next[k].is_none());
+                        if off_end && !within_ends(xi) {
+                            continue;
+                        }
                         let [a, b] = segments[k];
                         // The vertex near the closest point, and the segment beyond it
                         // when the kink there is concave.

@@ -320,6 +320,10 @@ pub fn project<X: Fn(usize) -> V3>(p: V3, face: &[usize; 4], x: &X) -> Option<Pr
 pub(super) struct Surface {
     normal: Vec<V3>,
     at_node: HashMap<usize, V3>,
+    /// The surface's boundary edges (sorted node pairs used by one face only) and
+    /// their nodes: where the master ends.
+    boundary: std::collections::HashSet<[usize; 2]>,
+    boundary_nodes: std::collections::HashSet<usize>,
 }
 
 impl Surface {
@@ -345,7 +349,62 @@ impl Surface {
         for v in at_node.values_mut() {
             *v = unit(*v).unwrap_or([0.0; 3]);
         }
-        Surface { normal, at_node }
+        let mut uses: HashMap<[usize; 2], u32> = HashMap::with_capacity(2 * faces.len());
+        for f in faces {
+            let c = corners(f);
+            for i in 0..c.len() {
+                let (a, b) = (c[i], c[(i + 1) % c.len()]);
+                *uses.entry([a.min(b), a.max(b)]).or_default() += 1;
+            }
+        }
+        let boundary: std::collections::HashSet<[usize; 2]> = uses
+            .into_iter()
+            .filter(|&(_, n)| n == 1)
+            .map(|(e, _)| e)
+            .collect();
+        let boundary_nodes = boundary.iter().flatten().copied().collect();
+        Surface {
+            normal,
+            at_node,
+            boundary,
+            boundary_nodes,
+        }
+    }
+
+    /// Whether the projection `pr` of `p` on `face` lies on the surface's boundary
+    /// (an edge of one face only, or a corner on one) with `p` beyond it: the slave's
+    /// projection has left the master surface, and no force holds it. The margin, a
+    /// thousandth of the face's longest edge (`detect::RIGID_END_MARGIN`), keeps a
+    /// slave exactly at the edge from flickering on round-off.
+    pub(super) fn beyond_boundary<X: Fn(usize) -> V3>(
+        &self,
+        p: V3,
+        face: &[usize; 4],
+        pr: &Projection,
+        x: &X,
+    ) -> bool {
+        let c = corners(face);
+        let on_edge = match pr.region {
+            Region::Edge(i) => {
+                let (a, b) = (c[i], c[(i + 1) % c.len()]);
+                self.boundary.contains(&[a.min(b), a.max(b)])
+            }
+            Region::Corner(i) => self.boundary_nodes.contains(&c[i]),
+            Region::Interior { .. } => false,
+        };
+        if !on_edge {
+            return false;
+        }
+        let d = sub(p, pr.point);
+        let dn = dot(d, pr.normal);
+        let t2 = (dot(d, d) - dn * dn).max(0.0);
+        let longest = (0..c.len())
+            .map(|i| {
+                let e = sub(x(c[(i + 1) % c.len()]), x(c[i]));
+                dot(e, e)
+            })
+            .fold(0.0, f64::max);
+        t2 > super::detect::RIGID_END_MARGIN.powi(2) * longest
     }
 
     /// The row's normal at a projection on `face`: the nodal normals interpolated
@@ -516,6 +575,9 @@ fn faces_side<X: Fn(usize) -> V3>(
             continue;
         };
         let (k, pr) = best;
+        if surface.beyond_boundary(p, &faces[k], &pr, x) {
+            continue;
+        }
         let key = (pi, si, s);
         // Faces rising beyond the edge or corner the point is at (or near): a
         // valley, each face its own half-space.

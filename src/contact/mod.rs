@@ -22,6 +22,7 @@ pub mod faces;
 pub mod implicit;
 pub mod kinematic;
 pub mod mortar;
+pub mod overlap;
 mod qp;
 pub mod rows;
 pub mod state;

@@ -173,6 +173,14 @@ pub fn mazars(variant: MazarsVariant, d: &ConcreteData) -> Result<MazarsIdentifi
             d.e * eps_c0
         ));
     }
+    if d.f_cm >= d.e * d.eps_c1 {
+        return Err(format!(
+            "f_cm = {:e} must lie below E ε_c1 = {:e}, the elastic stress at the peak \
+             strain: damage can only lower the stress",
+            d.f_cm,
+            d.e * d.eps_c1
+        ));
+    }
     let b_c = 1.0 / d.eps_c1;
     let a_c = (d.f_cm / d.e - eps_c0) / (d.eps_c1 * (b_c * (eps_c0 - d.eps_c1)).exp() - eps_c0);
     let b_c = match variant {

@@ -38,10 +38,13 @@ pub fn parse(bytes: &[u8]) -> std::result::Result<Part, String> {
     if !msh.has_elements {
         return Err("the file has no $Elements section".into());
     }
+    // A file with any volume element is a solid, whatever its types: the solid
+    // reader names the volume types it does not take (a plane reading would blame
+    // the nodes for lying off z = 0).
     if msh
         .element_blocks
         .iter()
-        .any(|b| matches!(b.element_type, 4 | 5))
+        .any(|b| b.entity_dim == 3 || is_volume_type(b.element_type))
     {
         return parse_solid(&msh);
     }
@@ -217,11 +220,20 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
     let (coords, node_tags, tag_to_index) = nodes(msh, true)?;
     let set_names = group_names(msh)?;
     let mut volumes: [(Vec<usize>, Vec<u64>); 2] = Default::default();
-    let mut faces: Vec<(String, [usize; 4])> = Vec::new();
+    let mut faces: Vec<(String, [usize; 4], u64)> = Vec::new();
+    let mut volume_elements: HashMap<Vec<usize>, u64> = HashMap::new();
     let node_sets = walk_elements(msh, &tag_to_index, &set_names, |el| {
         let (tag, ns) = (el.tag, &mut *el.nodes);
         match el.element_type {
             4 | 5 => {
+                let mut key = ns.clone();
+                key.sort_unstable();
+                if let Some(first) = volume_elements.insert(key, tag) {
+                    return Err(format!(
+                        "elements with Gmsh tags {first} and {tag} have the same nodes \
+                         (an element listed twice would count its stiffness and mass twice)"
+                    ));
+                }
                 let (kind, slot) = if ns.len() == 4 {
                     (ElementKind::Tet4, 0)
                 } else {
@@ -244,7 +256,7 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
                 let mut f = [usize::MAX; 4];
                 f[..ns.len()].copy_from_slice(ns);
                 for g in el.groups {
-                    faces.push((g.clone(), f));
+                    faces.push((g.clone(), f, tag));
                 }
             }
             1 | 15 => {}
@@ -272,7 +284,21 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
             });
         }
     }
-    let face_sets = oriented_faces(&blocks, &coords, faces);
+    if blocks.is_empty() {
+        return Err(
+            "the file has no volume elements (4-node tetrahedra or 8-node \
+                    hexahedra)"
+                .into(),
+        );
+    }
+    let mut face_sets = oriented_faces(&blocks, &coords, faces)?;
+    // A named surface group without elements is an empty face set (said so where it
+    // is used), not an unknown name.
+    for (dim, _, name) in &msh.physical_names {
+        if *dim == 2 {
+            face_sets.entry(name.clone()).or_default();
+        }
+    }
     Ok(Part {
         dim: 3,
         coords,
@@ -285,49 +311,68 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
 }
 
 /// The face sets with every face turned to point away from the volume element it
-/// bounds (a face of no element keeps the file's order).
+/// lies on: the element one of whose faces holds all its corners (a triangle on a
+/// hexahedron's quadrilateral face included). A face on no element's boundary is
+/// refused with its tag: its outward side would be a guess, and contact reads the
+/// normal from it.
 fn oriented_faces(
     blocks: &[Elements],
     coords: &[[f64; 3]],
-    faces: Vec<(String, [usize; 4])>,
-) -> BTreeMap<String, Vec<[usize; 4]>> {
+    faces: Vec<(String, [usize; 4], u64)>,
+) -> std::result::Result<BTreeMap<String, Vec<[usize; 4]>>, String> {
     use crate::mesh::{cross, sub};
-    // The element (block, index) holding each sorted face.
-    let mut owner: HashMap<Vec<usize>, (usize, usize)> = HashMap::new();
+    // The elements (block, index) at each node.
+    let mut at_node: HashMap<usize, Vec<(usize, usize)>> = HashMap::new();
     for (bi, b) in blocks.iter().enumerate() {
         for e in 0..b.len() {
-            let el = b.element(e);
-            for f in b.kind.faces() {
-                let mut key: Vec<usize> = f.iter().map(|&a| el[a]).collect();
-                key.sort_unstable();
-                owner.insert(key, (bi, e));
+            for &k in b.element(e) {
+                at_node.entry(k).or_default().push((bi, e));
             }
         }
     }
+    let lies_on = |corners: &[usize], bi: usize, e: usize| {
+        let el = blocks[bi].element(e);
+        blocks[bi]
+            .kind
+            .faces()
+            .iter()
+            .any(|f| corners.iter().all(|c| f.iter().any(|&a| el[a] == *c)))
+    };
     let mut out: BTreeMap<String, Vec<[usize; 4]>> = BTreeMap::new();
-    for (name, mut f) in faces {
+    for (name, mut f, tag) in faces {
         let n = if f[3] == usize::MAX { 3 } else { 4 };
-        let mut key = f[..n].to_vec();
-        key.sort_unstable();
-        if let Some(&(bi, e)) = owner.get(&key) {
-            let el = blocks[bi].element(e);
-            let centre = el.iter().fold([0.0; 3], |c, &k| {
-                let x = coords[k];
-                [c[0] + x[0], c[1] + x[1], c[2] + x[2]]
-            });
-            let centre = centre.map(|c| c / el.len() as f64);
-            let normal = cross(
-                sub(coords[f[1]], coords[f[0]]),
-                sub(coords[f[2]], coords[f[0]]),
-            );
-            let out_dir = sub(coords[f[0]], centre);
-            if normal[0] * out_dir[0] + normal[1] * out_dir[1] + normal[2] * out_dir[2] < 0.0 {
-                f[1..n].reverse();
-            }
+        let owner = at_node
+            .get(&f[0])
+            .and_then(|els| els.iter().find(|&&(bi, e)| lies_on(&f[..n], bi, e)));
+        let Some(&(bi, e)) = owner else {
+            return Err(format!(
+                "surface element with Gmsh tag {tag} (group `{name}`) does not lie on a \
+                 face of any volume element, so its outward side is unknown: mesh the \
+                 surface on the volume's boundary"
+            ));
+        };
+        let el = blocks[bi].element(e);
+        let centre = el.iter().fold([0.0; 3], |c, &k| {
+            let x = coords[k];
+            [c[0] + x[0], c[1] + x[1], c[2] + x[2]]
+        });
+        let centre = centre.map(|c| c / el.len() as f64);
+        let normal = cross(
+            sub(coords[f[1]], coords[f[0]]),
+            sub(coords[f[2]], coords[f[0]]),
+        );
+        let out_dir = sub(coords[f[0]], centre);
+        if normal[0] * out_dir[0] + normal[1] * out_dir[1] + normal[2] * out_dir[2] < 0.0 {
+            f[1..n].reverse();
         }
         out.entry(name).or_default().push(f);
     }
-    out
+    Ok(out)
+}
+
+/// Whether a Gmsh element type is a volume element (of any order).
+fn is_volume_type(t: i32) -> bool {
+    matches!(t, 4..=7 | 11..=14 | 17..=19 | 29..=31 | 92 | 93)
 }
 
 /// Orients every edge of the edge sets with its element on the left (the element's
@@ -421,8 +466,16 @@ fn type_name(t: i32) -> &'static str {
         8 => "3-node line",
         9 => "6-node triangle",
         10 => "9-node quadrilateral",
+        11 => "10-node tetrahedron",
+        12 => "27-node hexahedron",
+        13 => "18-node prism",
+        14 => "14-node pyramid",
         16 => "8-node quadrilateral",
-        _ => "a higher-order or 3D element",
+        17 => "20-node hexahedron",
+        18 => "15-node prism",
+        19 => "13-node pyramid",
+        t if is_volume_type(t) => "a higher-order volume element",
+        _ => "a higher-order element",
     }
 }
 

@@ -476,6 +476,19 @@ impl Mesh {
         polygon_area(&x).abs()
     }
 
+    /// The crack-band size of element `e` of `block`: the square root of its area in
+    /// the plane, the cube root of its volume in a solid. The element loop measures
+    /// the same (`assembly::internal`, from its points' `Σ w det J`), and validation
+    /// checks the crack-band limit with this one, so the two cannot disagree.
+    pub fn crack_band_length(&self, block: usize, e: usize) -> f64 {
+        let m = self.element_area(block, e).abs();
+        if self.blocks[block].elements.kind.dim() == 3 {
+            m.cbrt()
+        } else {
+            m.sqrt()
+        }
+    }
+
     /// Characteristic length of element `e` of `block` (the CFL estimate takes the minimum):
     /// for a triangle its smallest altitude, for a quadrilateral its area over its
     /// longest diagonal, for a bar its length; for a tetrahedron its smallest

@@ -58,6 +58,8 @@ pub struct CentralDifference<'m> {
     gravity: Option<Vec<f64>>,
     /// Every material linear elastic: `f_int = K u`.
     elastic: bool,
+    /// The stored energy of elastic models, translation removed.
+    stored: crate::energy::StoredEnergy,
     h: f64,
     damp_m: f64,
     damp_k: f64,
@@ -115,6 +117,7 @@ impl<'m> CentralDifference<'m> {
         Ok(CentralDifference {
             model,
             elastic: model.materials.iter().all(|m| m.is_linear_elastic()),
+            stored: crate::energy::StoredEnergy::new(&model.mesh),
             asm,
             k,
             m,
@@ -219,7 +222,7 @@ impl Integrator for CentralDifference<'_> {
         points.iter_mut().for_each(|p| p.commit());
         let e_el0 = match totals {
             Some(t) => t.psi,
-            None => 0.5 * super::dot(&u, &f_int),
+            None => crate::energy::StoredEnergy::new(&model.mesh).of(&u, &f_int),
         };
         let mut f_ext = vec![0.0; n];
         external_force(model, self.gravity.as_deref(), 0.0, &mut f_ext);
@@ -381,7 +384,7 @@ impl Integrator for CentralDifference<'_> {
                 d.numerical -= 0.5 * jump;
                 (t.psi, d)
             }
-            None => (0.5 * super::dot(&w.u1, &w.f_int1), Dissipation::default()),
+            None => (self.stored.of(&w.u1, &w.f_int1), Dissipation::default()),
         };
         let contact = -0.5 * dk_corr - 0.5 * h * mismatch;
         if let Some(d) = (0..n).find(|&d| !w.v1[d].is_finite() || !w.a1[d].is_finite()) {

@@ -314,7 +314,6 @@ impl StepProblem for ImplicitStep<'_> {
             damp_k,
         };
         let inputs = PassInputs {
-            u,
             du: &w.du,
             kdu: &w.kdu,
             f_ext: &w.f_ext_np1,
@@ -623,7 +622,7 @@ fn finish(
     let work = StepWork::from_sums(sums.work);
     let (elastic_energy, material) = if ops.response == Response::Elastic {
         (
-            sums.elastic,
+            ops.stored.of(&w.u_np1, &w.f_int_np1),
             Dissipation {
                 numerical: sums.elastic_loss,
                 ..Default::default()

@@ -30,6 +30,9 @@ pub struct StepControl {
     pub t_end: f64,
     /// Halvings allowed in a row before the run stops.
     pub max_cuts: usize,
+    /// The smallest step a cut may reach; a step that would need a smaller one stops
+    /// the run as stalled.
+    pub h_min: f64,
 }
 
 impl StepControl {
@@ -40,6 +43,7 @@ impl StepControl {
             h: a.time.dt,
             t_end: a.time.t_end,
             max_cuts: a.iteration.max_cuts,
+            h_min: a.iteration.dt_min,
         }
     }
 }
@@ -65,6 +69,7 @@ where
         h: h0,
         t_end,
         max_cuts,
+        h_min,
     } = control;
     let mut h = h0;
     let (mut cuts_in_row, mut easy) = (0usize, 0usize);
@@ -101,6 +106,19 @@ where
                     location: dof.map(|d| integrator.model().describe_dof(d)),
                     t: s.t + integrator.h(),
                 });
+            }
+            StepOutcome::Rejected(r) if 0.5 * h < h_min => {
+                return Err(Error::Stepping(format!(
+                    "step {} (t = {:.6e}) stalls: it would need a step below \
+                     analysis.dt_min = {h_min:.3e} s ({:.1e} of dt; {} steps so far): {}. \
+                     Try iteration = \"newton\" (a fixed point or a kept factor converges \
+                     slowly past a peak), a smaller dt, or a smaller load step",
+                    s.step + 1,
+                    s.t + integrator.h(),
+                    h_min / h0,
+                    s.step,
+                    r.message
+                )));
             }
             StepOutcome::Rejected(r) if cuts_in_row < max_cuts => {
                 cuts_in_row += 1;

@@ -75,6 +75,8 @@ pub(crate) struct Operators {
     /// a body in contact has rigid motions no support holds
     /// ([`super::statics::STATIC_SEAT`]).
     pub seat: f64,
+    /// The stored energy of elastic models, translation removed.
+    pub stored: crate::energy::StoredEnergy,
 }
 
 impl Operators {
@@ -112,6 +114,7 @@ impl Operators {
             free_mask,
             rate_independent: model.materials.iter().all(|m| m.is_rate_independent()),
             seat: 0.0,
+            stored: crate::energy::StoredEnergy::new(&model.mesh),
             test: Convergence {
                 tolerance: a.iteration.tolerance,
                 displacement_tolerance: a.iteration.displacement_tolerance,
@@ -296,7 +299,7 @@ impl Operators {
         let mut nodal = NodalState::default();
         let (e_el0, points) = if self.response == Response::Elastic {
             self.asm.pattern.matvec(&self.k, &u, &mut f_int);
-            (0.5 * super::dot(&u, &f_int), Vec::new())
+            (self.stored.of(&u, &f_int), Vec::new())
         } else if let Some(laws) = &self.nodal {
             let (state, psi) = laws.initial(&self.asm.pattern, &self.k, &u, &mut f_int);
             nodal = state;

@@ -19,8 +19,6 @@ pub(crate) struct PassCoefficients {
 /// What the residual pass reads (whole vectors, or one chunk of each).
 #[derive(Clone, Copy)]
 pub(crate) struct PassInputs<'a> {
-    /// Displacements of the iterate.
-    pub u: &'a [f64],
     /// Its increment over the step.
     pub du: &'a [f64],
     /// `K Δu`.
@@ -43,7 +41,6 @@ impl<'a> PassInputs<'a> {
     /// The same inputs restricted to the dofs `lo..hi`.
     pub fn range(&self, lo: usize, hi: usize) -> PassInputs<'a> {
         PassInputs {
-            u: &self.u[lo..hi],
             du: &self.du[lo..hi],
             kdu: &self.kdu[lo..hi],
             f_ext: &self.f_ext[lo..hi],
@@ -83,8 +80,6 @@ pub(crate) struct PassSums {
     pub kinetic: f64,
     /// `½ Δv·M Δv`, the scheme's loss (dynamic).
     pub scheme_loss: f64,
-    /// `½ u·f_int` (elastic models).
-    pub elastic: f64,
     /// `½ Δu·K Δu`, the elastic models' numerical loss.
     pub elastic_loss: f64,
 }
@@ -99,7 +94,6 @@ impl PassSums {
             work: std::array::from_fn(|k| a.work[k] + b.work[k]),
             kinetic: a.kinetic + b.kinetic,
             scheme_loss: a.scheme_loss + b.scheme_loss,
-            elastic: a.elastic + b.elastic,
             elastic_loss: a.elastic_loss + b.elastic_loss,
         }
     }
@@ -117,7 +111,7 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
     let n = out.r.len();
     let PassOutputs { r, f_int, mv, v } = out;
     let (f_int, mv, v) = (&mut f_int[..n], &mut mv[..n], &mut v[..n]);
-    let (u, du, kdu, f_ext) = (&inp.u[..n], &inp.du[..n], &inp.kdu[..n], &inp.f_ext[..n]);
+    let (du, kdu, f_ext) = (&inp.du[..n], &inp.kdu[..n], &inp.f_ext[..n]);
     let (mv_n, v_n, f_int_n) = (&inp.mv_n[..n], &inp.v_n[..n], &inp.f_int_n[..n]);
     let (f_ext_n, free) = (&inp.f_ext_n[..n], &inp.free[..n]);
     let mut acc = PassSums::default();
@@ -153,7 +147,6 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
             acc.scheme_loss += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);
         }
         if ELASTIC {
-            acc.elastic += 0.5 * u[i] * fi;
             acc.elastic_loss += 0.5 * du[i] * kdu[i];
         }
     }

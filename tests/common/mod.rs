@@ -46,6 +46,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
                 method: rothe::model::IterationMethod::Newton,
                 refactor_rate: Some(rothe::model::DEFAULT_REFACTOR_RATE),
                 max_cuts: 8,
+                dt_min: 0.0,
                 ordering: rothe::model::Ordering::Auto,
             },
             contact: rothe::model::ContactSettings {

@@ -38,10 +38,12 @@ fn hardening(
         } => {
             positive(&format!("{field}.f_cm"), f_cm)?;
             positive(&format!("{field}.eps_c1"), eps_c1)?;
-            if eps_cu1.is_nan() || eps_cu1 <= eps_c1 {
+            // Equal is EN 1992-1-1's own C90/105 (ε_c1 = ε_cu1 = 2.8 ‰): the curve
+            // ends at its peak, where the strength then stays.
+            if eps_cu1.is_nan() || eps_cu1 < eps_c1 {
                 return Err(Error::config(
                     format!("{field}.eps_cu1"),
-                    format!("must exceed eps_c1 = {eps_c1}, got {eps_cu1:?}"),
+                    format!("must be at least eps_c1 = {eps_c1}, got {eps_cu1:?}"),
                 ));
             }
             let k = 1.05 * e * eps_c1 / f_cm;
@@ -98,6 +100,12 @@ pub(super) fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()
                 Hardening::LinearSoftening {
                     strength,
                     fracture_energy,
+                } if mat.identified_from.is_some() => {
+                    (strength, fracture_energy, "identify.fracture_energy")
+                }
+                Hardening::LinearSoftening {
+                    strength,
+                    fracture_energy,
                 } => (strength, fracture_energy, "tension.fracture_energy"),
                 _ => continue,
             },
@@ -110,11 +118,11 @@ pub(super) fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()
         };
         let limit = 2.0 * fracture_energy * mat.e / (strength * strength);
         for e in 0..b.elements.len() {
-            let h = mesh.element_area(bi, e).sqrt();
+            let h = mesh.crack_band_length(bi, e);
             if h >= limit {
                 return Err(Error::config(
                     format!("materials.{}.{key}", mat.name),
-                    format!("element {e} of block {bi} is {h:.3} m across, beyond the crack-band limit 2 G_f E / f_t² = {limit:.3} m: refine the mesh or raise G_f"),
+                    format!("element {e} of block {bi} is {h:.3} m across (the {} of its {}), beyond the crack-band limit 2 G_f E / f_t² = {limit:.3} m{}: refine the mesh or raise G_f", if b.elements.kind.dim() == 3 { "cube root" } else { "square root" }, if b.elements.kind.dim() == 3 { "volume" } else { "area" }, if mat.identified_from.is_some() { format!(" (identified G_f = {} N/m)", crate::material::sig(fracture_energy)) } else { String::new() }),
                 ));
             }
         }
@@ -205,6 +213,16 @@ fn concrete_data(
         }
     };
     check_elastic(field, d.e, d.nu, 1.0)?;
+    if d.f_ct >= d.f_cm {
+        return Err(Error::config(
+            f("f_ct"),
+            format!(
+                "the tensile strength f_ct = {:e} Pa must lie below the compressive \
+                 strength f_cm = {:e} Pa (a concrete's is about a tenth of it)",
+                d.f_ct, d.f_cm
+            ),
+        ));
+    }
     let g = crate::material::sig;
     let line = format!(
         "{source}: E = {}, nu = {}, f_ct = {}, f_cm = {}, eps_c1 = {}",
@@ -424,8 +442,16 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
             };
             positive(&name("eps_t0"), ident.eps_t0)?;
             positive(&name("eps_c0"), ident.eps_c0)?;
+            // Given parameters lie in [0, 2]; an identified A_c is whatever puts the
+            // peak f_cm at ε_c1 (above 2 from C70/85 on), which (I2) guarantees
+            // while E ε_c1 > f_cm (`identify::mazars` checks it).
             for (k, v) in [("A_t", ident.a_t), ("A_c", ident.a_c)] {
-                if !(0.0..=2.0).contains(&v) {
+                let top = if from.is_some() && k == "A_c" {
+                    f64::INFINITY
+                } else {
+                    2.0
+                };
+                if !(0.0..=top).contains(&v) {
                     return Err(Error::config(
                         name(k),
                         format!("must lie in [0, 2], got {v:?}"),

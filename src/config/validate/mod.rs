@@ -126,7 +126,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 ),
             ));
         }
-        let plane = if part.dim == 3 { Plane::Solid } else { a.plane };
+        let plane = body_plane(a.plane, part.dim, &b.name)?;
         let velocity =
             constraints::dimensioned(part.dim, &format!("{field}.velocity"), &b.velocity)?;
         products_are_finite(&field, thickness, &materials[mat], plane, &part)?;
@@ -177,7 +177,11 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let mut model = Model {
         mesh,
         materials,
-        plane: if solid { Plane::Solid } else { a.plane },
+        plane: if solid {
+            Plane::Solid
+        } else {
+            a.plane.unwrap_or_default()
+        },
         bodies,
         constraints,
         loads,
@@ -211,6 +215,11 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                             .unwrap_or(crate::model::DEFAULT_REFACTOR_RATE)
                     }),
                 max_cuts: a.max_cuts,
+                dt_min: match (a.dt_min, a.dt) {
+                    (Some(m), _) => m,
+                    (None, Some(h)) => h * DEFAULT_DT_MIN,
+                    (None, None) => 0.0,
+                },
                 ordering: a.ordering,
             },
             contact: ContactSettings {
@@ -243,11 +252,14 @@ fn initial_overlap(model: &Model) -> Result<()> {
         .filter(|c| c.gap < -tol)
         .min_by(|a, b| a.gap.total_cmp(&b.gap));
     let Some(c) = deepest else {
-        return Ok(());
+        return deep_overlap(model, tol);
     };
     let count = cands.iter().filter(|c| c.gap < -tol).count();
     let pair = &model.contacts[c.pair];
     let master = match c.master {
+        crate::contact::rows::Contactee::Rigid if model.mesh.dim == 3 => {
+            "its rigid plane".to_string()
+        }
         crate::contact::rows::Contactee::Rigid => "its rigid line".to_string(),
         crate::contact::rows::Contactee::Segment { nodes, .. } => {
             format!("the master segment of nodes {} and {}", nodes[0], nodes[1])
@@ -272,6 +284,57 @@ fn initial_overlap(model: &Model) -> Result<()> {
             model.describe_node(c.slave),
             -c.gap,
             if count == 1 { "" } else { "s" },
+        ),
+    ))
+}
+
+/// The idealisation a body of dimension `dim` runs with: a solid mesh is a solid
+/// (`plane = "stress"` or `"strain"` are refused there: they would be ignored), a
+/// plane mesh takes the given plane, never `solid` (a plane element has three strain
+/// components).
+fn body_plane(given: Option<Plane>, dim: usize, body: &str) -> Result<Plane> {
+    match (dim, given) {
+        (3, None | Some(Plane::Solid)) => Ok(Plane::Solid),
+        (3, Some(p)) => {
+            Err(Error::config(
+                "analysis.plane",
+                format!(
+                "body `{body}` is a solid (its mesh is three-dimensional), so `plane = \"{}\"` \
+                 would be ignored: remove the key (or give \"solid\")",
+                if p == Plane::Strain { "strain" } else { "stress" }
+            ),
+            ))
+        }
+        (_, Some(Plane::Solid)) => Err(Error::config(
+            "analysis.plane",
+            format!(
+                "`solid` needs a three-dimensional mesh, but body `{body}` is plane; give \
+                 \"stress\" or \"strain\", or mesh the body as a solid (`box` or a Gmsh \
+                 solid)"
+            ),
+        )),
+        (_, p) => Ok(p.unwrap_or_default()),
+    }
+}
+
+/// Overlaps deeper than detection's reach (`contact::overlap`): a slave inside the
+/// master's body at any depth, a rigid line or plane that cuts its slave body.
+fn deep_overlap(model: &Model, tol: f64) -> Result<()> {
+    let Some(o) = crate::contact::overlap::deepest(&model.mesh, &model.contacts, tol) else {
+        return Ok(());
+    };
+    Err(Error::config(
+        format!("contact[{}]", o.pair),
+        format!(
+            "pair `{}`: the bodies overlap at the start: {} lies {:.3e} m {} ({} node{} \
+             deeper than the contact tolerance {tol:.1e} m); move the bodies apart \
+             (touching is fine)",
+            model.contacts[o.pair].name,
+            model.describe_node(o.node),
+            o.depth,
+            o.what,
+            o.count,
+            if o.count == 1 { "" } else { "s" },
         ),
     ))
 }
@@ -399,6 +462,23 @@ fn explicit_step(model: &mut Model, dt: Option<f64>, opts: &LoadOptions) -> Resu
         }
         Some(_) => {}
     }
+    // Equal steps: central differences carry the half-step velocity of prescribed
+    // motion from one step to the next, so a shortened last step would prescribe it
+    // over the wrong interval and the ledger would miss (theory/explicit.md). The
+    // step is lowered (never raised: stability) until it divides t_end.
+    let (t_end, h) = (model.analysis.time.t_end, model.analysis.time.dt);
+    let n = (t_end / h * (1.0 - 1e-9)).ceil().max(1.0);
+    let even = t_end / n;
+    if h - even > 1e-9 * h {
+        if dt.is_some() {
+            model.warnings.push(format!(
+                "analysis.dt = {h:?} s does not divide t_end = {t_end:?} s; central \
+                 differences take {n} equal steps of {even:.6e} s instead (a shortened \
+                 last step would break the prescribed motion's half-step velocities)"
+            ));
+        }
+        model.analysis.time.dt = even;
+    }
     Ok(())
 }
 
@@ -487,6 +567,13 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
                 "is read only with a kept factor, but analysis.keep_factor = false",
             ));
         }
+        if a.keep_factor.is_none() && a.kind == AnalysisKind::Static {
+            return Err(Error::config(
+                "analysis.refactor_rate",
+                "is read only with a kept factor, which statics does not keep by default: \
+                 give analysis.keep_factor = true beside it, or remove it",
+            ));
+        }
     }
     checks::count_in(
         "analysis.max_iterations",
@@ -505,6 +592,15 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
     for (i, c) in a.rayleigh.iter().enumerate() {
         checks::non_negative(&format!("analysis.rayleigh[{i}]"), *c)?;
     }
+    if let Some(m) = a.dt_min {
+        positive("analysis.dt_min", m)?;
+        if let Some(h) = a.dt.filter(|&h| m > h) {
+            return Err(Error::config(
+                "analysis.dt_min",
+                format!("{m:?} s exceeds the step dt = {h:?} s: no step could be taken"),
+            ));
+        }
+    }
 
     Ok(())
 }
@@ -512,6 +608,11 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
 /// More corrections per step than any converging iteration needs; the residual
 /// history of a step is kept for its report.
 const MAX_ITERATIONS: usize = 10_000;
+
+/// The default smallest step, relative to `dt`: 2⁻²⁰, twelve halvings beyond the
+/// default eight in a row. A run that keeps cutting, succeeding and cutting again
+/// (a fixed-point iteration past a softening peak) would otherwise crawl on for ever.
+const DEFAULT_DT_MIN: f64 = 1.0 / 1_048_576.0;
 
 /// Halvings in a row: 2⁻⁵⁰ of the step is far below any useful step size.
 const MAX_CUTS: usize = 50;

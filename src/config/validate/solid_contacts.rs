@@ -208,14 +208,18 @@ fn plane_of(
     };
     let point = three("point", &plane.point)?;
     let raw = three("normal", &plane.normal)?;
-    let l = (raw[0] * raw[0] + raw[1] * raw[1] + raw[2] * raw[2]).sqrt();
-    if !(l > 0.0 && l.is_finite()) {
+    // Scaled by its largest component first, so that a normal of any magnitude
+    // (1e-200 or 1e200) has a length; only the zero vector has no direction.
+    let big = raw.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if big == 0.0 {
         return Err(Error::config(
             format!("{field}.rigid_plane.normal"),
-            format!("{raw:?} is no direction (zero or overflowing length)"),
+            format!("{raw:?} is no direction (all components zero)"),
         ));
     }
-    let mut n = [raw[0] / l, raw[1] / l, raw[2] / l];
+    let scaled = raw.map(|c| c / big);
+    let l = (scaled[0] * scaled[0] + scaled[1] * scaled[1] + scaled[2] * scaled[2]).sqrt();
+    let mut n = scaled.map(|c| c / l);
     let body = mesh.node_body[slaves[0]];
     let (mut c, mut k) = ([0.0; 3], 0.0);
     for (node, &b) in mesh.node_body.iter().enumerate() {
