@@ -46,14 +46,18 @@ fn static_ledger_closes() {
     for _ in 0..m.analysis.n_steps() {
         st.step_accepted(&mut s).unwrap();
         let l = &s.ledger;
+        // The stored energy leaves out the round-off net force of `K u` on the
+        // body's mean motion, which the work terms keep (theory/energy.md): the
+        // balance closes to that round-off, `n ε |K| |u|²` (5e-13 here).
         assert!(
-            l.residual().abs() <= 1e-12 * l.scale(),
-            "residual {}",
-            l.residual()
+            l.residual().abs() <= 1e-11 * l.scale(),
+            "residual {} of {}",
+            l.residual(),
+            l.scale()
         );
         assert!(l.dissipated().numerical.abs() <= 1e-12 * l.scale());
-        assert!((l.external_work() - l.elastic()).abs() <= 1e-12 * l.scale());
-        assert!((l.internal() - l.elastic()).abs() <= 1e-12 * l.scale());
+        assert!((l.external_work() - l.elastic()).abs() <= 1e-11 * l.scale());
+        assert!((l.internal() - l.elastic()).abs() <= 1e-11 * l.scale());
         assert_eq!(l.kinetic(), 0.0);
     }
     assert!(s.ledger.elastic() > 0.0);

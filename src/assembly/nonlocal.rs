@@ -88,11 +88,43 @@ fn block_radius(mesh: &Mesh, materials: &[Material], bi: usize) -> Option<f64> {
     materials[b.material].nonlocal_radius()
 }
 
-/// An estimate of the table's entries before it is built (for the memory estimate):
-/// per nonlocal block, its points times those of its body's points a disc (a ball
-/// in a solid) of the radius holds at the block's mean point density.
+/// The table's entries before it is built (for the memory estimate): its points
+/// and the neighbours each point's radius reaches, counted with the same R-trees
+/// the build queries, so a mesh refined where it matters (a notch) is counted as it
+/// is, not at its mean density. Counting stops past [`COUNT_CAP`] entries (a table
+/// beyond any machine), and a mean-density estimate beyond it is not counted at all.
 pub fn estimated_entries(mesh: &Mesh, materials: &[Material]) -> (u64, u64) {
-    let (mut points, mut entries) = (0u64, 0u64);
+    let Some(m) = Members::of(mesh, materials) else {
+        return (0, 0);
+    };
+    let n = m.points.len() as u64;
+    let mean = mean_density_entries(mesh, materials);
+    if mean > COUNT_CAP {
+        return (n, mean);
+    }
+    let trees = m.trees();
+    let counted = std::sync::atomic::AtomicU64::new(0);
+    (0..m.points.len()).into_par_iter().for_each(|i| {
+        if counted.load(std::sync::atomic::Ordering::Relaxed) > COUNT_CAP {
+            return;
+        }
+        let (body, r) = m.owner[i];
+        let tree = &trees.iter().find(|t| t.0 == body).expect("body tree").1;
+        let k = tree.locate_within_distance(m.points[i], r * r).count() as u64;
+        counted.fetch_add(k, std::sync::atomic::Ordering::Relaxed);
+    });
+    (n, counted.into_inner())
+}
+
+/// Entries past which [`estimated_entries`] stops counting: 2³³ (over 100 GB of
+/// table), far beyond what any machine holds, so the memory check refuses anyway.
+const COUNT_CAP: u64 = 1 << 33;
+
+/// Per nonlocal block, its points times those a disc (a ball in a solid) of the
+/// radius holds at the block's mean point density: the cheap bound that decides
+/// whether counting is worth it.
+fn mean_density_entries(mesh: &Mesh, materials: &[Material]) -> u64 {
+    let mut entries = 0u64;
     for (bi, b) in mesh.blocks.iter().enumerate() {
         let Some(r) = block_radius(mesh, materials, bi) else {
             continue;
@@ -107,55 +139,90 @@ pub fn estimated_entries(mesh: &Mesh, materials: &[Material]) -> (u64, u64) {
             std::f64::consts::PI * r * r
         };
         let per_point = (reach * n as f64 / measure.max(f64::MIN_POSITIVE)).clamp(1.0, n as f64);
-        points += n;
-        entries += (n as f64 * per_point) as u64;
+        entries = entries.saturating_add((n as f64 * per_point) as u64);
     }
-    (points, entries)
+    entries
 }
 
-impl NonlocalTable {
-    /// The table of `mesh` for `materials`, or `None` when no material is nonlocal.
-    pub fn build(mesh: &Mesh, materials: &[Material]) -> Option<NonlocalTable> {
+/// The members of every nonlocal block (their Gauss points, block after block).
+struct Members {
+    /// Per block: the radius of its material when nonlocal.
+    radii: Vec<Option<f64>>,
+    /// Per block: its first member.
+    offsets: Vec<Option<usize>>,
+    points: Vec<[f64; 3]>,
+    volumes: Vec<f64>,
+    /// Per member: its body and radius.
+    owner: Vec<(usize, f64)>,
+    /// Per member: its block.
+    block: Vec<u32>,
+}
+
+impl Members {
+    /// The members of `mesh`, or `None` when no material is nonlocal.
+    fn of(mesh: &Mesh, materials: &[Material]) -> Option<Members> {
         let radii: Vec<Option<f64>> = (0..mesh.blocks.len())
             .map(|bi| block_radius(mesh, materials, bi))
             .collect();
         if radii.iter().all(Option::is_none) {
             return None;
         }
-        let mut offsets = vec![None; mesh.blocks.len()];
-        let mut points = Vec::new();
-        let mut volumes = Vec::new();
-        // Member -> (body, radius), and its block.
-        let mut owner = Vec::new();
-        let mut block = Vec::new();
+        let mut m = Members {
+            offsets: vec![None; mesh.blocks.len()],
+            radii,
+            points: Vec::new(),
+            volumes: Vec::new(),
+            owner: Vec::new(),
+            block: Vec::new(),
+        };
         for (bi, b) in mesh.blocks.iter().enumerate() {
-            let Some(r) = radii[bi] else { continue };
-            offsets[bi] = Some(points.len());
+            let Some(r) = m.radii[bi] else { continue };
+            m.offsets[bi] = Some(m.points.len());
             let ng = stiffness_rule(b.elements.kind).len();
             for e in 0..b.elements.len() {
                 for q in 0..ng {
                     let (p, v) = point_geometry(mesh, bi, e, q);
-                    points.push(p);
-                    volumes.push(v);
-                    owner.push((b.body, r));
-                    block.push(bi as u32);
+                    m.points.push(p);
+                    m.volumes.push(v);
+                    m.owner.push((b.body, r));
+                    m.block.push(bi as u32);
                 }
             }
         }
-        // One R-tree per body over its members.
-        let mut bodies: Vec<usize> = owner.iter().map(|o| o.0).collect();
+        Some(m)
+    }
+
+    /// One R-tree per body over its members.
+    fn trees(&self) -> Vec<(usize, PointTree)> {
+        let mut bodies: Vec<usize> = self.owner.iter().map(|o| o.0).collect();
         bodies.sort_unstable();
         bodies.dedup();
-        let trees: Vec<(usize, PointTree)> = bodies
+        bodies
             .iter()
             .map(|&body| {
-                let items = (0..points.len())
-                    .filter(|&m| owner[m].0 == body)
-                    .map(|m| GeomWithData::new(points[m], m as u32))
+                let items = (0..self.points.len())
+                    .filter(|&m| self.owner[m].0 == body)
+                    .map(|m| GeomWithData::new(self.points[m], m as u32))
                     .collect();
                 (body, RTree::bulk_load(items))
             })
-            .collect();
+            .collect()
+    }
+}
+
+impl NonlocalTable {
+    /// The table of `mesh` for `materials`, or `None` when no material is nonlocal.
+    pub fn build(mesh: &Mesh, materials: &[Material]) -> Option<NonlocalTable> {
+        let members = Members::of(mesh, materials)?;
+        let trees = members.trees();
+        let Members {
+            radii,
+            offsets,
+            points,
+            volumes,
+            owner,
+            block,
+        } = members;
         let rows: Vec<(Vec<u32>, Vec<f64>)> = (0..points.len())
             .into_par_iter()
             .map(|i| {
