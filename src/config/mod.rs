@@ -585,6 +585,13 @@ pub fn parse_with(text: &str, ov: &Overrides) -> Result<Scenario> {
 /// Parses scenario text (no validation). A value of the wrong type or length is
 /// named by its field path and its line and column.
 pub fn parse(text: &str) -> Result<Scenario> {
+    parse_located(text)
+}
+
+/// Parses TOML text into any of the file types (a scenario, a material-point
+/// file), naming a value of the wrong type or length by its field path and its
+/// line and column.
+pub fn parse_located<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {
     let de = toml::Deserializer::new(text);
     serde_path_to_error::deserialize(de).map_err(|e| {
         let path = field_path(e.path());

@@ -175,6 +175,21 @@ fn check(p: &PathSpec) -> Result<()> {
     crate::config::finite_pub("path.ratio", &[p.ratio])?;
     crate::config::check_function_pub("path.function", &p.function)?;
     if p.kind == PathKind::Table {
+        // The table prescribes every component itself: the keys of the other kinds
+        // would be ignored.
+        let ignored = [
+            ("control", p.control != Control::default()),
+            ("amplitude", p.amplitude != 0.0),
+            ("function", p.function != TimeFunction::Constant),
+            ("ratio", p.ratio != 1.0),
+        ];
+        if let Some((k, _)) = ignored.iter().find(|(_, given)| *given) {
+            return Err(Error::config(
+                format!("path.{k}"),
+                "a table path prescribes every strain component from `times` and \
+                 `strains`; remove the key (it would be ignored)",
+            ));
+        }
         if p.times.is_empty() || p.times.len() != p.strains.len() {
             return Err(Error::config(
                 "path.strains",
@@ -397,8 +412,13 @@ where
 /// parameters, identified ones included).
 pub fn run_file(file: &Path, out: &Path, announce: impl FnOnce(&Material)) -> Result<usize> {
     let text = std::fs::read_to_string(file).map_err(|e| Error::io(file, e))?;
-    let spec: DriverFile = toml::from_str(&text)
-        .map_err(|e| Error::config(file.display().to_string(), e.message().to_string()))?;
+    let in_file = |e: Error| match e {
+        Error::Config { field, message } => {
+            Error::config(format!("{}: {field}", file.display()), message)
+        }
+        other => other,
+    };
+    let spec: DriverFile = crate::config::parse_located(&text).map_err(in_file)?;
     let mat = crate::config::material("point", "material", &spec.material)
         .map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
     check(&spec.path).map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;

@@ -65,6 +65,8 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     meshes::meshing_size_is_taken(s)?;
     let mut mesh = Mesh::default();
     let mut bodies = Vec::new();
+    // The largest stiffness and mass products of the bodies.
+    let mut largest = [0.0f64; 2];
     for (bi, b) in s.bodies.iter().enumerate() {
         let field = format!("bodies[{bi}]");
         if b.name.is_empty() || b.name.contains('.') {
@@ -129,7 +131,9 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         let plane = body_plane(a.plane, part.dim, &b.name)?;
         let velocity =
             constraints::dimensioned(part.dim, &format!("{field}.velocity"), &b.velocity)?;
-        products_are_finite(&field, thickness, &materials[mat], plane, &part)?;
+        let (stiff, mass) =
+            products_are_finite(&field, thickness, &materials[mat], plane, &part, a.dt)?;
+        largest = [largest[0].max(stiff), largest[1].max(mass)];
         mesh.add_part(&part, bi, &b.name, mat, thickness);
         bodies.push(Body {
             name: b.name.clone(),
@@ -137,6 +141,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             thickness,
         });
     }
+    rayleigh_is_finite(a.rayleigh, a.dt, largest[0], largest[1])?;
     meshes::add_bars(s, &mut mesh, &bodies, &materials, &find_material)?;
     let names: Vec<String> = bodies.iter().map(|b| b.name.clone()).collect();
     mesh.check_elements(&names)?;
@@ -348,7 +353,8 @@ fn products_are_finite(
     m: &crate::material::Material,
     plane: crate::fe::Plane,
     part: &crate::mesh::Part,
-) -> Result<()> {
+    dt: Option<f64>,
+) -> Result<(f64, f64)> {
     let stiffness = if plane == Plane::Solid {
         m.c_solid()
             .iter()
@@ -373,16 +379,65 @@ fn products_are_finite(
             }
         })
         .sum();
-    for (what, product) in [
-        ("its material's stiffness", thickness * stiffness),
-        ("its density and area (the mass)", thickness * m.rho * area),
+    let solid = plane == Plane::Solid;
+    let thick = (format!("{field}.thickness"), thickness, "m");
+    let size = (format!("{field}.mesh"), area, if solid { "m³" } else { "m²" });
+    let e = (format!("materials.{}.E", m.name), m.e, "Pa");
+    let rho = (format!("materials.{}.rho", m.name), m.rho, "kg/m³");
+    let (stiff, mass) = (thickness * stiffness, thickness * m.rho * area);
+    let per_h2 = dt.map_or(1.0, |h| 1.0 / (h * h));
+    for (what, product, mut factors) in [
+        ("the stiffness", stiff, vec![e]),
+        ("the mass over h²", mass * per_h2, vec![rho, size]),
     ] {
-        if !product.is_finite() {
+        if !(product.abs() < MATRIX_LIMIT) {
+            // A solid has no thickness to blame; the largest factor is the culprit.
+            if !solid {
+                factors.push(thick.clone());
+            }
+            let (key, value, unit) = factors
+                .iter()
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                .cloned()
+                .expect("factors");
+            let terms = factors
+                .iter()
+                .map(|(k, v, u)| format!("{k} = {} {u}", crate::material::sig(*v)))
+                .collect::<Vec<_>>()
+                .join(" × ");
             return Err(Error::config(
-                format!("{field}.thickness"),
+                key,
                 format!(
-                    "{thickness:e} m times {what} overflows ({product}): the element \
-                     matrices would not be finite"
+                    "{} {unit} makes {what} of the body {}, beyond \
+                     {MATRIX_LIMIT:e} ({terms}): the residual's squared forces would \
+                     overflow",
+                    crate::material::sig(value),
+                    crate::material::sig(product)
+                ),
+            ));
+        }
+    }
+    Ok((stiff, mass))
+}
+
+/// The largest entry an effective matrix may reach: the residual test squares
+/// forces, and `1e154²` overflows. No model of a real structure comes near it
+/// (steel: `E t` about 2e10 N/m, `ρ V/h²` about 1e17 kg/s² at h = 1 µs).
+const MATRIX_LIMIT: f64 = 1e150;
+
+/// Rayleigh's `a_m M + a_k K` must stay finite, and so must its share `C/h` of the
+/// effective matrix: a coefficient of 1e300 would otherwise surface as a failed
+/// step far from its cause.
+fn rayleigh_is_finite(rayleigh: [f64; 2], dt: Option<f64>, stiffness: f64, mass: f64) -> Result<()> {
+    let h = dt.unwrap_or(1.0);
+    for (i, scale, what) in [(0, mass, "mass"), (1, stiffness, "stiffness")] {
+        let c = rayleigh[i];
+        if c != 0.0 && !((c * scale / h).abs() < MATRIX_LIMIT) {
+            return Err(Error::config(
+                format!("analysis.rayleigh[{i}]"),
+                format!(
+                    "{c:e} times the largest {what} of the model ({scale:e}) over the step \
+                     exceeds {MATRIX_LIMIT:e}: the residual's squared forces would overflow"
                 ),
             ));
         }
