@@ -5,7 +5,9 @@
 //! message: never a panic, never a non-finite number reported as a success, never an
 //! allocation beyond the memory limit (2 GB here, so a huge mesh is refused).
 //!
-//! Gmsh files are fuzzed too (the node and element blocks of a real Gmsh mesh
+//! The scenarios include the solids (box meshes, rigid planes, Coulomb cones) and a
+//! Gmsh solid. Gmsh files are fuzzed too, a plane one and a solid one (the node and
+//! element blocks of a real Gmsh mesh
 //! with tags permuted, repeated, dropped or made sparse, coordinates and counts
 //! corrupted, bytes cut off or flipped): read, a mesh must come out with every node
 //! where its block put it, or an error. Command-line overrides (`--set`, `--unset`,
@@ -277,6 +279,9 @@ fn campaign(cases: u32) {
     let mut scenarios = examples("examples/scenarios");
     scenarios.extend(examples("examples/contact"));
     scenarios.extend(examples("examples/explicit"));
+    // Solids: box meshes, rigid planes, Coulomb cones, a Gmsh solid.
+    scenarios.extend(examples("examples/solid"));
+    scenarios.extend(examples("tests/data"));
     let materials = examples("examples/materials");
     let all: Vec<(PathBuf, String, bool)> = scenarios
         .into_iter()
@@ -582,7 +587,16 @@ fn exercise_gmsh(
 #[test]
 fn mutated_gmsh_files_read_right_or_are_refused() {
     std::panic::set_hook(Box::new(|_| {}));
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/plate_tri.msh");
+    for (file, seed) in [("plate_tri.msh", 0x5eed_0003), ("bar_hex.msh", 0x5eed_0005)] {
+        gmsh_campaign(file, seed);
+    }
+}
+
+/// The Gmsh campaign on one file of `tests/data` (a plane file and a solid one).
+fn gmsh_campaign(file: &str, seed: u64) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(file);
     let original = std::fs::read(&path).unwrap();
     let reference: std::collections::HashMap<u64, [f64; 3]> = {
         let p = rothe::mesh::gmsh::parse(&original).unwrap();
@@ -594,7 +608,7 @@ fn mutated_gmsh_files_read_right_or_are_refused() {
         ..Config::default()
     };
     if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
-        config.rng_seed = proptest::test_runner::RngSeed::Fixed(0x5eed_0003);
+        config.rng_seed = proptest::test_runner::RngSeed::Fixed(seed);
     }
     let mut runner = TestRunner::new(config);
     runner
@@ -640,6 +654,17 @@ fn override_case() -> impl Strategy<Value = (u8, String)> {
         Just("meshing.element_size"),
         Just("materials"),
         Just("contact.0.rigid_line"),
+        Just("contact.0.rigid_plane"),
+        Just("contact.0.mu"),
+        Just("analysis.plane"),
+        Just("analysis.dt_min"),
+        Just("analysis.keep_factor"),
+        Just("analysis.refactor_rate"),
+        Just("analysis.iteration"),
+        Just("materials.concrete.identify"),
+        Just("materials.concrete.nonlocal"),
+        Just("materials.concrete.fracture_energy"),
+        Just("bodies.1.mesh.origin"),
         Just("probes.0.at"),
         Just("..x"),
     ];
@@ -654,6 +679,15 @@ fn override_case() -> impl Strategy<Value = (u8, String)> {
         Just("[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]"),
         Just("\"central_difference\""),
         Just("\"full\""),
+        Just("\"solid\""),
+        Just("1e-20"),
+        Just("100.0"),
+        Just("true"),
+        Just("[0.0, -0.05, 0.0]"),
+        Just("[0.3, 0.05]"),
+        Just("{ class = \"C90/105\" }"),
+        Just("{ radius = 1e-20 }"),
+        Just("{ point = [0.0, 0.1, 0.0], normal = [0.0, 1e-200, 0.0] }"),
         Just("{ a = 1 }"),
         Just("text"),
     ];
@@ -668,8 +702,10 @@ fn command_line_overrides_give_a_model_or_an_error() {
     std::panic::set_hook(Box::new(|_| {}));
     let mut scenarios = examples("examples/scenarios");
     scenarios.extend(examples("examples/contact"));
+    scenarios.extend(examples("examples/solid"));
+    scenarios.extend(examples("examples/explicit"));
     let mut config = Config {
-        cases: 200,
+        cases: 300,
         failure_persistence: None,
         ..Config::default()
     };

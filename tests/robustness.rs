@@ -978,7 +978,7 @@ fn messages_name_the_field_the_line_and_the_column() {
     );
     // A product that overflows: named as such, not as a singular stiffness.
     let thick = text.replacen("thickness = ", "thickness = 1e300 #", 1);
-    refused(&thick, &["bodies[0].thickness", "overflows"]);
+    refused(&thick, &["bodies[0].thickness", "overflow"]);
 }
 
 #[test]

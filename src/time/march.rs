@@ -111,8 +111,9 @@ where
                 return Err(Error::Stepping(format!(
                     "step {} (t = {:.6e}) stalls: it would need a step below \
                      analysis.dt_min = {h_min:.3e} s ({:.1e} of dt; {} steps so far): {}. \
-                     Try iteration = \"newton\" (a fixed point or a kept factor converges \
-                     slowly past a peak), a smaller dt, or a smaller load step",
+                     Try a smaller dt (load step); with iteration = \"fixed\" or a kept \
+                     factor past a softening peak, iteration = \"newton\" and \
+                     keep_factor = false",
                     s.step + 1,
                     s.t + integrator.h(),
                     h_min / h0,

@@ -633,7 +633,7 @@ impl Correction for ContactCorrection<'_> {
         self.stats.rows += m;
         let status = match self.qp {
             ContactQp::Condensed => self.condensed(sys, &g, m)?,
-            ContactQp::Full => self.full(sys, &g, rhs),
+            ContactQp::Full => self.full(sys, &g, rhs)?,
         };
         if let Err(status) = status {
             let worst = self
