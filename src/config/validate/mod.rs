@@ -394,7 +394,8 @@ fn products_are_finite(
         ("the stiffness", stiff, vec![e]),
         ("the mass over h²", mass * per_h2, vec![rho, size]),
     ] {
-        if !(product.abs() < MATRIX_LIMIT) {
+        // NaN counts as beyond.
+        if product.is_nan() || product.abs() >= MATRIX_LIMIT {
             // A solid has no thickness to blame; the largest factor is the culprit.
             if !solid {
                 factors.push(thick.clone());
@@ -441,7 +442,8 @@ fn rayleigh_is_finite(
     let h = dt.unwrap_or(1.0);
     for (i, scale, what) in [(0, mass, "mass"), (1, stiffness, "stiffness")] {
         let c = rayleigh[i];
-        if c != 0.0 && !((c * scale / h).abs() < MATRIX_LIMIT) {
+        let term = (c * scale / h).abs();
+        if c != 0.0 && (term.is_nan() || term >= MATRIX_LIMIT) {
             return Err(Error::config(
                 format!("analysis.rayleigh[{i}]"),
                 format!(
