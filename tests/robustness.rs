@@ -1574,3 +1574,23 @@ fn a_nonlocal_radius_far_below_the_mesh_runs_as_the_local_law() {
     assert!(!err.contains("panicked"));
     assert!(h["t"].len() > 2);
 }
+
+#[test]
+fn a_body_held_by_frictionless_contact_alone_carries_any_pressure() {
+    // Statics, the block with no support of its own (its sideways and rotational
+    // motions held by the seat's stiffness only), plane and solid, at 3 kPa and
+    // 3 MPa: the seat carries the traction's resultant.
+    for (file, area) in [("held_by_contact.toml", 0.5 * 0.1), ("held_by_contact_solid.toml", 0.4 * 0.2)] {
+        let text = std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file),
+        )
+        .unwrap();
+        for q in [3.0e3, 3.0e6] {
+            let loaded = text.replace("-3.0e6", &format!("{:e}", -q));
+            let (ok, err, h) = run_history(&loaded, &[]);
+            assert!(ok, "{file} at {q} Pa: {err}");
+            let f = *h["seat_force"].last().unwrap();
+            assert!((f - q * area).abs() < 1e-6 * q * area, "{file}: {f} N vs {}", q * area);
+        }
+    }
+}
