@@ -1179,8 +1179,17 @@ fn the_kept_factor_settings_are_checked_and_default_by_the_kind_of_analysis() {
 
 // --- The classes of the solids, Gmsh solids, 3D contact and identification round.
 
-/// `rothe run SCENARIO --out OUT --quiet --overwrite`, and its history as columns.
+/// `rothe run SCENARIO --out OUT --quiet`, and its history as columns.
 fn run_history(text: &str, extra: &[&str]) -> (bool, String, BTreeColumns) {
+    let (ok, err, h, _) = run_history_and_summary(text, extra);
+    (ok, err, h)
+}
+
+/// [`run_history`] with the run's `summary.json`.
+fn run_history_and_summary(
+    text: &str,
+    extra: &[&str],
+) -> (bool, String, BTreeColumns, serde_json::Value) {
     let dir = tempfile::tempdir().unwrap();
     let sc = scenario(dir.path(), "s.toml", text);
     let out = dir.path().join("out");
@@ -1196,7 +1205,11 @@ fn run_history(text: &str, extra: &[&str]) -> (bool, String, BTreeColumns) {
     let columns = std::fs::read_to_string(out.join("history.csv"))
         .map(|h| columns(&h))
         .unwrap_or_default();
-    (ok, err, columns)
+    let s = std::fs::read_to_string(out.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    (ok, err, columns, s)
 }
 
 type BTreeColumns = std::collections::BTreeMap<String, Vec<f64>>;
@@ -1474,21 +1487,10 @@ fn stored_energy_is_never_negative_under_a_large_rigid_motion() {
         mesh = { kind = \"box\", origin = [0.0, 1.0, 0.0], size = [0.1, 0.1, 0.1], divisions = [2, 2, 2] }\n\n\
         [[contact]]\nname = \"floor\"\nslave = \"cube.bottom\"\n\
         rigid_plane = { point = [0.0, 0.0, 0.0], normal = [0.0, 1.0, 0.0] }\n";
-    let dir = tempfile::tempdir().unwrap();
-    let sc = scenario(dir.path(), "s.toml", text);
-    let out = dir.path().join("out");
-    let (ok, _, err) = rothe(&[
-        "run",
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (ok, err, h, s) = run_history_and_summary(text, &[]);
     assert!(ok, "{err}");
-    let h = columns(&std::fs::read_to_string(out.join("history.csv")).unwrap());
     assert!(h["E_el"].iter().all(|&e| e >= 0.0));
     assert!(h["floor_force"].iter().any(|&f| f > 0.0), "it lands");
-    let s = summary(&out);
     for c in [
         "dissipation_within_internal_work",
         "dissipation_within_supplied_energy",
@@ -1580,9 +1582,14 @@ fn a_body_held_by_frictionless_contact_alone_carries_any_pressure() {
     // Statics, the block with no support of its own (its sideways and rotational
     // motions held by the seat's stiffness only), plane and solid, at 3 kPa and
     // 3 MPa: the seat carries the traction's resultant.
-    for (file, area) in [("held_by_contact.toml", 0.5 * 0.1), ("held_by_contact_solid.toml", 0.4 * 0.2)] {
+    for (file, area) in [
+        ("held_by_contact.toml", 0.5 * 0.1),
+        ("held_by_contact_solid.toml", 0.4 * 0.2),
+    ] {
         let text = std::fs::read_to_string(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(file),
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/data")
+                .join(file),
         )
         .unwrap();
         for q in [3.0e3, 3.0e6] {
@@ -1590,7 +1597,11 @@ fn a_body_held_by_frictionless_contact_alone_carries_any_pressure() {
             let (ok, err, h) = run_history(&loaded, &[]);
             assert!(ok, "{file} at {q} Pa: {err}");
             let f = *h["seat_force"].last().unwrap();
-            assert!((f - q * area).abs() < 1e-6 * q * area, "{file}: {f} N vs {}", q * area);
+            assert!(
+                (f - q * area).abs() < 1e-6 * q * area,
+                "{file}: {f} N vs {}",
+                q * area
+            );
         }
     }
 }

@@ -211,18 +211,11 @@ fn inside_polygon(p: Point, x: &[Point]) -> bool {
 /// Whether `p` lies in the tetrahedron or hexahedron `x` (a hexahedron as the six
 /// tetrahedra about its diagonal 0-6) or on its boundary.
 fn inside_solid(p: Point, x: &[Point]) -> bool {
-    const HEX: [[usize; 4]; 6] = [
-        [0, 1, 2, 6],
-        [0, 2, 3, 6],
-        [0, 3, 7, 6],
-        [0, 7, 4, 6],
-        [0, 4, 5, 6],
-        [0, 5, 1, 6],
-    ];
     if x.len() == 4 {
         return inside_tet(p, [x[0], x[1], x[2], x[3]]);
     }
-    HEX.iter()
+    crate::mesh::solid::KUHN
+        .iter()
         .any(|t| inside_tet(p, [x[t[0]], x[t[1]], x[t[2]], x[t[3]]]))
 }
 

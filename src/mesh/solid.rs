@@ -150,7 +150,7 @@ pub fn block(origin: [f64; 3], xs: &[f64], ys: &[f64], zs: &[f64], kind: Element
 
 /// The Kuhn split of the cube (local hexahedron nodes) into six tetrahedra around
 /// the diagonal 0-6, each positively oriented.
-const KUHN: [[usize; 4]; 6] = [
+pub(crate) const KUHN: [[usize; 4]; 6] = [
     [0, 1, 2, 6],
     [0, 2, 3, 6],
     [0, 3, 7, 6],
