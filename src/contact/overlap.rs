@@ -163,6 +163,7 @@ fn inside_body(
         }
     }
     let tree = RTree::bulk_load(items);
+    let boundary = exterior(mesh, body);
     let mut element_of = std::collections::HashMap::new();
     let hits = slaves.iter().filter_map(|&s| {
         if mesh.node_body[s] == body {
@@ -173,18 +174,25 @@ fn inside_body(
             .locate_in_envelope_intersecting(AABB::from_point(p))
             .map(|g| g.data)
             .find(|&(bi, e)| {
-                let x: Vec<Point> = mesh.blocks[bi]
-                    .elements
-                    .element(e)
-                    .iter()
-                    .map(|&k| mesh.coords[k])
-                    .collect();
-                if solid {
+                let nodes = mesh.blocks[bi].elements.element(e);
+                let x: Vec<Point> = nodes.iter().map(|&k| mesh.coords[k]).collect();
+                let inside = if solid {
                     inside_solid(p, &x)
                 } else {
                     inside_polygon(p, &x)
-                }
+                };
+                inside
             })?;
+        // Touching the master's body anywhere on its boundary (beside it, on a
+        // face that is not the master's) is no overlap.
+        if boundary
+            .iter()
+            .map(|b| b.distance2(p, mesh))
+            .fold(f64::INFINITY, f64::min)
+            <= tol * tol
+        {
+            return None;
+        }
         let depth = distance2(p).sqrt();
         element_of.insert(s, (bi, e));
         (depth > tol).then_some((s, depth))
@@ -197,6 +205,69 @@ fn inside_body(
              the master surface)"
         )
     })
+}
+
+/// An edge (plane) or face (solid) on a body's boundary.
+enum Facet {
+    Edge([usize; 2]),
+    Face([usize; 4]),
+}
+
+impl Facet {
+    fn distance2(&self, p: Point, mesh: &Mesh) -> f64 {
+        let x = |n: usize| mesh.coords[n];
+        match self {
+            Facet::Edge([a, b]) => {
+                super::detect::closest([p[0], p[1]], crate::mesh::xy(x(*a)), crate::mesh::xy(x(*b)))
+                    .1
+            }
+            Facet::Face(f) => super::faces::project(p, f, &x).map_or(f64::INFINITY, |pr| pr.d2),
+        }
+    }
+}
+
+/// The facets of `body`'s continuum elements that no other of its elements shares:
+/// its boundary.
+fn exterior(mesh: &Mesh, body: usize) -> Vec<Facet> {
+    let mut uses: std::collections::HashMap<Vec<usize>, (u32, Facet)> =
+        std::collections::HashMap::new();
+    for b in mesh.blocks.iter().filter(|b| b.body == body) {
+        let kind = b.elements.kind;
+        if kind == crate::mesh::ElementKind::Bar2 {
+            continue;
+        }
+        for e in 0..b.elements.len() {
+            let nodes = b.elements.element(e);
+            let facets: Vec<Facet> = if kind.dim() == 3 {
+                kind.faces()
+                    .iter()
+                    .map(|f| {
+                        let mut face = [usize::MAX; 4];
+                        for (k, &a) in f.iter().enumerate() {
+                            face[k] = nodes[a];
+                        }
+                        Facet::Face(face)
+                    })
+                    .collect()
+            } else {
+                (0..nodes.len())
+                    .map(|i| Facet::Edge([nodes[i], nodes[(i + 1) % nodes.len()]]))
+                    .collect()
+            };
+            for f in facets {
+                let mut key: Vec<usize> = match &f {
+                    Facet::Edge(e) => e.to_vec(),
+                    Facet::Face(f) => super::faces::corners(f).to_vec(),
+                };
+                key.sort_unstable();
+                uses.entry(key).or_insert((0, f)).0 += 1;
+            }
+        }
+    }
+    uses.into_values()
+        .filter(|(n, _)| *n == 1)
+        .map(|(_, f)| f)
+        .collect()
 }
 
 /// Whether `p` lies in the polygon `x` (counter-clockwise, convex) or on its boundary.
