@@ -176,12 +176,11 @@ fn inside_body(
             .find(|&(bi, e)| {
                 let nodes = mesh.blocks[bi].elements.element(e);
                 let x: Vec<Point> = nodes.iter().map(|&k| mesh.coords[k]).collect();
-                let inside = if solid {
+                if solid {
                     inside_solid(p, &x)
                 } else {
                     inside_polygon(p, &x)
-                };
-                inside
+                }
             })?;
         // Touching the master's body anywhere on its boundary (beside it, on a
         // face that is not the master's) is no overlap.
