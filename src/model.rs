@@ -378,6 +378,10 @@ pub struct ContactSide {
     /// A solid's slave faces, when the slave is a face set: the tributary areas of
     /// its nodes for the contact pressure; empty otherwise.
     pub faces: Vec<[usize; 4]>,
+    /// A master face set's boundary edges (sorted node pairs, each an edge of one
+    /// face only), where node to face ends: topology, so found once at validation
+    /// (`contact::faces::boundary_edges`); empty for other masters.
+    pub master_boundary: Vec<[usize; 2]>,
 }
 
 /// How a deformable pair's impenetrability is written (`theory/contact.md`).

@@ -320,10 +320,6 @@ pub fn project<X: Fn(usize) -> V3>(p: V3, face: &[usize; 4], x: &X) -> Option<Pr
 pub(super) struct Surface {
     normal: Vec<V3>,
     at_node: HashMap<usize, V3>,
-    /// The surface's boundary edges (sorted node pairs used by one face only) and
-    /// their nodes: where the master ends.
-    boundary: std::collections::HashSet<[usize; 2]>,
-    boundary_nodes: std::collections::HashSet<usize>,
 }
 
 impl Surface {
@@ -349,62 +345,7 @@ impl Surface {
         for v in at_node.values_mut() {
             *v = unit(*v).unwrap_or([0.0; 3]);
         }
-        let mut uses: HashMap<[usize; 2], u32> = HashMap::with_capacity(2 * faces.len());
-        for f in faces {
-            let c = corners(f);
-            for i in 0..c.len() {
-                let (a, b) = (c[i], c[(i + 1) % c.len()]);
-                *uses.entry([a.min(b), a.max(b)]).or_default() += 1;
-            }
-        }
-        let boundary: std::collections::HashSet<[usize; 2]> = uses
-            .into_iter()
-            .filter(|&(_, n)| n == 1)
-            .map(|(e, _)| e)
-            .collect();
-        let boundary_nodes = boundary.iter().flatten().copied().collect();
-        Surface {
-            normal,
-            at_node,
-            boundary,
-            boundary_nodes,
-        }
-    }
-
-    /// Whether the projection `pr` of `p` on `face` lies on the surface's boundary
-    /// (an edge of one face only, or a corner on one) with `p` beyond it: the slave's
-    /// projection has left the master surface, and no force holds it. The margin, a
-    /// thousandth of the face's longest edge (`detect::RIGID_END_MARGIN`), keeps a
-    /// slave exactly at the edge from flickering on round-off.
-    pub(super) fn beyond_boundary<X: Fn(usize) -> V3>(
-        &self,
-        p: V3,
-        face: &[usize; 4],
-        pr: &Projection,
-        x: &X,
-    ) -> bool {
-        let c = corners(face);
-        let on_edge = match pr.region {
-            Region::Edge(i) => {
-                let (a, b) = (c[i], c[(i + 1) % c.len()]);
-                self.boundary.contains(&[a.min(b), a.max(b)])
-            }
-            Region::Corner(i) => self.boundary_nodes.contains(&c[i]),
-            Region::Interior { .. } => false,
-        };
-        if !on_edge {
-            return false;
-        }
-        let d = sub(p, pr.point);
-        let dn = dot(d, pr.normal);
-        let t2 = (dot(d, d) - dn * dn).max(0.0);
-        let longest = (0..c.len())
-            .map(|i| {
-                let e = sub(x(c[(i + 1) % c.len()]), x(c[i]));
-                dot(e, e)
-            })
-            .fold(0.0, f64::max);
-        t2 > super::detect::RIGID_END_MARGIN.powi(2) * longest
+        Surface { normal, at_node }
     }
 
     /// The row's normal at a projection on `face`: the nodal normals interpolated
@@ -426,6 +367,64 @@ impl Surface {
         }
         unit(n).unwrap_or(pr.normal)
     }
+}
+
+/// The boundary edges of a face set: the sorted node pairs that one face only has,
+/// sorted. Where a master surface ends (validation stores them with the side).
+pub fn boundary_edges(faces: &[[usize; 4]]) -> Vec<[usize; 2]> {
+    let mut edges: Vec<[usize; 2]> = faces
+        .iter()
+        .flat_map(|f| {
+            let c = corners(f);
+            (0..c.len()).map(move |i| {
+                let (a, b) = (c[i], c[(i + 1) % c.len()]);
+                [a.min(b), a.max(b)]
+            })
+        })
+        .collect();
+    edges.sort_unstable();
+    edges
+        .chunk_by(|a, b| a == b)
+        .filter(|run| run.len() == 1)
+        .map(|run| run[0])
+        .collect()
+}
+
+/// Whether the projection `pr` of `p` on `face` lies on the master surface's
+/// boundary (`edges`, sorted, and their sorted nodes `rim`: an edge of one face
+/// only, or a corner on one) with `p` beyond it: the slave's projection has left the
+/// master surface, and no force holds it. The margin, a thousandth of the face's
+/// longest edge (`detect::RIGID_END_MARGIN`), keeps a slave exactly at the edge from
+/// flickering on round-off.
+fn beyond_boundary<X: Fn(usize) -> V3>(
+    (edges, rim): (&[[usize; 2]], &[usize]),
+    p: V3,
+    face: &[usize; 4],
+    pr: &Projection,
+    x: &X,
+) -> bool {
+    let c = corners(face);
+    let on_edge = match pr.region {
+        Region::Edge(i) => {
+            let (a, b) = (c[i], c[(i + 1) % c.len()]);
+            edges.binary_search(&[a.min(b), a.max(b)]).is_ok()
+        }
+        Region::Corner(i) => rim.binary_search(&c[i]).is_ok(),
+        Region::Interior { .. } => false,
+    };
+    if !on_edge {
+        return false;
+    }
+    let d = sub(p, pr.point);
+    let dn = dot(d, pr.normal);
+    let t2 = (dot(d, d) - dn * dn).max(0.0);
+    let longest = (0..c.len())
+        .map(|i| {
+            let e = sub(x(c[(i + 1) % c.len()]), x(c[i]));
+            dot(e, e)
+        })
+        .fold(0.0, f64::max);
+    t2 > super::detect::RIGID_END_MARGIN.powi(2) * longest
 }
 
 /// Two unit tangents orthonormal with the unit vector `n`: the coordinate axis
@@ -493,7 +492,7 @@ where
         for (si, side) in pair.sides.iter().enumerate() {
             match &side.master {
                 Master::Faces(faces) => {
-                    faces_side((pi, si), &side.slaves, faces, r, &x, out);
+                    faces_side((pi, si), side, faces, r, &x, out);
                 }
                 Master::Plane { point, n, tangents } => {
                     for &s in &side.slaves {
@@ -526,13 +525,18 @@ where
 /// The candidates of one side with a deformable master.
 fn faces_side<X: Fn(usize) -> V3>(
     (pi, si): (usize, usize),
-    slaves: &[usize],
+    side: &crate::model::ContactSide,
     faces: &[[usize; 4]],
     r: f64,
     x: &X,
     out: &mut Vec<Candidate>,
 ) {
     let surface = Surface::new(faces, x);
+    let slaves = &side.slaves;
+    let edges = &side.master_boundary;
+    let mut rim: Vec<usize> = edges.iter().flatten().copied().collect();
+    rim.sort_unstable();
+    rim.dedup();
     let tree = face_tree(faces, |n| std::iter::once(x(n)), 0.0);
     let mut near: Vec<(usize, Projection)> = Vec::new();
     for &s in slaves {
@@ -575,7 +579,7 @@ fn faces_side<X: Fn(usize) -> V3>(
             continue;
         };
         let (k, pr) = best;
-        if surface.beyond_boundary(p, &faces[k], &pr, x) {
+        if beyond_boundary((edges, &rim), p, &faces[k], &pr, x) {
             continue;
         }
         let key = (pi, si, s);
@@ -713,6 +717,7 @@ mod tests {
                 master: Master::Faces(faces),
                 mortar: Vec::new(),
                 faces: Vec::new(),
+                master_boundary: Vec::new(),
             }],
             radius: 1.0,
             friction: 0.0,

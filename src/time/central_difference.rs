@@ -222,7 +222,7 @@ impl Integrator for CentralDifference<'_> {
         points.iter_mut().for_each(|p| p.commit());
         let e_el0 = match totals {
             Some(t) => t.psi,
-            None => crate::energy::StoredEnergy::new(&model.mesh).of(&u, &f_int),
+            None => self.stored.of(&u, &f_int),
         };
         let mut f_ext = vec![0.0; n];
         external_force(model, self.gravity.as_deref(), 0.0, &mut f_ext);

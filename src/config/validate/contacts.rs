@@ -286,6 +286,7 @@ pub(super) fn contacts(
                     master: Master::Segments(edges.clone()),
                     mortar: mortar.clone().unwrap_or_default(),
                     faces: Vec::new(),
+                    master_boundary: Vec::new(),
                 });
                 if *both_ways {
                     let back =
@@ -308,6 +309,7 @@ pub(super) fn contacts(
                         master: Master::Segments(back),
                         mortar: Vec::new(),
                         faces: Vec::new(),
+                        master_boundary: Vec::new(),
                     });
                 }
             }
@@ -356,6 +358,7 @@ pub(super) fn contacts(
                     master: Master::Rigid { a: *a, b: *b, n },
                     mortar: Vec::new(),
                     faces: Vec::new(),
+                    master_boundary: Vec::new(),
                 });
             }
             _ => {

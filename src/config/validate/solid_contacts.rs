@@ -71,6 +71,7 @@ pub(super) fn sides(
                 master: Master::Faces(faces.clone()),
                 mortar: Vec::new(),
                 faces: slave_faces.clone(),
+                master_boundary: crate::contact::faces::boundary_edges(&faces),
             });
             if c.both_ways {
                 if slave_faces.is_empty() {
@@ -84,6 +85,7 @@ pub(super) fn sides(
                 shortest = shortest.min(short);
                 sides.push(ContactSide {
                     slaves: master_nodes,
+                    master_boundary: crate::contact::faces::boundary_edges(&slave_faces),
                     master: Master::Faces(slave_faces),
                     mortar: Vec::new(),
                     faces,
@@ -108,6 +110,7 @@ pub(super) fn sides(
                 },
                 mortar: Vec::new(),
                 faces: slave_faces,
+                master_boundary: Vec::new(),
             });
         }
         _ => {
