@@ -52,6 +52,9 @@ const GUESS_GAP_TOLERANCE: f64 = 1e-9;
 /// Multipliers below this fraction of the largest count as inactive.
 const ACTIVE_FRACTION: f64 = 1e-6;
 
+/// Rounds of one correction's QP that may add rows left out and found penetrating.
+const MAX_ROW_ROUNDS: usize = 4;
+
 /// A pressed node sticks when its tangential force is below `1 − STICK_MARGIN` of
 /// the cone's bound (the cone program ends within its tolerance of the bound).
 const STICK_MARGIN: f64 = 1e-6;
@@ -130,6 +133,9 @@ pub struct ContactCorrection<'m> {
     /// Node positions at the start of the step (`x` above is the current one).
     x0: Vec<f64>,
     delta0: Vec<f64>,
+    /// `δ₀` kept for a second round of the QP, and the candidates a round forced in.
+    delta_start: Vec<f64>,
+    forced: Vec<usize>,
     rows: Vec<usize>,
     y: Vec<f64>,
     w: Vec<f64>,
@@ -186,6 +192,8 @@ impl<'m> ContactCorrection<'m> {
             x: vec![0.0; n],
             x0: Vec::new(),
             delta0: Vec::new(),
+            delta_start: Vec::new(),
+            forced: Vec::new(),
             rows: Vec::new(),
             y: Vec::new(),
             w: Vec::new(),
@@ -427,6 +435,114 @@ impl<'m> ContactCorrection<'m> {
         c.tangential(|n, i| u[dim * n + i] - self.u0[dim * n + i])
     }
 
+    /// The rows of the QP at an iterate: the candidates predicted (by `δ₀`) to close
+    /// to within the tolerance, those active before, and those forced in by an
+    /// earlier round of the same correction; then the tangential rows of the
+    /// frictional ones. `leading`: the candidates were detected at `u + h v`.
+    fn select_rows(&mut self, g: &nalgebra_sparse::CsrMatrix<f64>, u: &[f64], leading: bool) {
+        let n_cands = self.cands.len();
+        let tdim = self.dim - 1;
+        self.rows.clear();
+        self.cones.clear();
+        self.c.clear();
+        self.gaps.clear();
+        for (i, c) in self.cands.iter().enumerate() {
+            let row = g.row(i);
+            let dot = |x: &[f64]| {
+                row.col_indices()
+                    .iter()
+                    .zip(row.values())
+                    .map(|(&e, v)| v * x[e])
+                    .sum::<f64>()
+            };
+            // The gap at u: at u + hv less its linearised change over hv.
+            let gap = if leading {
+                c.gap - dot(&self.lead)
+            } else {
+                c.gap
+            };
+            self.gaps.push(gap);
+            if row.nnz() == 0 {
+                continue;
+            }
+            let predicted = gap + dot(&self.delta0);
+            if predicted < self.tol
+                || self.previous.contains(&c.key())
+                || self.forced.binary_search(&i).is_ok()
+            {
+                self.rows.push(i);
+                self.c.push(predicted);
+            }
+        }
+        // The tangential rows of the frictional pairs' rows, after the normal ones
+        // (one per tangent, `dim − 1`): the slip since the start of the step,
+        // predicted.
+        self.normal_rows = self.rows.len();
+        self.pressed.clear();
+        self.guess_t.clear();
+        if self.frictional {
+            for &i in &self.rows {
+                let key = self.cands[i].key();
+                self.pressed.push(self.previous.binary_search(&key).is_ok());
+            }
+            for j in 0..self.normal_rows {
+                let i = self.rows[j];
+                let c = &self.cands[i];
+                let mu = self.pairs[c.pair].mu;
+                if mu > 0.0 {
+                    let slip = self.slip(c, u);
+                    for (t, s) in slip.iter().enumerate().take(tdim) {
+                        let row = g.row(n_cands + tdim * i + t);
+                        let moved: f64 = row
+                            .col_indices()
+                            .iter()
+                            .zip(row.values())
+                            .map(|(&e, v)| v * self.delta0[e])
+                            .sum();
+                        self.rows.push(n_cands + tdim * i + t);
+                        self.c.push(s + moved);
+                    }
+                    self.cones.push((j, mu));
+                    let key = c.key();
+                    let ln = self.lambda.get(&key).copied().unwrap_or(0.0);
+                    let lt = self.lambda_t.get(&key).copied().unwrap_or([0.0; 2]);
+                    self.guess_t
+                        .push(if lt[0].hypot(lt[1]) < (1.0 - STICK_MARGIN) * mu * ln {
+                            super::coulomb::Guess::Stick
+                        } else {
+                            super::coulomb::Guess::Slip(lt[0].signum())
+                        });
+                }
+            }
+        }
+    }
+
+    /// Whether the correction `δ` now in `delta0` makes a candidate left out of the
+    /// QP penetrate (beyond the QP's own accuracy); those that do are added to
+    /// `forced` for the next round.
+    fn left_out_penetrate(&mut self, g: &nalgebra_sparse::CsrMatrix<f64>) -> bool {
+        let inside = &self.rows[..self.normal_rows];
+        let floor = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let before = self.forced.len();
+        for i in 0..self.cands.len() {
+            let row = g.row(i);
+            if row.nnz() == 0 || inside.binary_search(&i).is_ok() {
+                continue;
+            }
+            let moved: f64 = row
+                .col_indices()
+                .iter()
+                .zip(row.values())
+                .map(|(&e, v)| v * self.delta0[e])
+                .sum();
+            if self.gaps[i] + moved < -floor {
+                self.forced.push(i);
+            }
+        }
+        self.forced.sort_unstable();
+        self.forced.len() > before
+    }
+
     /// The threshold below which a multiplier counts as zero: a millionth of the
     /// largest. A constraint that is only weakly active (its gap and its force both
     /// about zero, as at the instant of a release) would otherwise flip in and out of
@@ -541,100 +657,44 @@ impl Correction for ContactCorrection<'_> {
         self.delta0
             .extend(free.iter().zip(rhs.iter()).map(|(&d, &b)| b - self.f_c[d]));
         sys.solve(&mut self.delta0)?;
-        // G over the free dofs (nalgebra-sparse CSR). The rows: predicted to close, or
-        // active before; rows the free dofs cannot move are left out (nothing can
-        // enforce them).
+        // G over the free dofs (nalgebra-sparse CSR).
         let n_cands = self.cands.len();
         let g = if self.frictional {
             super::rows::gap_and_tangent_matrix(&self.cands, eq, free.len())
         } else {
             super::rows::gap_matrix(&self.cands, eq, free.len())
         };
-        self.rows.clear();
-        self.cones.clear();
-        self.c.clear();
-        self.gaps.clear();
-        for (i, c) in self.cands.iter().enumerate() {
-            let row = g.row(i);
-            let dot = |x: &[f64]| {
-                row.col_indices()
-                    .iter()
-                    .zip(row.values())
-                    .map(|(&e, v)| v * x[e])
-                    .sum::<f64>()
-            };
-            // The gap at u: at u + hv less its linearised change over hv.
-            let gap = if leading {
-                c.gap - dot(&self.lead)
-            } else {
-                c.gap
-            };
-            self.gaps.push(gap);
-            if row.nnz() == 0 {
-                continue;
-            }
-            let predicted = gap + dot(&self.delta0);
-            if predicted < self.tol || self.current.contains(&c.key()) {
-                self.rows.push(i);
-                self.c.push(predicted);
-            }
-        }
-        // The tangential rows of the frictional pairs' rows, after the normal ones
-        // (one per tangent, `dim − 1`): the slip since the start of the step,
-        // predicted.
         let tdim = self.dim - 1;
-        self.normal_rows = self.rows.len();
-        self.pressed.clear();
-        self.guess_t.clear();
-        if self.frictional {
-            for &i in &self.rows {
-                let key = self.cands[i].key();
-                self.pressed.push(self.current.binary_search(&key).is_ok());
-            }
-            for j in 0..self.normal_rows {
-                let i = self.rows[j];
-                let c = &self.cands[i];
-                let mu = self.pairs[c.pair].mu;
-                if mu > 0.0 {
-                    let slip = self.slip(c, u);
-                    for (t, s) in slip.iter().enumerate().take(tdim) {
-                        let row = g.row(n_cands + tdim * i + t);
-                        let moved: f64 = row
-                            .col_indices()
-                            .iter()
-                            .zip(row.values())
-                            .map(|(&e, v)| v * self.delta0[e])
-                            .sum();
-                        self.rows.push(n_cands + tdim * i + t);
-                        self.c.push(s + moved);
-                    }
-                    self.cones.push((j, mu));
-                    let key = c.key();
-                    let ln = self.lambda.get(&key).copied().unwrap_or(0.0);
-                    let lt = self.lambda_t.get(&key).copied().unwrap_or([0.0; 2]);
-                    self.guess_t
-                        .push(if lt[0].hypot(lt[1]) < (1.0 - STICK_MARGIN) * mu * ln {
-                            super::coulomb::Guess::Stick
-                        } else {
-                            super::coulomb::Guess::Slip(lt[0].signum())
-                        });
-                }
-            }
-        }
-        let m = self.rows.len();
         self.previous = std::mem::take(&mut self.current);
         self.lambda.clear();
         self.lambda_t.clear();
-        if m == 0 {
-            rhs.copy_from_slice(&self.delta0);
-            return Ok(Corrected::Ok);
-        }
-        self.stats.qps += 1;
-        self.stats.rows += m;
-        let status = match self.qp {
-            ContactQp::Condensed => self.condensed(sys, &g, m)?,
-            ContactQp::Full => self.full(sys, &g, rhs)?,
+        // The QP on the rows predicted to close; a row left out that the QP's
+        // correction would make penetrate joins them and the QP is solved again, so
+        // no slave is let into its master for want of a row (theory/contact.md,
+        // "rows left out").
+        self.delta_start.clone_from(&self.delta0);
+        self.forced.clear();
+        let mut rounds = 0;
+        let status = loop {
+            self.select_rows(&g, u, leading);
+            let m = self.rows.len();
+            if m == 0 {
+                rhs.copy_from_slice(&self.delta0);
+                return Ok(Corrected::Ok);
+            }
+            self.stats.qps += 1;
+            self.stats.rows += m;
+            let status = match self.qp {
+                ContactQp::Condensed => self.condensed(sys, &g, m)?,
+                ContactQp::Full => self.full(sys, &g, rhs)?,
+            };
+            rounds += 1;
+            if status.is_err() || rounds > MAX_ROW_ROUNDS || !self.left_out_penetrate(&g) {
+                break status;
+            }
+            self.delta0.clone_from(&self.delta_start);
         };
+
         if let Err(status) = status {
             let worst = self
                 .cands
@@ -682,7 +742,6 @@ impl Correction for ContactCorrection<'_> {
                 self.current.push(key);
             }
         }
-        let tdim = self.dim - 1;
         for (k, &(j, _)) in self.cones.iter().enumerate() {
             let mut l = [0.0; 2];
             l[..tdim].copy_from_slice(&self.lambda_rows[nr + tdim * k..nr + tdim * (k + 1)]);
