@@ -347,6 +347,34 @@ fn a_solid_block_on_an_incline_sliding_off_the_axes_follows_the_closed_forms() {
     assert!(rec.sticking > 0 && rec.slipping == 0, "{rec:?}");
 }
 
+/// Large coefficients stick in a solid too (the cone programs' shift did not settle
+/// from μ ≈ 10: 1233 cut steps at μ = 100, a failure at 1e4): the sticking statuses
+/// give the law's solution, the block held by the weight's tangential part.
+#[test]
+fn a_solid_block_on_an_incline_sticks_at_any_large_friction() {
+    let (theta, phi) = (30f64.to_radians(), 35f64.to_radians());
+    for mu in [100.0, 1e4] {
+        let (m, s) = run_incline(theta, phi, mu);
+        let (v, u) = mean_xz(&m, &s);
+        assert!(
+            v[0].hypot(v[1]) < 1e-6 && u[0].hypot(u[1]) < 1e-7,
+            "μ = {mu}: {v:?} {u:?}"
+        );
+        let rec = s.contact.pairs[0];
+        assert!(rec.sticking > 0 && rec.slipping == 0, "μ = {mu}: {rec:?}");
+        // The nodes' forces sum to the weight's tangential part; their magnitudes (the
+        // record's) to at least that, a little more where the bottom's edges shear
+        // outwards.
+        let hold = 7850.0 * 1e-3 * G * theta.sin();
+        let t = rec.tangential_magnitude;
+        assert!(
+            t > (1.0 - 1e-3) * hold && t < 1.1 * hold,
+            "μ = {mu}: {} against {hold}",
+            rec.tangential_magnitude
+        );
+    }
+}
+
 /// A block 0.4 x 0.2 x 0.4 m pressed by a uniform traction `p` on its top onto
 /// a base of the same material; the two meshes' divisions in x and z.
 fn patch(upper: [usize; 2], lower: [usize; 2], p: f64) -> String {

@@ -89,7 +89,15 @@ fn run_incline(theta: f64, mu: f64) -> (Model, State, f64) {
             "{rec:?}"
         );
         let l = &s.ledger;
-        assert!(l.dissipated().friction >= -1e-12 * l.scale());
+        // A sticking node's slip is zero to the round-off of the solves (1e-17 m here):
+        // times its force, up to 1.5e-8 of the tiny scale of a block at rest (μ = 1e3).
+        assert!(
+            l.dissipated().friction >= -1e-6 * l.scale(),
+            "μ = {mu}: D_friction {:e} of {:e} at t = {:e}",
+            l.dissipated().friction,
+            l.scale(),
+            s.t
+        );
         assert!(
             l.residual().abs() <= 1e-8 * l.scale(),
             "ledger residual {} of {}",
@@ -138,8 +146,24 @@ fn a_block_on_an_incline_slides_with_the_closed_form_acceleration() {
 
 #[test]
 fn a_block_on_an_incline_sticks_below_the_friction_angle() {
+    assert_sticks(0.7);
+}
+
+/// Large coefficients stick as well: the cone programs' shift is `μ` times a slip
+/// known to Clarabel's tolerance, which no longer settled for `μ ≳ 10` (a crawl of
+/// cut steps at 100, a failure from 1e3); the iteration on statuses finds the law's
+/// solution (theory/friction.md, "large μ").
+#[test]
+fn a_block_on_an_incline_sticks_at_any_large_friction() {
+    for mu in [10.0, 1e3, 1e6] {
+        assert_sticks(mu);
+    }
+}
+
+/// The incline at 30° with `mu > tan 30°`: the block stays, held by the weight's
+/// tangential part, and only micro-slip dissipates.
+fn assert_sticks(mu: f64) {
     let theta = 30f64.to_radians();
-    let mu = 0.7;
     assert!(theta.tan() < mu);
     let (m, s, _) = run_incline(theta, mu);
     let (v, u) = mean_x(&m, &s);
@@ -269,6 +293,45 @@ fn an_oblique_impact_keeps_friction_in_the_cone_and_conserves_momentum() {
             l.residual().abs() < 1e-8 * l.scale(),
             "{formulation}: {}",
             l.residual()
+        );
+    }
+}
+
+#[test]
+fn an_oblique_impact_with_a_large_coefficient_sticks_and_conserves_momentum() {
+    for formulation in ["mortar", "node_to_segment"] {
+        let mu = 1e3;
+        let m = model(&oblique(mu, formulation));
+        let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let p = |s: &State, dir: usize| {
+            (0..m.mesh.n_nodes())
+                .map(|i| s.mv[2 * i + dir])
+                .sum::<f64>()
+        };
+        let (px0, py0) = (p(&s, 0), p(&s, 1));
+        let mut stuck = 0;
+        for _ in 0..m.analysis.n_steps() {
+            be.step_accepted(&mut s).unwrap();
+            let rec = s.contact.pairs[0];
+            stuck += rec.sticking;
+            assert!(rec.tangential_force.abs() <= mu * rec.force * (1.0 + 1e-6) + 1e-9);
+        }
+        assert!(stuck > 0, "{formulation}: nothing stuck");
+        let scale = px0.abs().max(py0.abs());
+        assert!((p(&s, 0) - px0).abs() < 1e-9 * scale, "{formulation}");
+        assert!((p(&s, 1) - py0).abs() < 1e-9 * scale, "{formulation}");
+        let l = &s.ledger;
+        assert!(l.dissipated().friction >= -1e-12 * l.scale());
+        assert!(
+            l.residual().abs() < 1e-8 * l.scale(),
+            "{formulation}: {}",
+            l.residual()
+        );
+        // The sliding of μ = 0.3 takes a fifth of the energy; sticking almost none.
+        assert!(
+            l.dissipated().friction < 1e-2 * l.kinetic_0(),
+            "{formulation}"
         );
     }
 }

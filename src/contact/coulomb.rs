@@ -100,6 +100,11 @@ pub(crate) fn solve(
         .map_err(|e| format!("Clarabel setup: {e}"))?;
     let mut stats = QpStats::default();
     let f = ell / w_bar;
+    // The shift is μ times a slip Clarabel gives to about 1e-9 of `ell`: it settles to
+    // the tolerance scaled by the largest μ (theory/friction.md, "large μ").
+    let mu_max = cones.iter().fold(1.0f64, |a, &(_, mu)| a.max(mu));
+    let mut last_moved = f64::INFINITY;
+    let mut by_status = Vec::new();
     for _ in 0..MAX_SHIFT_ITERATIONS {
         solver.solve();
         accept(solver.solution.status)?;
@@ -126,12 +131,28 @@ pub(crate) fn solve(
             shift[k] = s;
             q[j] = (c[j] + s) / ell;
         }
-        if moved <= SHIFT_TOLERANCE * ell {
+        if moved <= SHIFT_TOLERANCE * mu_max * ell {
+            // With μ > 1 the cone's two entries differ by μ and Clarabel's tolerance on
+            // the larger one is a tolerance of μ on the tangential force: in the plane
+            // the statuses polish it to the law's solution.
+            if mu_max > 1.0 && by_statuses(w, c, (n, tdim, cones), lambda, ell, &mut by_status) {
+                lambda.copy_from_slice(&by_status);
+                return Ok(stats);
+            }
             for l in &mut lambda[..n] {
                 *l = l.max(0.0);
             }
             return Ok(stats);
         }
+        // Not contracting by half: in the plane the law is linear on statuses, and
+        // an iteration on them from where this program ended finds its solution.
+        if moved > 0.5 * last_moved
+            && by_statuses(w, c, (n, tdim, cones), lambda, ell, &mut by_status)
+        {
+            lambda.copy_from_slice(&by_status);
+            return Ok(stats);
+        }
+        last_moved = moved;
         solver
             .update_q(&q)
             .map_err(|e| format!("Clarabel update: {e:?}"))?;
@@ -139,6 +160,54 @@ pub(crate) fn solve(
     Err(format!(
         "the friction shift did not settle in {MAX_SHIFT_ITERATIONS} cone programs"
     ))
+}
+
+/// Rounds of the status iteration before it is given up.
+const MAX_STATUS_ROUNDS: usize = 16;
+
+/// Coulomb's law in the plane by an iteration on statuses, started from those a cone
+/// program's forces `lambda` end in (a normal row pressed if its force exceeds a
+/// millionth of the largest; a node sticking inside the cone, or slipping against
+/// its tangential force): each round solves the linear law of its statuses and
+/// changes those the result breaks. True, with the forces in `out`, when a round's
+/// result satisfies the whole law.
+fn by_statuses(
+    w: &[f64],
+    c: &[f64],
+    (n, tdim, cones): (usize, usize, &[(usize, f64)]),
+    lambda: &[f64],
+    ell: f64,
+    out: &mut Vec<f64>,
+) -> bool {
+    let largest = lambda[..n].iter().fold(0.0f64, |a, x| a.max(*x));
+    let mut pressed: Vec<bool> = lambda[..n].iter().map(|&l| l > 1e-6 * largest).collect();
+    let mut guess: Vec<Guess> = cones
+        .iter()
+        .enumerate()
+        .map(|(k, &(j, mu))| {
+            let t = &lambda[n + tdim * k..n + tdim * (k + 1)];
+            if t.iter().map(|x| x * x).sum::<f64>().sqrt() < (1.0 - 1e-6) * mu * lambda[j] {
+                Guess::Stick
+            } else {
+                Guess::Slip(t[0].signum())
+            }
+        })
+        .collect();
+    for _ in 0..MAX_STATUS_ROUNDS {
+        match law_on_guess(
+            w,
+            c,
+            (n, cones),
+            (&mut pressed, &mut guess),
+            1e-9 * ell,
+            out,
+        ) {
+            Verdict::Holds => return true,
+            Verdict::Singular => return false,
+            Verdict::Changed => {}
+        }
+    }
+    false
 }
 
 /// A CSC matrix from `(row, column, value)` triplets (distinct positions).
@@ -288,23 +357,63 @@ pub(crate) fn solve_by_guess(
     tol: f64,
     lambda: &mut Vec<f64>,
 ) -> bool {
+    let mut p = pressed.to_vec();
+    let mut g = guess.to_vec();
+    law_on_guess(w, c, (n, cones), (&mut p, &mut g), tol, lambda) == Verdict::Holds
+}
+
+/// What the law says of the forces a guess of statuses gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Verdict {
+    /// They satisfy the whole law: the law's solution.
+    Holds,
+    /// Some statuses were wrong and have been changed to what the forces say.
+    Changed,
+    /// The linear system of the guess is singular.
+    Singular,
+}
+
+/// [`solve_by_guess`]'s elimination and check; where the law is broken, the statuses
+/// are changed to what the forces and gaps say (a pressed row pulling opens, an open
+/// row penetrating is pressed, a sticking force outside the cone slips with its
+/// sign, a slip along its force sticks), the step of a status iteration.
+fn law_on_guess(
+    w: &[f64],
+    c: &[f64],
+    (n, cones): (usize, &[(usize, f64)]),
+    (pressed, guess): (&mut [bool], &mut [Guess]),
+    tol: f64,
+    lambda: &mut Vec<f64>,
+) -> Verdict {
     let m = c.len();
+    // One tangential row per node in the plane, two in a solid, where a slip (its
+    // direction unknown) is not linear.
+    let tdim = if cones.is_empty() {
+        1
+    } else {
+        (m - n) / cones.len()
+    };
+    if tdim > 1
+        && cones
+            .iter()
+            .zip(guess.iter())
+            .any(|(&(j, _), g)| pressed[j] && *g != Guess::Stick)
+    {
+        return Verdict::Singular;
+    }
     // Unknowns: λ_N of the pressed rows, then λ_T of their sticking nodes.
-    let mut var = vec![usize::MAX; m];
     let mut rows = Vec::new();
     for j in (0..n).filter(|&j| pressed[j]) {
-        var[j] = rows.len();
         rows.push(j);
     }
     for (k, &(j, _)) in cones.iter().enumerate() {
         if pressed[j] && guess[k] == Guess::Stick {
-            var[n + k] = rows.len();
-            rows.push(n + k);
+            rows.extend((0..tdim).map(|i| n + tdim * k + i));
         }
     }
     let q = rows.len();
     if q == 0 {
-        return false;
+        return Verdict::Singular;
     }
     // dΛ/dx: a pressed row's λ_N also drives its slipping node's λ_T.
     let mut slip_of = vec![None; n];
@@ -326,7 +435,7 @@ pub(crate) fn solve_by_guess(
         }
     }
     if !eliminate(&mut b, &mut rhs, q) {
-        return false;
+        return Verdict::Singular;
     }
     lambda.clear();
     lambda.resize(m, 0.0);
@@ -339,30 +448,47 @@ pub(crate) fn solve_by_guess(
     // The whole law.
     let scale = lambda.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     let y = |r: usize, lambda: &[f64]| c[r] + (0..m).map(|i| w[r + i * m] * lambda[i]).sum::<f64>();
+    let mut changed = false;
     for j in 0..n {
         if pressed[j] {
             if lambda[j] < -1e-12 * scale {
-                return false;
+                pressed[j] = false;
+                changed = true;
             }
         } else if y(j, lambda) < -tol {
-            return false;
+            pressed[j] = true;
+            changed = true;
         }
     }
     for (k, &(j, mu)) in cones.iter().enumerate() {
-        let (ln, lt) = (lambda[j], lambda[n + k]);
-        let broken = match guess[k] {
-            _ if !pressed[j] => false,
-            Guess::Stick => lt.abs() > mu * ln * (1.0 + 1e-12) + 1e-12 * scale,
-            Guess::Slip(sign) => sign * y(n + k, lambda) > tol,
-        };
-        if broken {
-            return false;
+        if !pressed[j] {
+            continue;
         }
+        let ln = lambda[j];
+        let lt = lambda[n + tdim * k..n + tdim * (k + 1)]
+            .iter()
+            .map(|x| x * x)
+            .sum::<f64>()
+            .sqrt();
+        match guess[k] {
+            Guess::Stick if lt > mu * ln * (1.0 + 1e-12) + 1e-12 * scale => {
+                guess[k] = Guess::Slip(lambda[n + tdim * k].signum());
+                changed = true;
+            }
+            Guess::Slip(sign) if sign * y(n + k, lambda) > tol => {
+                guess[k] = Guess::Stick;
+                changed = true;
+            }
+            _ => {}
+        }
+    }
+    if changed {
+        return Verdict::Changed;
     }
     for l in &mut lambda[..n] {
         *l = l.max(0.0);
     }
-    true
+    Verdict::Holds
 }
 
 /// Solves the dense `q x q` system `b x = rhs` (column-major) by Gaussian elimination
