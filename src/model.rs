@@ -384,6 +384,21 @@ pub struct ContactSide {
     pub master_boundary: Vec<[usize; 2]>,
 }
 
+impl ContactSide {
+    /// The nodes of a deformable master (segments' or faces' corners, with
+    /// repeats); none for a rigid one.
+    pub fn master_nodes(&self) -> Vec<usize> {
+        match &self.master {
+            Master::Segments(segs) => segs.iter().flatten().copied().collect(),
+            Master::Faces(faces) => faces
+                .iter()
+                .flat_map(|f| crate::contact::faces::corners(f).iter().copied())
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+}
+
 /// How a deformable pair's impenetrability is written (`theory/contact.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
 #[serde(rename_all = "snake_case")]

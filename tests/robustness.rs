@@ -1605,3 +1605,32 @@ fn a_body_held_by_frictionless_contact_alone_carries_any_pressure() {
         }
     }
 }
+
+#[test]
+fn a_static_load_that_contact_alone_cannot_hold_names_the_body_and_the_pair() {
+    // The seated block pushed sideways as well as down: frictionless contact cannot
+    // hold the push, and statics has no equilibrium. The failure says so, with the
+    // body, the pair and what to add, not only "no convergence".
+    for file in ["held_by_contact.toml", "held_by_contact_solid.toml"] {
+        let text = std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/data")
+                .join(file),
+        )
+        .unwrap();
+        let pushed = text.replace("[0.0, -3.0e6", "[1.0e5, -3.0e6");
+        assert_ne!(pushed, text);
+        let (ok, err, _) = run_history(&pushed, &[]);
+        assert!(!ok, "{file}: a frictionless block pushed sideways stood");
+        for w in [
+            "body `block` has no support against this motion",
+            "contact pair(s) `seat` alone",
+            "frictionless contact carries only pressure",
+            "friction (`mu`)",
+        ] {
+            assert!(err.contains(w), "{file}: `{w}` not in: {err}");
+        }
+        // The residuals are summed up, not listed to the last iteration.
+        assert!(err.contains("…"), "{err}");
+    }
+}

@@ -19,7 +19,7 @@ pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> Str
             history,
             worst,
         } => {
-            let worst = worst
+            let worst_text = worst
                 .map(|(d, r)| {
                     format!(
                         "; largest residual {:.3e} N at {}",
@@ -28,13 +28,13 @@ pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> Str
                     )
                 })
                 .unwrap_or_default();
+            let unheld = worst
+                .as_ref()
+                .and_then(|&(d, _)| unheld_load(model, d))
+                .unwrap_or_default();
             format!(
-                "no convergence {when} after {iterations} iterations; relative residuals [{}]{worst}",
-                history
-                    .iter()
-                    .map(|r| format!("{r:.2e}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                "no convergence {when} after {iterations} iterations; relative residuals {}{worst_text}{unheld}",
+                residuals(history)
             )
         }
         Outcome::NotPositiveDefinite { dof, message } => format!(
@@ -57,6 +57,75 @@ pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> Str
                 .unwrap_or_default()
         ),
     }
+}
+
+/// The relative residuals of a failed loop: all of them up to eight, else the first
+/// three and the last three, and whether the last ones stagnate (within 1 %).
+fn residuals(history: &[f64]) -> String {
+    let show = |r: &[f64]| {
+        r.iter()
+            .map(|r| format!("{r:.2e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if history.len() <= 8 {
+        return format!("[{}]", show(history));
+    }
+    let tail = &history[history.len() - 3..];
+    let last = tail[2];
+    let stagnant = tail.iter().all(|&r| (r - last).abs() <= 0.01 * last.abs());
+    format!(
+        "[{}, …, {}]{}",
+        show(&history[..3]),
+        show(tail),
+        if stagnant {
+            format!(" (stagnant at {last:.2e})")
+        } else {
+            String::new()
+        }
+    )
+}
+
+/// In statics, when the largest residual of a failed loop sits on a body that
+/// only contact holds: that body, its pairs and what the load needs.
+fn unheld_load(model: &Model, dof: usize) -> Option<String> {
+    if model.analysis.time.kind != crate::model::AnalysisKind::Static {
+        return None;
+    }
+    let mesh = &model.mesh;
+    let body = mesh.node_body[dof / mesh.dim];
+    if !super::statics::bodies_held_by_contact_only(model).contains(&body) {
+        return None;
+    }
+    let pairs: Vec<String> = model
+        .contacts
+        .iter()
+        .filter(|p| {
+            p.sides.iter().any(|s| {
+                s.slaves.iter().any(|&n| mesh.node_body[n] == body)
+                    || s.master_nodes().iter().any(|&n| mesh.node_body[n] == body)
+            })
+        })
+        .map(|p| format!("`{}`", p.name))
+        .collect();
+    let frictionless = model.contacts.iter().all(|p| p.mu == 0.0);
+    Some(format!(
+        "; body `{}` has no support against this motion and is held by contact pair(s) {} \
+         alone, which cannot carry the load on it ({}): a static load without \
+         equilibrium. Add a support, {}or run it dynamically",
+        model.bodies[body].name,
+        pairs.join(", "),
+        if frictionless {
+            "frictionless contact carries only pressure across the surface"
+        } else {
+            "the contact's friction cone cannot hold it, or the load pulls it off"
+        },
+        if frictionless {
+            "friction (`mu`), "
+        } else {
+            ""
+        }
+    ))
 }
 
 /// Why the initial effective matrix is not positive definite, as far as can be told:

@@ -131,6 +131,12 @@ pub const STATIC_SEAT: f64 = 1e-8;
 /// Whether some body with a contact side has a rigid motion (translation or
 /// rotation) that its supports and prescribed displacements do not hold.
 fn held_by_contact_only(model: &Model) -> bool {
+    !bodies_held_by_contact_only(model).is_empty()
+}
+
+/// The bodies with a contact side that have a rigid motion (translation or rotation)
+/// their supports and prescribed displacements do not hold.
+pub(crate) fn bodies_held_by_contact_only(model: &Model) -> Vec<usize> {
     let mesh = &model.mesh;
     let dim = mesh.dim;
     let mut in_contact = vec![false; model.bodies.len()];
@@ -139,15 +145,7 @@ fn held_by_contact_only(model: &Model) -> bool {
             for &n in &side.slaves {
                 in_contact[mesh.node_body[n]] = true;
             }
-            let master: Vec<usize> = match &side.master {
-                crate::model::Master::Segments(segs) => segs.iter().flatten().copied().collect(),
-                crate::model::Master::Faces(faces) => faces
-                    .iter()
-                    .flat_map(|f| crate::contact::faces::corners(f).iter().copied())
-                    .collect(),
-                _ => Vec::new(),
-            };
-            for n in master {
+            for n in side.master_nodes() {
                 in_contact[mesh.node_body[n]] = true;
             }
         }
@@ -155,82 +153,85 @@ fn held_by_contact_only(model: &Model) -> bool {
     // Rigid modes: the translations, then the rotations (one in the plane, about z;
     // three in a solid).
     let modes = if dim == 3 { 6 } else { 3 };
-    (0..model.bodies.len()).filter(|&b| in_contact[b]).any(|b| {
-        // Gram matrix of the rigid modes about the body's centroid on the body's
-        // constrained dofs: singular when a mode is free.
-        let nodes: Vec<usize> = (0..mesh.n_nodes())
-            .filter(|&n| mesh.node_body[n] == b)
-            .collect();
-        let mut c = [0.0; 3];
-        for &n in &nodes {
-            for i in 0..dim {
-                c[i] += mesh.coords[n][i] / nodes.len() as f64;
-            }
-        }
-        let mut g = [[0.0f64; 6]; 6];
-        let mut size: f64 = 0.0;
-        for con in &model.constraints {
-            let (n, comp) = (con.dof / dim, con.dof % dim);
-            if mesh.node_body[n] != b {
-                continue;
-            }
-            let mut r = [0.0; 3];
-            for i in 0..dim {
-                r[i] = mesh.coords[n][i] - c[i];
-                size = size.max(r[i].abs());
-            }
-            // The dof's component of each mode: e_comp for the translations,
-            // (e_a × r)_comp for the rotations about axis a.
-            let mut row = [0.0; 6];
-            row[comp] = 1.0;
-            let rot = |a: usize| match (a, comp) {
-                (0, 1) => -r[2],
-                (0, 2) => r[1],
-                (1, 0) => r[2],
-                (1, 2) => -r[0],
-                (2, 0) => -r[1],
-                (2, 1) => r[0],
-                _ => 0.0,
-            };
-            if dim == 3 {
-                for a in 0..3 {
-                    row[3 + a] = rot(a);
-                }
-            } else {
-                row[2] = rot(2);
-            }
-            for i in 0..modes {
-                for j in 0..modes {
-                    g[i][j] += row[i] * row[j];
+    (0..model.bodies.len())
+        .filter(|&b| in_contact[b])
+        .filter(|&b| {
+            // Gram matrix of the rigid modes about the body's centroid on the body's
+            // constrained dofs: singular when a mode is free.
+            let nodes: Vec<usize> = (0..mesh.n_nodes())
+                .filter(|&n| mesh.node_body[n] == b)
+                .collect();
+            let mut c = [0.0; 3];
+            for &n in &nodes {
+                for i in 0..dim {
+                    c[i] += mesh.coords[n][i] / nodes.len() as f64;
                 }
             }
-        }
-        if size == 0.0 {
-            return true;
-        }
-        // Rotations in units of the body's size, then a Cholesky factorisation:
-        // a pivot below 1e-10 of the largest diagonal is a free mode.
-        for (i, row) in g.iter_mut().enumerate().take(modes) {
-            for (j, v) in row.iter_mut().enumerate().take(modes) {
-                let f = |k: usize| if k >= dim { size } else { 1.0 };
-                *v /= f(i) * f(j);
+            let mut g = [[0.0f64; 6]; 6];
+            let mut size: f64 = 0.0;
+            for con in &model.constraints {
+                let (n, comp) = (con.dof / dim, con.dof % dim);
+                if mesh.node_body[n] != b {
+                    continue;
+                }
+                let mut r = [0.0; 3];
+                for i in 0..dim {
+                    r[i] = mesh.coords[n][i] - c[i];
+                    size = size.max(r[i].abs());
+                }
+                // The dof's component of each mode: e_comp for the translations,
+                // (e_a × r)_comp for the rotations about axis a.
+                let mut row = [0.0; 6];
+                row[comp] = 1.0;
+                let rot = |a: usize| match (a, comp) {
+                    (0, 1) => -r[2],
+                    (0, 2) => r[1],
+                    (1, 0) => r[2],
+                    (1, 2) => -r[0],
+                    (2, 0) => -r[1],
+                    (2, 1) => r[0],
+                    _ => 0.0,
+                };
+                if dim == 3 {
+                    for a in 0..3 {
+                        row[3 + a] = rot(a);
+                    }
+                } else {
+                    row[2] = rot(2);
+                }
+                for i in 0..modes {
+                    for j in 0..modes {
+                        g[i][j] += row[i] * row[j];
+                    }
+                }
             }
-        }
-        let scale = (0..modes).fold(0.0f64, |a, i| a.max(g[i][i]));
-        for k in 0..modes {
-            let p = g[k][k];
-            if p <= 1e-10 * scale {
+            if size == 0.0 {
                 return true;
             }
-            for i in k + 1..modes {
-                let f = g[i][k] / p;
-                for j in k..modes {
-                    g[i][j] -= f * g[k][j];
+            // Rotations in units of the body's size, then a Cholesky factorisation:
+            // a pivot below 1e-10 of the largest diagonal is a free mode.
+            for (i, row) in g.iter_mut().enumerate().take(modes) {
+                for (j, v) in row.iter_mut().enumerate().take(modes) {
+                    let f = |k: usize| if k >= dim { size } else { 1.0 };
+                    *v /= f(i) * f(j);
                 }
             }
-        }
-        false
-    })
+            let scale = (0..modes).fold(0.0f64, |a, i| a.max(g[i][i]));
+            for k in 0..modes {
+                let p = g[k][k];
+                if p <= 1e-10 * scale {
+                    return true;
+                }
+                for i in k + 1..modes {
+                    let f = g[i][k] / p;
+                    for j in k..modes {
+                        g[i][j] -= f * g[k][j];
+                    }
+                }
+            }
+            false
+        })
+        .collect()
 }
 
 /// The multiple of `M` statics add to the matrix: [`STATIC_SEAT`] times
