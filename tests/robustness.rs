@@ -1634,3 +1634,40 @@ fn a_static_load_that_contact_alone_cannot_hold_names_the_body_and_the_pair() {
         assert!(err.contains("…"), "{err}");
     }
 }
+
+/// A solid block (0.1 x 0.05 x 0.1 m) over a solid base, no gravity, its bottom at
+/// `y` (0.2 touches) and its velocity `v` (x, y), 200 steps of 20 µs.
+fn touching_block(y: f64, v: [f64; 2]) -> String {
+    format!(
+        "[analysis]\nt_end = 4.0e-3\ndt = 2.0e-5\nvtk_every = 0\n\n\
+         [materials.steel]\nmodel = \"elastic\"\nE = 210e9\nnu = 0.3\nrho = 7850.0\n\n\
+         [[bodies]]\nname = \"base\"\nmaterial = \"steel\"\n\
+         mesh = {{ kind = \"box\", size = [1.0, 0.2, 0.2], divisions = [5, 1, 1] }}\n\n\
+         [[bodies]]\nname = \"block\"\nmaterial = \"steel\"\nvelocity = [{}, {}, 0.0]\n\
+         mesh = {{ kind = \"box\", origin = [0.3, {y}, 0.05], size = [0.1, 0.05, 0.1], divisions = [2, 1, 2] }}\n\n\
+         [[supports]]\nset = \"base.bottom\"\nfix = [\"x\", \"y\", \"z\"]\n\n\
+         [[contact]]\nname = \"seat\"\nslave = \"block.bottom\"\nmaster = \"base.top\"\n",
+        v[0], v[1]
+    )
+}
+
+#[test]
+fn a_solid_resting_or_grazing_at_a_zero_gap_keeps_its_steps() {
+    // At rest on the base, sliding over it, and landing exactly at the end of the
+    // fifth step: the gaps are zero to round-off, and so are the first forces. A
+    // multiplier that closes only a gap of round-off is no active constraint, so
+    // the active set does not flip on round-off forces and no step is cut (9, 2 and
+    // 2 cut steps before).
+    let landing = 0.2 + 0.5 * 2.0e-5 * 5.0;
+    for (what, y, v) in [
+        ("resting", 0.2, [0.0, 0.0]),
+        ("sliding", 0.2, [1.0, 0.0]),
+        ("landing", landing, [0.0, -0.5]),
+    ] {
+        let (ok, err, h, s) = run_history_and_summary(&touching_block(y, v), &[]);
+        assert!(ok, "{what}: {err}");
+        assert_eq!(h["t"].len(), 201, "{what}: steps were cut");
+        let rel = s["energy"]["balance_residual_rel"].as_f64().unwrap();
+        assert!(rel.abs() < 1e-8, "{what}: ledger {rel:e}");
+    }
+}

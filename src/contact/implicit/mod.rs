@@ -52,6 +52,10 @@ const GUESS_GAP_TOLERANCE: f64 = 1e-9;
 /// Multipliers below this fraction of the largest count as inactive.
 const ACTIVE_FRACTION: f64 = 1e-6;
 
+/// Ulps of the largest coordinate below which a multiplier's own closure of its gap
+/// is round-off.
+const GAP_ROUNDOFF: f64 = 8.0;
+
 /// Rounds of one correction's QP that may add rows left out and found penetrating.
 const MAX_ROW_ROUNDS: usize = 4;
 
@@ -90,6 +94,8 @@ pub struct ContactCorrection<'m> {
     model: &'m Model,
     pairs: &'m [ContactPair],
     tol: f64,
+    /// The gap the coordinates resolve (m): [`GAP_ROUNDOFF`] ulps of the largest.
+    gap_floor: f64,
     qp: ContactQp,
     /// Tributary area (length × thickness) of each node as a slave, for pressures.
     area: Vec<f64>,
@@ -171,6 +177,14 @@ impl<'m> ContactCorrection<'m> {
             model,
             pairs: &model.contacts,
             tol: model.analysis.contact.tolerance,
+            gap_floor: GAP_ROUNDOFF
+                * f64::EPSILON
+                * model
+                    .mesh
+                    .coords
+                    .iter()
+                    .flat_map(|c| c.iter())
+                    .fold(0.0f64, |a, x| a.max(x.abs())),
             qp: model.analysis.contact.qp,
             area,
             dofs: crate::system::DofMap::new(n, model.constraints.iter().map(|c| c.dof)),
@@ -731,14 +745,21 @@ impl Correction for ContactCorrection<'_> {
         // their force out of the balance); the active set, for the test that it has
         // settled and for complementarity, holds the significant ones.
         let nr = self.normal_rows;
+        // A multiplier whose own closure `λ W_jj` is below what the coordinates
+        // resolve holds a gap of round-off, not a contact: left out of the active
+        // set (its force still acts), or a slave resting or grazing at a gap of
+        // exactly zero flips in and out of the set on round-off forces.
         let threshold = self.active_threshold(&self.lambda_rows[..nr]);
+        let m = self.rows.len();
+        let condensed = self.w.len() == m * m;
         for (j, &i) in self.rows[..nr].iter().enumerate() {
             let l = self.lambda_rows[j];
             let key = self.cands[i].key();
             if l > 0.0 {
                 self.lambda.insert(key, l);
             }
-            if l > threshold {
+            let resolved = !condensed || l * self.w[j + j * m] > self.gap_floor;
+            if l > threshold && resolved {
                 self.current.push(key);
             }
         }
