@@ -1,5 +1,6 @@
 //! Criterion benches of workload W1 (see `rothe::workload`): element assembly of K and
-//! M, numeric factorisation of the effective matrix, and one backward-Euler step, each
+//! M, numeric factorisation of the effective matrix, and one backward-Euler step and
+//! one trapezoidal step, each
 //! at several sizes (`ny`), with setup outside the timed loop. Larger sizes and the
 //! CHOLMOD backend: `cargo run --release --example w1 -- NY [faer|cholmod]`.
 
@@ -43,6 +44,14 @@ fn factorisation_and_step(c: &mut Criterion) {
         let mut s = be.initial_state();
         g.bench_with_input(BenchmarkId::new("step", ny), &ny, |b, _| {
             b.iter(|| be.step_accepted(&mut s).unwrap())
+        });
+        // The trapezoidal rule's step beside it (theory/trapezoidal.md).
+        let mut trap = model.clone();
+        trap.analysis.time.scheme = rothe::model::TimeScheme::Trapezoidal;
+        let mut tr = BackwardEuler::new(&trap, Backend::Faer).unwrap();
+        let mut s = tr.initial_state();
+        g.bench_with_input(BenchmarkId::new("step_trapezoidal", ny), &ny, |b, _| {
+            b.iter(|| tr.step_accepted(&mut s).unwrap())
         });
     }
     g.finish();

@@ -198,7 +198,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         cfl,
         stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
         scheme: (a.time.kind == crate::model::AnalysisKind::Dynamic).then_some(a.time.scheme),
-        iteration: (a.time.scheme == crate::model::TimeScheme::BackwardEuler
+        iteration: (a.time.scheme.is_implicit()
             && model.materials.iter().any(|m| !m.has_constant_tangent()))
         .then_some((a.iteration.method, a.iteration.refactor_rate)),
         nnz: (system.matrix().row_idx.len(), nnz_l),
@@ -290,6 +290,8 @@ impl fmt::Display for Report {
                 "scheme      {}",
                 match scheme {
                     crate::model::TimeScheme::BackwardEuler => "backward Euler (implicit)",
+                    crate::model::TimeScheme::Trapezoidal =>
+                        "trapezoidal rule (implicit, second order, contact at the step's end)",
                     crate::model::TimeScheme::CentralDifference =>
                         "central differences (explicit, lumped mass, kinematic contact)",
                 }

@@ -63,6 +63,9 @@ enum Command {
         scenario: ScenarioArgs,
         #[command(flatten)]
         sweep: SweepArgs,
+        /// The implicit run's scheme: backward_euler or trapezoidal.
+        #[arg(long, default_value = "backward_euler")]
+        implicit_scheme: String,
     },
     /// Draw the charts of a run's output directory into DIR/plots (PNG and SVG).
     Plot {
@@ -354,9 +357,15 @@ fn main() -> ExitCode {
             overwrite,
         } => run_command(&scenario, &out, backend, quiet, record_fields, overwrite),
         Command::Study { study } => study_command(study),
-        Command::Compare { scenario, sweep } => scenario
+        Command::Compare {
+            scenario,
+            sweep,
+            implicit_scheme,
+        } => scenario
             .overrides()
-            .and_then(|base| rothe::study::compare::plan(&scenario.scenario, &base))
+            .and_then(|base| {
+                rothe::study::compare::plan(&scenario.scenario, &base, &implicit_scheme)
+            })
             .and_then(|plan| sweep.execute(&plan)),
         Command::Plot { dir } => rothe::plot::plot_run(&dir).map(|files| {
             for f in files {

@@ -152,8 +152,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             backend: opts.backend.name().into(),
             factorizations: 0,
             reused_factors: 0,
-            keep_factor: a.time.scheme == TimeScheme::BackwardEuler
-                && a.iteration.refactor_rate.is_some(),
+            keep_factor: a.time.scheme.is_implicit() && a.iteration.refactor_rate.is_some(),
             fallbacks: 0,
             iterations: 0,
             iterations_per_step: 0.0,
@@ -172,7 +171,7 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         catch_unwind(AssertUnwindSafe(|| match (a.time.kind, a.time.scheme) {
             (AnalysisKind::Dynamic, TimeScheme::CentralDifference) => CentralDifference::new(model)
                 .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
-            (AnalysisKind::Dynamic, TimeScheme::BackwardEuler) => {
+            (AnalysisKind::Dynamic, TimeScheme::BackwardEuler | TimeScheme::Trapezoidal) => {
                 BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
                     .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
             }

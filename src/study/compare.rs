@@ -13,11 +13,19 @@ use crate::config::Overrides;
 use crate::error::{Error, Result};
 use crate::plot::{draw, Figure, Series, Style};
 
-/// The two runs of a comparison of `scenario` (with `base` applied to both).
-pub fn plan(scenario: &Path, base: &Overrides) -> Result<Plan> {
+/// The two runs of a comparison of `scenario` (with `base` applied to both), the
+/// implicit one by `implicit_scheme` (`backward_euler` or `trapezoidal`).
+pub fn plan(scenario: &Path, base: &Overrides, implicit_scheme: &str) -> Result<Plan> {
+    if !matches!(implicit_scheme, "backward_euler" | "trapezoidal") {
+        return Err(Error::config(
+            "--implicit-scheme",
+            format!("`{implicit_scheme}` is no implicit scheme (backward_euler or trapezoidal)"),
+        ));
+    }
+    let scheme = Overrides::none().set(&format!("analysis.scheme=\"{implicit_scheme}\""))?;
     Ok(Plan {
         kind: StudyKind::Compare,
-        runs: pair(scenario, base, "", "")?,
+        runs: pair(scenario, &base.then(&scheme), "", "")?,
     })
 }
 
@@ -30,10 +38,20 @@ pub fn pair(
     label: &str,
 ) -> Result<Vec<PlannedRun>> {
     let scenario = super::plan::absolute(scenario)?;
-    let implicit = base.then(&Overrides::none().set("analysis.scheme=\"backward_euler\"")?);
+    // The implicit run keeps an implicit scheme the overrides chose, else backward
+    // Euler.
+    let table = crate::config::merged_table(&scenario, base)?;
+    let chosen = table
+        .get("analysis")
+        .and_then(|a| a.get("scheme"))
+        .and_then(|s| s.as_str())
+        .filter(|s| *s == "trapezoidal");
+    let implicit = match chosen {
+        Some(_) => base.clone(),
+        None => base.then(&Overrides::none().set("analysis.scheme=\"backward_euler\"")?),
+    };
     // The explicit run takes its own stable step and lumped mass: the scenario's
     // `dt` and `mass` are removed where it has them.
-    let table = crate::config::merged_table(&scenario, base)?;
     let mut own = Overrides::none();
     for key in ["analysis.dt", "analysis.mass"] {
         if crate::config::overrides::has_path(&table, key) {

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use super::orders::observed;
+use super::orders::observed_from_differences;
 use super::plan::{Plan, PlannedRun, StudyKind};
 use super::run_data::{RunData, DISSIPATION_LINES};
 use super::table::{num, Table};
@@ -134,9 +134,16 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
         })
         .collect();
     let n = done.len();
-    let orders: Vec<Vec<Option<f64>>> = changes
+    // Orders from successive differences of the probe (theory/studies.md).
+    let orders: Vec<Vec<Option<f64>>> = probes
         .iter()
-        .map(|c| observed(&sizes[..n - 1], &c[..n - 1]))
+        .map(|p| {
+            let d: Vec<f64> = done
+                .windows(2)
+                .map(|w| (w[0].probe_min(p) - w[1].probe_min(p)).abs())
+                .collect();
+            observed_from_differences(&sizes, &d)
+        })
         .collect();
     for (i, r) in done.iter().enumerate() {
         let mut row = vec![

@@ -14,7 +14,7 @@
 //! `theory/energy.md`.
 
 use super::implicit::Core;
-use super::operators::Scheme;
+use super::operators::{Rule, Scheme};
 use super::{Integrator, SolverFacts, State, StepOutcome, Timing};
 use crate::assembly::{Assembler, Mass};
 use crate::error::Result;
@@ -22,7 +22,9 @@ use crate::linsolve::Backend;
 use crate::model::Model;
 use crate::system::{DofMap, EffectiveSystem};
 
-/// Backward Euler integrator: matrices, solver and scratch.
+/// The implicit dynamic integrator: backward Euler, or the trapezoidal rule when
+/// `analysis.scheme` says so (the same matrices, loop, contact and ledger; only the
+/// step's weights differ, [`Rule`]). Matrices, solver and scratch.
 pub struct BackwardEuler<'m> {
     core: Core<'m>,
 }
@@ -41,10 +43,11 @@ impl<'m> BackwardEuler<'m> {
         memory_limit: Option<u64>,
     ) -> Result<Self> {
         let a = &model.analysis;
-        let scheme = Scheme::BackwardEuler {
+        let scheme = Scheme::Dynamic {
             h: a.time.dt,
             damp_m: a.damping.zeta + a.damping.rayleigh[0],
             damp_k: a.damping.rayleigh[1],
+            rule: Rule::of(a.time.scheme),
         };
         Ok(BackwardEuler {
             core: Core::new(model, backend, scheme, memory_limit)?,

@@ -139,7 +139,7 @@ pub(crate) fn likely_cause(
     dofs: &DofMap,
 ) -> String {
     let (c_m, _, _) = ops.coefficients();
-    if let Scheme::BackwardEuler { h, .. } = ops.scheme {
+    if let Scheme::Dynamic { h, .. } = ops.scheme {
         if !c_m.is_finite() || c_m == 0.0 {
             return format!(
                 "the step h = {h:e} s puts 1/h² = {:e} outside the floating-point range",
@@ -192,7 +192,7 @@ pub(crate) fn likely_cause(
                 )
             }
         }
-        Scheme::BackwardEuler { h, .. } => format!(
+        Scheme::Dynamic { h, .. } => format!(
             "with h = {h:e} s the mass term 1/h² M is too small against the stiffness of an \
              unsupported body; use a smaller step or supports"
         ),

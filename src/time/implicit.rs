@@ -17,7 +17,7 @@ use std::time::Instant;
 use super::diagnostics::{describe, likely_cause};
 use super::forces::external_force;
 use super::nodal::{MassProduct, NodalState};
-use super::operators::{Operators, Response, Scheme};
+use super::operators::{Operators, Response, Rule, Scheme};
 use super::residual::{residual_chunk, PassCoefficients, PassInputs, PassOutputs, PassSums};
 use super::{Rejection, State, StepOutcome, StepReport};
 use crate::assembly::internal::{new_stores, PointPass, PointTotals};
@@ -192,10 +192,22 @@ impl StepProblem for ImplicitStep<'_> {
         let inv_h = ops.dynamic().map(|(h, _, _)| 1.0 / h);
         let moving = self.moving;
         let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext_np1, &w.m_du, &w.kdu, &w.kt_du);
+        let (f_int_n, f_ext_n) = (&s.f_int, &s.f_ext);
+        let trapezoidal = ops.rule() == Rule::Trapezoidal;
         let value = |i: usize| {
-            let mut r = base[i] - f_ext[i];
+            // The residual at Δu = Δu_c: the forces at the step's end (averaged with
+            // the start's by the trapezoidal rule), the momentum of the start.
+            let mut r = if trapezoidal {
+                0.5 * (base[i] + f_int_n[i]) - 0.5 * (f_ext[i] + f_ext_n[i])
+            } else {
+                base[i] - f_ext[i]
+            };
             if let Some(inv_h) = inv_h {
-                r -= mv_n[i] * inv_h;
+                r -= if trapezoidal {
+                    2.0 * mv_n[i] * inv_h
+                } else {
+                    mv_n[i] * inv_h
+                };
             }
             if moving {
                 r += c_m * m_du[i] + c_k * kdu[i];
@@ -308,6 +320,7 @@ impl StepProblem for ImplicitStep<'_> {
         // elastic models, f_int = f_int,n + K Δu, and sums the step's ledger terms
         // (with the applied loads: `finish` adds what the reactions do).
         let (damp_m, damp_k) = dynamic.map_or((0.0, 0.0), |(_, m, k)| (m, k));
+        let trapezoidal = ops.rule() == Rule::Trapezoidal;
         let c = PassCoefficients {
             inv_h: 1.0 / h,
             damp_m,
@@ -335,11 +348,13 @@ impl StepProblem for ImplicitStep<'_> {
         let leaf = |(lo, [r, f_int, mv, v]): halves::Slices<4>| {
             let inp = inputs.range(lo, lo + r.len());
             let out = PassOutputs { r, f_int, mv, v };
-            match (dynamic.is_some(), elastic) {
-                (true, true) => residual_chunk::<true, true>(&inp, out, &c),
-                (true, false) => residual_chunk::<true, false>(&inp, out, &c),
-                (false, true) => residual_chunk::<false, true>(&inp, out, &c),
-                (false, false) => residual_chunk::<false, false>(&inp, out, &c),
+            match (dynamic.is_some(), elastic, trapezoidal) {
+                (true, true, false) => residual_chunk::<true, true, false>(&inp, out, &c),
+                (true, false, false) => residual_chunk::<true, false, false>(&inp, out, &c),
+                (true, true, true) => residual_chunk::<true, true, true>(&inp, out, &c),
+                (true, false, true) => residual_chunk::<true, false, true>(&inp, out, &c),
+                (false, true, _) => residual_chunk::<false, true, false>(&inp, out, &c),
+                (false, false, _) => residual_chunk::<false, false, false>(&inp, out, &c),
             }
         };
         let sums = halves::in_halves(
@@ -612,31 +627,46 @@ fn finish(
     (contact, friction): (f64, f64),
 ) {
     let mut sums = w.ledger_sums;
+    let trapezoidal = ops.rule() == Rule::Trapezoidal;
+    // The residual on a constrained dof is the reaction the step's equation needs:
+    // at the end (backward Euler), or in the average ½(R_n + R_{n+1}) (trapezoidal).
+    let end_weight = 1.0 / ops.rule().theta();
     for &d in &dofs.constrained {
-        let reaction = w.r[d];
+        let reaction = end_weight * w.r[d];
         w.f_ext_np1[d] += reaction;
         // External work and load jump are linear in f_ext,n+1.
         sums.work[1] += w.du[d] * reaction;
         sums.work[2] += w.du[d] * reaction;
     }
     let work = StepWork::from_sums(sums.work);
-    let (elastic_energy, material) = if ops.response == Response::Elastic {
+    let (elastic_energy, mut material) = if ops.response == Response::Elastic {
         (
             ops.stored.of(&w.u_np1, &w.f_int_np1),
             Dissipation {
-                numerical: sums.elastic_loss,
+                numerical: if trapezoidal { 0.0 } else { sums.elastic_loss },
                 ..Default::default()
             },
         )
     } else {
         (w.totals.psi, w.totals.dissipation)
     };
+    // The trapezoidal rule works with ½Δu·(f_int,n + f_int,n+1) where the points book
+    // σ_{n+1}:Δε (their algorithmic loss is backward Euler's), and with the averaged
+    // loads, so the load jump is no loss of it (theory/trapezoidal.md).
+    let scheme_loss = if trapezoidal {
+        if ops.response != Response::Elastic {
+            material.numerical -= sums.internal_jump;
+        }
+        work.load_jump
+    } else {
+        sums.scheme_loss
+    };
     s.ledger.record(&StepIncrements {
         kinetic: sums.kinetic,
         elastic: elastic_energy,
         work,
         material,
-        scheme_loss: sums.scheme_loss,
+        scheme_loss,
         contact,
         friction,
     });
@@ -666,10 +696,11 @@ fn finish(
 pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, EffectiveSystem)> {
     let a = &model.analysis;
     let scheme = match a.time.kind {
-        crate::model::AnalysisKind::Dynamic => Scheme::BackwardEuler {
+        crate::model::AnalysisKind::Dynamic => Scheme::Dynamic {
             h: a.time.dt,
             damp_m: a.damping.zeta + a.damping.rayleigh[0],
             damp_k: a.damping.rayleigh[1],
+            rule: super::operators::Rule::of(a.time.scheme),
         },
         crate::model::AnalysisKind::Static => Scheme::Static { dt: a.time.dt },
     };

@@ -34,20 +34,52 @@ pub(crate) enum Response {
 /// The time discretisation of the step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Scheme {
-    /// Backward Euler with step `h` and damping `C = damp_m M + damp_k K`.
-    BackwardEuler {
+    /// Inertia, with step `h` and damping `C = damp_m M + damp_k K`, by `rule`.
+    Dynamic {
         /// Step size.
         h: f64,
         /// Mass-proportional damping `zeta + a_m` (1/s).
         damp_m: f64,
         /// Stiffness-proportional damping `a_k` (s).
         damp_k: f64,
+        /// Backward Euler or the trapezoidal rule.
+        rule: Rule,
     },
     /// Static equilibrium at load steps of size `dt` (the material rates use it).
     Static {
         /// Load step size.
         dt: f64,
     },
+}
+
+/// The rule of an implicit dynamic step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Rule {
+    /// Backward Euler, eq. (9): `v = Δu/h`, the equation at the step's end.
+    BackwardEuler,
+    /// The trapezoidal rule in averaged-force form: `v = 2Δu/h − v_n`, the internal
+    /// and applied forces averaged over the step, the contact force at its end
+    /// (`theory/trapezoidal.md`).
+    Trapezoidal,
+}
+
+impl Rule {
+    /// The rule of a dynamic scheme (central differences has none).
+    pub fn of(scheme: crate::model::TimeScheme) -> Rule {
+        match scheme {
+            crate::model::TimeScheme::Trapezoidal => Rule::Trapezoidal,
+            _ => Rule::BackwardEuler,
+        }
+    }
+
+    /// The weight of the step's end in the internal and applied forces (1 or ½);
+    /// the start has the rest.
+    pub fn theta(self) -> f64 {
+        match self {
+            Rule::BackwardEuler => 1.0,
+            Rule::Trapezoidal => 0.5,
+        }
+    }
 }
 
 /// Matrices and settings of an implicit scheme: built once, read by every step.
@@ -142,7 +174,7 @@ impl Operators {
     /// The step size (statics: the load step).
     pub fn h(&self) -> f64 {
         match self.scheme {
-            Scheme::BackwardEuler { h, .. } => h,
+            Scheme::Dynamic { h, .. } => h,
             Scheme::Static { dt } => dt,
         }
     }
@@ -150,7 +182,7 @@ impl Operators {
     /// Sets the step size.
     pub fn set_h(&mut self, model: &Model, h_new: f64) {
         match &mut self.scheme {
-            Scheme::BackwardEuler { h, .. } => *h = h_new,
+            Scheme::Dynamic { h, .. } => *h = h_new,
             Scheme::Static { dt } => *dt = h_new,
         }
         self.update_constant_tangent(model);
@@ -183,14 +215,23 @@ impl Operators {
             1.0
         };
         match self.scheme {
-            Scheme::BackwardEuler { h, damp_m, damp_k } => {
-                let c_m = 1.0 / (h * h) + damp_m / h;
+            Scheme::Dynamic {
+                h,
+                damp_m,
+                damp_k,
+                rule,
+            } => {
+                // r = M(v − v_n)/h + C(v + v_n)/2 or C v + θ f_int + …, with
+                // ∂v/∂u = 1/(θh): the mass term 1/(θh²), the damping 1/h, the
+                // internal force's θ.
+                let theta = rule.theta();
+                let c_m = 1.0 / (theta * h * h) + damp_m / h;
                 let c_k = if c_t == 0.0 {
-                    1.0 + damp_k / h
+                    theta + damp_k / h
                 } else {
                     damp_k / h
                 };
-                (c_m, c_k, c_t)
+                (c_m, c_k, theta * c_t)
             }
             Scheme::Static { .. } => (self.seat, 1.0 - c_t, c_t),
         }
@@ -244,10 +285,20 @@ impl Operators {
         Ok((sys, factored, None))
     }
 
+    /// The rule of a dynamic step (statics: backward Euler's weights, θ = 1).
+    pub(crate) fn rule(&self) -> Rule {
+        match self.scheme {
+            Scheme::Dynamic { rule, .. } => rule,
+            Scheme::Static { .. } => Rule::BackwardEuler,
+        }
+    }
+
     /// Whether the scheme has inertia (backward Euler) or not (statics).
     pub(crate) fn dynamic(&self) -> Option<(f64, f64, f64)> {
         match self.scheme {
-            Scheme::BackwardEuler { h, damp_m, damp_k } => Some((h, damp_m, damp_k)),
+            Scheme::Dynamic {
+                h, damp_m, damp_k, ..
+            } => Some((h, damp_m, damp_k)),
             Scheme::Static { .. } => None,
         }
     }
@@ -283,7 +334,7 @@ impl Operators {
             u[c.dof] = c.at(0.0);
         }
         let v = match self.scheme {
-            Scheme::BackwardEuler { .. } => model.initial_velocity(),
+            Scheme::Dynamic { .. } => model.initial_velocity(),
             Scheme::Static { .. } => vec![0.0; n],
         };
         let mut mv = vec![0.0; n];

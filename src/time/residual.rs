@@ -82,6 +82,9 @@ pub(crate) struct PassSums {
     pub scheme_loss: f64,
     /// `½ Δu·K Δu`, the elastic models' numerical loss.
     pub elastic_loss: f64,
+    /// `½ Δu·(f_int,n+1 − f_int,n)` (the trapezoidal rule): what separates the work
+    /// of the averaged internal force from backward Euler's `Δu·f_int,n+1`.
+    pub internal_jump: f64,
 }
 
 impl PassSums {
@@ -95,15 +98,17 @@ impl PassSums {
             kinetic: a.kinetic + b.kinetic,
             scheme_loss: a.scheme_loss + b.scheme_loss,
             elastic_loss: a.elastic_loss + b.elastic_loss,
+            internal_jump: a.internal_jump + b.internal_jump,
         }
     }
 }
 
-/// The residual pass over one chunk of dofs, specialised for inertia (`DYN`) and
-/// for elastic models (`ELASTIC`, where `f_int = f_int,n + K Δu` is formed here).
-/// Returns the chunk's [`PassSums`].
+/// The residual pass over one chunk of dofs, specialised for inertia (`DYN`), for
+/// elastic models (`ELASTIC`, where `f_int = f_int,n + K Δu` is formed here) and for
+/// the trapezoidal rule (`TRAP`, with `DYN`: `v = 2Δu/h − v_n`, the internal and
+/// applied forces averaged, `C(v + v_n)/2`). Returns the chunk's [`PassSums`].
 #[inline]
-pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
+pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool, const TRAP: bool>(
     inp: &PassInputs,
     out: PassOutputs,
     c: &PassCoefficients,
@@ -119,7 +124,17 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
         if ELASTIC {
             f_int[i] = f_int_n[i] + kdu[i];
         }
-        let (inertia, damping, momenta) = if DYN {
+        let (inertia, damping, momenta) = if TRAP {
+            // M v = 2 M Δu/h − M v_n; C (v + v_n)/2 = C Δu/h.
+            let m_du_h = mv[i] * c.inv_h;
+            mv[i] = 2.0 * m_du_h - mv_n[i];
+            v[i] = 2.0 * du[i] * c.inv_h - v_n[i];
+            (
+                (mv[i] - mv_n[i]) * c.inv_h,
+                c.damp_m * m_du_h + c.damp_k * kdu[i] * c.inv_h,
+                (mv[i].abs() + mv_n[i].abs()) * c.inv_h,
+            )
+        } else if DYN {
             mv[i] *= c.inv_h;
             v[i] = du[i] * c.inv_h;
             (
@@ -131,7 +146,11 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
             (0.0, 0.0, 0.0)
         };
         let fi = f_int[i];
-        r[i] = inertia + damping + fi - f_ext[i];
+        r[i] = if TRAP {
+            inertia + damping + 0.5 * (fi + f_int_n[i]) - 0.5 * (f_ext[i] + f_ext_n[i])
+        } else {
+            inertia + damping + fi - f_ext[i]
+        };
         acc.force_scale2 += free[i] * (f_ext[i] * f_ext[i] + fi * fi + inertia * inertia);
         acc.increment2 += free[i] * du[i] * du[i];
         // Over every dof: the reactions size the forces of a model whose free dofs
@@ -144,6 +163,10 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool>(
         }
         if DYN {
             acc.kinetic += 0.5 * v[i] * mv[i];
+        }
+        if TRAP {
+            acc.internal_jump += 0.5 * du[i] * (fi - f_int_n[i]);
+        } else if DYN {
             acc.scheme_loss += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);
         }
         if ELASTIC {
