@@ -1,5 +1,6 @@
-//! `rothe compare`: one scenario through the implicit path (backward Euler, the
-//! contact QP) and the explicit path (central differences with lumped mass, the
+//! `rothe compare`: one scenario through the implicit path (backward Euler or, with
+//! `--implicit-scheme trapezoidal`, the trapezoidal rule; the contact QP) and the
+//! explicit path (central differences with lumped mass, the
 //! kinematic contact method, its stable step), the two ledgers side by side and the
 //! difference put down to its mechanism. Theory: `theory/explicit.md`,
 //! `theory/contact.md`.
@@ -84,15 +85,17 @@ const WHY: [(&str, &str); 7] = [
     (
         "numerical",
         "backward Euler loses ½|Δv|²_M per step (and the material's algorithmic share): \
-         first order in h, concentrated in the high frequencies an impact excites. Central \
-         differences conserve a modified energy: their line is the small oscillating \
-         difference to it",
+         first order in h, concentrated in the high frequencies an impact excites; the \
+         trapezoidal rule loses nothing of its own in linear elasticity (the materials' \
+         algorithmic share only, of either sign). Central differences conserve a modified \
+         energy: their line is the small oscillating difference to it",
     ),
     (
         "contact",
         "implicit: the work of the QP's contact forces on the gaps they close; the velocity \
-         jump of an impact is split between this line and the scheme's loss. Explicit: the \
-         kinetic energy the perfectly inelastic impulses remove",
+         jump of an impact is split between this line and the scheme's loss (backward \
+         Euler) or booked here whole (trapezoidal). Explicit: the kinetic energy the \
+         perfectly inelastic impulses remove",
     ),
     (
         "friction",

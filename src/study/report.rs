@@ -126,6 +126,15 @@ pub fn plan(o: &ReportOptions) -> Result<Plan> {
             label: format!("{m}, {} m, explicit", o.compare_mesh),
             ..explicit[1].clone()
         });
+        // The same by the trapezoidal rule (theory/trapezoidal.md).
+        runs.push(PlannedRun {
+            id: format!("b1_{m}_{}_{TRAPEZOIDAL}", o.compare_mesh),
+            scenario: abs1.clone(),
+            overrides: base.then(&Overrides::none().set("analysis.scheme=\"trapezoidal\"")?),
+            param: o.compare_mesh,
+            label: format!("{m}, {} m, trapezoidal", o.compare_mesh),
+            record_fields: false,
+        });
     }
     // Benchmark 1 as solids at the comparison mesh (theory/contact3d.md).
     let abs_solid = super::plan::absolute(&b1_solid)?;
@@ -164,6 +173,65 @@ pub fn plan(o: &ReportOptions) -> Result<Plan> {
         kind: StudyKind::Report,
         runs,
     })
+}
+
+/// The suffix of the benchmark 1 runs by the trapezoidal rule.
+const TRAPEZOIDAL: &str = "trapezoidal";
+
+/// Benchmark 1 by backward Euler and by the trapezoidal rule at one mesh, model by
+/// model: the scheme's own loss, the contact's, the material dissipation and how
+/// much of it the scheme changes, and the peak deflection.
+fn schemes_side_by_side(runs: &[RunData]) -> String {
+    let mut t = Table::new(&[
+        "model",
+        "mesh [m]",
+        "D_num / E_kin⁰ BE",
+        "trapezoidal",
+        "D_contact / E_kin⁰ BE",
+        "trapezoidal",
+        "material / E_kin⁰ BE",
+        "trapezoidal",
+        "material change [%]",
+        "peak [mm] BE",
+        "trapezoidal",
+    ]);
+    for m in BENCHMARK1_MODELS {
+        let Some(tr) = runs.iter().find(|r| {
+            r.run.id.starts_with(&format!("b1_{m}_"))
+                && r.run.id.ends_with(&format!("_{TRAPEZOIDAL}"))
+                && r.completed()
+        }) else {
+            continue;
+        };
+        let Some(be) = find(runs, &format!("b1_{m}_{}", tr.run.param)) else {
+            continue;
+        };
+        let k = be.kinetic_0();
+        let (mb, mt) = (be.dissipated_material(), tr.dissipated_material());
+        t.push(vec![
+            m.to_string(),
+            format!("{}", tr.run.param),
+            num(Some(be.dissipated("numerical") / k)),
+            num(Some(tr.dissipated("numerical") / k)),
+            num(Some(be.dissipated("contact") / k)),
+            num(Some(tr.dissipated("contact") / k)),
+            num(Some(mb / k)),
+            num(Some(mt / k)),
+            num((mb > 0.0).then(|| 100.0 * (mt - mb) / mb)),
+            num(Some(-1e3 * be.probe_min("probe"))),
+            num(Some(-1e3 * tr.probe_min("probe"))),
+        ]);
+    }
+    if t.rows.is_empty() {
+        return String::new();
+    }
+    format!(
+        "\n## Backward Euler against the trapezoidal rule\n\nBenchmark 1 at the \
+         comparison mesh, the same file by both implicit schemes: backward Euler's own \
+         loss, which the trapezoidal rule does not have in linear elasticity, and how much \
+         each model's dissipation changes with it (theory/trapezoidal.md).\n\n{}",
+        t.markdown()
+    )
 }
 
 /// The paper's figures the report sets beside its own (NOTES.md).
@@ -298,7 +366,11 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     let meshes: Vec<f64> = {
         let mut m: Vec<f64> = runs
             .iter()
-            .filter(|r| r.run.id.starts_with("b1_") && !r.run.id.ends_with("explicit"))
+            .filter(|r| {
+                r.run.id.starts_with("b1_")
+                    && !r.run.id.ends_with("explicit")
+                    && !r.run.id.ends_with(TRAPEZOIDAL)
+            })
             .map(|r| r.run.param)
             .collect();
         m.sort_by(|a, b| b.total_cmp(a));
@@ -308,7 +380,8 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     let b1 = |m: &str, s: f64| find(runs, &format!("b1_{m}_{s}"));
     let mut md = String::from(
         "# rothe: the paper's benchmarks\n\nEvery run below is an implicit (backward \
-         Euler, contact QP) run of `examples/benchmarks/` unless marked explicit; \
+         Euler, contact QP) run of `examples/benchmarks/` unless marked explicit or \
+         trapezoidal; \
          energies are normalised by the initial kinetic energy `E_kin⁰`. Why the numbers \
          differ from the paper's: `theory/benchmarks.md`.\n\n",
     );
@@ -486,6 +559,8 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     }
 
     md.push_str(&solid_against_plane(runs, &plots)?);
+
+    md.push_str(&schemes_side_by_side(runs));
 
     md.push_str("\n## Implicit against explicit\n\n");
     for m in BENCHMARK1_MODELS {
