@@ -43,6 +43,8 @@ pub struct Report {
     pub stable: Option<(f64, usize, usize)>,
     /// The time scheme (for a dynamic analysis).
     pub scheme: Option<crate::model::TimeScheme>,
+    /// Generalized-α's spectral radius at infinity.
+    pub rho_inf: f64,
     /// How an implicit step of damage or plasticity iterates: the method and the
     /// kept factor's rate (`None` when every material has a constant tangent or the
     /// scheme is explicit).
@@ -198,6 +200,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         cfl,
         stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
         scheme: (a.time.kind == crate::model::AnalysisKind::Dynamic).then_some(a.time.scheme),
+        rho_inf: a.time.rho_inf,
         iteration: (a.time.scheme.is_implicit()
             && model.materials.iter().any(|m| !m.has_constant_tangent()))
         .then_some((a.iteration.method, a.iteration.refactor_rate)),
@@ -289,11 +292,15 @@ impl fmt::Display for Report {
                 f,
                 "scheme      {}",
                 match scheme {
-                    crate::model::TimeScheme::BackwardEuler => "backward Euler (implicit)",
+                    crate::model::TimeScheme::BackwardEuler => String::from("backward Euler (implicit)"),
                     crate::model::TimeScheme::Trapezoidal =>
-                        "trapezoidal rule (implicit, second order, contact at the step's end)",
+                        "trapezoidal rule (implicit, second order, contact at the step's end)".into(),
+                    crate::model::TimeScheme::GeneralizedAlpha => format!(
+                        "generalized-α (implicit, second order, rho_inf = {}, contact at the step's end)",
+                        self.rho_inf
+                    ),
                     crate::model::TimeScheme::CentralDifference =>
-                        "central differences (explicit, lumped mass, kinematic contact)",
+                        "central differences (explicit, lumped mass, kinematic contact)".into(),
                 }
             )?;
         }

@@ -63,7 +63,7 @@ enum Command {
         scenario: ScenarioArgs,
         #[command(flatten)]
         sweep: SweepArgs,
-        /// The implicit run's scheme: backward_euler or trapezoidal.
+        /// The implicit run's scheme: backward_euler, trapezoidal or generalized_alpha.
         #[arg(long, default_value = "backward_euler")]
         implicit_scheme: String,
     },

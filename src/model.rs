@@ -153,6 +153,11 @@ pub enum TimeScheme {
     /// implicit: implicit, second order, no numerical loss in linear elasticity
     /// (`theory/trapezoidal.md`).
     Trapezoidal,
+    /// Chung and Hulbert's generalized-α with high-frequency dissipation set by
+    /// `rho_inf` (1: the trapezoidal rule's spectrum), contact at the step's end as
+    /// the trapezoidal rule's: implicit, second order, its loss booked in `D_num`
+    /// (`theory/trapezoidal.md`).
+    GeneralizedAlpha,
 }
 
 impl TimeScheme {
@@ -198,6 +203,8 @@ pub struct TimeSettings {
     pub scheme: TimeScheme,
     /// Central differences: the fraction of the critical step of the default step.
     pub omega: f64,
+    /// Generalized-α: the spectral radius at `ωh → ∞`, in `[0, 1]`.
+    pub rho_inf: f64,
     /// Step size `h`.
     pub dt: f64,
     /// End time `T`.

@@ -171,10 +171,11 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         catch_unwind(AssertUnwindSafe(|| match (a.time.kind, a.time.scheme) {
             (AnalysisKind::Dynamic, TimeScheme::CentralDifference) => CentralDifference::new(model)
                 .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
-            (AnalysisKind::Dynamic, TimeScheme::BackwardEuler | TimeScheme::Trapezoidal) => {
-                BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
-                    .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
-            }
+            (
+                AnalysisKind::Dynamic,
+                TimeScheme::BackwardEuler | TimeScheme::Trapezoidal | TimeScheme::GeneralizedAlpha,
+            ) => BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
+                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
             (AnalysisKind::Static, _) => {
                 Statics::with_memory_limit(model, opts.backend, opts.memory_limit)
                     .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))

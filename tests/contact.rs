@@ -294,7 +294,7 @@ fn contact_ledgers_close_with_every_material_model() {
             "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }",
         ),
     ] {
-      for scheme in ["backward_euler", "trapezoidal"] {
+      for scheme in ["backward_euler", "trapezoidal", "generalized_alpha"] {
         let name = format!("{name} ({scheme})");
         let text = drop_on(lines).replace("[analysis]", &format!("[analysis]\nscheme = \"{scheme}\""));
         let m = model(&text);

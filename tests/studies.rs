@@ -151,7 +151,11 @@ fn time_studies_of_a_smooth_load_read_order_one_and_two() {
     // trapezoidal rule 2.00 ± 0.1 at every level in both norms of the linear
     // interpolant (successive differences; a reference-biased ratio read 1.22 for
     // order one), the constant interpolant 1 ± 0.1 for both (its O(h)).
-    for (scheme, expect, band) in [("backward_euler", 1.0, 0.05), ("trapezoidal", 2.0, 0.1)] {
+    for (scheme, expect, band) in [
+        ("backward_euler", 1.0, 0.05),
+        ("trapezoidal", 2.0, 0.1),
+        ("generalized_alpha", 2.0, 0.1),
+    ] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("study");
         let (ok, _, err) = rothe(&[

@@ -160,6 +160,13 @@ fn the_trapezoidal_rule_converges_at_order_two_and_backward_euler_at_one() {
 
 #[test]
 fn two_bars_meet_and_part_without_gaining_energy() {
+    for scheme in ["trapezoidal", "generalized_alpha"] {
+        bars_by(scheme);
+    }
+}
+
+/// The bar impact by `scheme` (the contact at the step's end).
+fn bars_by(scheme: &str) {
     // The bars of examples/contact/bars_impact.toml: contact for 2L/c at ρcAv/2,
     // momentum kept, and after they part the energy is at most E_kin⁰ (the contact
     // at the step's end can only take energy, −λ·g_n ≤ 0) and within 1 % of it.
@@ -167,7 +174,7 @@ fn two_bars_meet_and_part_without_gaining_energy() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/contact/bars_impact.toml"),
     )
     .unwrap()
-    .replace("[analysis]", "[analysis]\nscheme = \"trapezoidal\"")
+    .replace("[analysis]", &format!("[analysis]\nscheme = \"{scheme}\""))
     .replace("vtk_every = 20", "vtk_every = 0");
     let h = 1e-6;
     let (c, force) = (5000.0, 8000.0 * 5000.0 * 0.005 * 1.0 / 2.0);
@@ -193,14 +200,20 @@ fn two_bars_meet_and_part_without_gaining_energy() {
         );
         let l = &s.ledger;
         assert!(l.dissipated().contact >= -1e-12 * l.scale());
-        assert!(l.kinetic() + l.elastic() <= l.kinetic_0() * (1.0 + 1e-12));
+        // The trapezoidal rule's energy never rises; generalized-α's true energy may
+        // swing above its start within a step or two of an impact (only its
+        // modified energy with the acceleration term decays), so it is held to the
+        // bound once the bars have parted, below.
+        if scheme == "trapezoidal" {
+            assert!(l.kinetic() + l.elastic() <= l.kinetic_0() * (1.0 + 1e-12));
+        }
     });
     let duration = t_off.unwrap() - t_on.unwrap();
     let plateau = plateau / f64::from(count);
     let l = &s.ledger;
     let kept = (l.kinetic() + l.elastic()) / l.kinetic_0();
     eprintln!(
-        "duration {duration:.4e} s (2L/c {:.4e}), plateau {plateau:.5e} N ({force:.5e}), energy kept {kept:.5}, D_contact {:.3e} J",
+        "{scheme}: duration {duration:.4e} s (2L/c {:.4e}), plateau {plateau:.5e} N ({force:.5e}), energy kept {kept:.5}, D_contact {:.3e} J",
         2.0 / c,
         l.dissipated().contact
     );
@@ -212,4 +225,122 @@ fn two_bars_meet_and_part_without_gaining_energy() {
     assert!(kept > 0.99 && kept <= 1.0 + 1e-12, "{kept}");
     assert!(l.residual().abs() < 1e-9 * l.scale());
     let _ = m;
+}
+
+#[test]
+fn generalized_alpha_at_rho_one_is_the_trapezoidal_rule() {
+    let text = |scheme: &str| {
+        cantilever(scheme, 1e-5, 1e-2, [0.0, -1.0], "rho_inf = 1.0").replace(
+            "rho_inf = 1.0",
+            if scheme == "trapezoidal" {
+                ""
+            } else {
+                "rho_inf = 1.0"
+            },
+        )
+    };
+    let mut tips = [Vec::new(), Vec::new()];
+    for (k, scheme) in ["trapezoidal", "generalized_alpha"].iter().enumerate() {
+        let tip = &mut tips[k];
+        run(&text(scheme), |m, s| {
+            let n = m.mesh.nearest_node([2.0, 0.5, 0.0]).unwrap();
+            tip.push(s.u[2 * n + 1]);
+        });
+    }
+    let scale = tips[0].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let worst = tips[0]
+        .iter()
+        .zip(&tips[1])
+        .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+    eprintln!(
+        "generalized-α (ρ∞ = 1) against the trapezoidal rule: {:.2e} of the tip's amplitude",
+        worst / scale
+    );
+    assert!(worst < 1e-9 * scale, "{worst:e} of {scale:e}");
+}
+
+#[test]
+fn generalized_alpha_damps_the_highest_modes_by_rho_inf_per_step() {
+    // h = 1 s puts every mode of the cantilever at ωh > 300, where the amplification
+    // matrix has the triple eigenvalue −ρ∞ of Chung and Hulbert's design: the
+    // amplitude falls as n² ρ∞ⁿ, so over steps n to 2n the rate per step is
+    // ρ∞ 2^{2/n}, which the measurement divides out. The window ends where the
+    // energy is 1e-20 of its start (below, the incremental elastic force's
+    // round-off, relative to the largest force met, takes over). The loss is booked
+    // in D_num, which grows as ρ∞ falls, and the ledger closes.
+    let mut finals = Vec::new();
+    for rho in [0.95f64, 0.9, 0.8] {
+        let text = cantilever(
+            "generalized_alpha",
+            1.0,
+            200.0,
+            [0.0, -1.0],
+            &format!("rho_inf = {rho}"),
+        );
+        let mut energies = Vec::new();
+        let mut early = 0.0;
+        let (_, s) = run(&text, |_, s| {
+            let l = &s.ledger;
+            energies.push(l.kinetic() + l.elastic());
+            if s.step == 10 {
+                early = l.dissipated().numerical;
+            }
+            assert!(l.residual().abs() < 1e-10 * l.scale(), "{}", l.residual());
+            assert!(l.dissipated().numerical >= -1e-12 * l.scale());
+        });
+        let n = ((10.0 / -rho.log10()) as usize).min(200) / 2;
+        let measured = (energies[2 * n - 1] / energies[n - 1]).powf(0.5 / n as f64)
+            / 2f64.powf(2.0 / n as f64);
+        eprintln!(
+            "ρ∞ = {rho}: measured {measured:.4}, D_num {:.4} of E_kin0",
+            s.ledger.dissipated().numerical / s.ledger.kinetic_0()
+        );
+        // Within 2.5 %: the lower terms of the amplitude's polynomial (b n + c) are
+        // still a fiftieth at ρ∞ = 0.8's window (n = 51).
+        assert!(
+            (measured - rho).abs() < 0.025 * rho,
+            "ρ∞ = {rho}: {measured}"
+        );
+        assert!((s.ledger.dissipated().numerical / s.ledger.kinetic_0() - 1.0).abs() < 1e-6);
+        finals.push(early);
+    }
+    // After ten steps the lower ρ∞ has taken more.
+    assert!(
+        finals.windows(2).all(|w| w[1] > w[0]) && finals[0] > 0.0,
+        "{finals:?}"
+    );
+}
+
+#[test]
+fn rho_inf_is_checked_and_read_by_generalized_alpha_only() {
+    let refused = |text: String, words: &[&str]| {
+        let e = rothe::config::from_str(&text, Path::new("."))
+            .expect_err("accepted")
+            .to_string();
+        for w in words {
+            assert!(e.contains(w), "`{w}` not in: {e}");
+        }
+    };
+    for bad in ["1.5", "-0.1"] {
+        refused(
+            cantilever(
+                "generalized_alpha",
+                1e-5,
+                1e-3,
+                [0.0, 0.0],
+                &format!("rho_inf = {bad}"),
+            ),
+            &["analysis.rho_inf", "outside [0, 1]"],
+        );
+    }
+    for scheme in ["backward_euler", "trapezoidal", "central_difference"] {
+        refused(
+            cantilever(scheme, 1e-5, 1e-3, [0.0, 0.0], "rho_inf = 0.5")
+                .replace("mass = \"consistent\"", ""),
+            &["analysis.rho_inf", "generalized_alpha"],
+        );
+    }
+    // The default is 0.8, and `check` names the scheme with it.
+    let m = model(&cantilever("generalized_alpha", 1e-5, 1e-3, [0.0, 0.0], ""));
+    assert_eq!(m.analysis.time.rho_inf, 0.8);
 }

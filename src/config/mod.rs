@@ -201,6 +201,10 @@ pub struct AnalysisSpec {
     /// takes (the paper's `ω`). Default 0.9.
     #[serde(default)]
     pub omega: Option<f64>,
+    /// Generalized-α: the spectral radius at `ωh → ∞` in `[0, 1]` (1 damps nothing,
+    /// 0 annihilates the highest modes in one step). Default 0.8.
+    #[serde(default)]
+    pub rho_inf: Option<f64>,
     /// `stress` (default: the paper's walls) or `strain`; `solid` names what a
     /// three-dimensional mesh is anyway (a plane mesh refuses it).
     #[serde(default)]

@@ -15,12 +15,19 @@ use crate::error::{Error, Result};
 use crate::plot::{draw, Figure, Series, Style};
 
 /// The two runs of a comparison of `scenario` (with `base` applied to both), the
-/// implicit one by `implicit_scheme` (`backward_euler` or `trapezoidal`).
+/// implicit one by `implicit_scheme` (`backward_euler`, `trapezoidal` or
+/// `generalized_alpha`).
 pub fn plan(scenario: &Path, base: &Overrides, implicit_scheme: &str) -> Result<Plan> {
-    if !matches!(implicit_scheme, "backward_euler" | "trapezoidal") {
+    if !matches!(
+        implicit_scheme,
+        "backward_euler" | "trapezoidal" | "generalized_alpha"
+    ) {
         return Err(Error::config(
             "--implicit-scheme",
-            format!("`{implicit_scheme}` is no implicit scheme (backward_euler or trapezoidal)"),
+            format!(
+                "`{implicit_scheme}` is no implicit scheme (backward_euler, trapezoidal or \
+                 generalized_alpha)"
+            ),
         ));
     }
     let scheme = Overrides::none().set(&format!("analysis.scheme=\"{implicit_scheme}\""))?;
@@ -46,7 +53,7 @@ pub fn pair(
         .get("analysis")
         .and_then(|a| a.get("scheme"))
         .and_then(|s| s.as_str())
-        .filter(|s| *s == "trapezoidal");
+        .filter(|s| matches!(*s, "trapezoidal" | "generalized_alpha"));
     let implicit = match chosen {
         Some(_) => base.clone(),
         None => base.then(&Overrides::none().set("analysis.scheme=\"backward_euler\"")?),

@@ -47,7 +47,7 @@ impl<'m> BackwardEuler<'m> {
             h: a.time.dt,
             damp_m: a.damping.zeta + a.damping.rayleigh[0],
             damp_k: a.damping.rayleigh[1],
-            rule: Rule::of(a.time.scheme),
+            rule: Rule::of(&a.time),
         };
         Ok(BackwardEuler {
             core: Core::new(model, backend, scheme, memory_limit)?,

@@ -60,6 +60,14 @@ pub(crate) struct Scratch {
     kt_du: Vec<f64>,
     /// The residual (all dofs).
     r: Vec<f64>,
+    /// Generalized-α: the step's start vectors (`residual::History`), `M a_n`, and
+    /// the new acceleration.
+    hist_p: Vec<f64>,
+    hist_q: Vec<f64>,
+    hist_mq: Vec<f64>,
+    hist_d: Vec<f64>,
+    ma_n: Vec<f64>,
+    a_np1: Vec<f64>,
     /// Tangent of the last evaluation (state-dependent materials).
     kt: Vec<f64>,
     /// The tangent the factor holds, and the factorisation count and coefficients
@@ -116,6 +124,12 @@ impl Scratch {
             m_du: z(),
             kt_du: z(),
             r: z(),
+            hist_p: Vec::new(),
+            hist_q: Vec::new(),
+            hist_mq: Vec::new(),
+            hist_d: Vec::new(),
+            ma_n: Vec::new(),
+            a_np1: Vec::new(),
             kt: if matches!(ops.response, Response::StateDependent(_)) {
                 vec![0.0; ops.asm.pattern.nnz()]
             } else {
@@ -193,20 +207,25 @@ impl StepProblem for ImplicitStep<'_> {
         let moving = self.moving;
         let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext_np1, &w.m_du, &w.kdu, &w.kt_du);
         let (f_int_n, f_ext_n) = (&s.f_int, &s.f_ext);
-        let trapezoidal = ops.rule() == Rule::Trapezoidal;
+        let rule = ops.rule();
+        let (hist_p, hist_d) = (&w.hist_p, &w.hist_d);
         let value = |i: usize| {
             // The residual at Δu = Δu_c: the forces at the step's end (averaged with
-            // the start's by the trapezoidal rule), the momentum of the start.
-            let mut r = if trapezoidal {
-                0.5 * (base[i] + f_int_n[i]) - 0.5 * (f_ext[i] + f_ext_n[i])
-            } else {
-                base[i] - f_ext[i]
+            // the start's by the trapezoidal rule and generalized-α), the momentum of
+            // the start.
+            let mut r = match rule {
+                Rule::BackwardEuler => base[i] - f_ext[i],
+                Rule::Trapezoidal => 0.5 * (base[i] + f_int_n[i]) - 0.5 * (f_ext[i] + f_ext_n[i]),
+                Rule::GeneralizedAlpha(a) => {
+                    let w = 1.0 - a.alpha_f;
+                    w * base[i] + (1.0 - w) * f_int_n[i] - w * f_ext[i] - (1.0 - w) * f_ext_n[i]
+                }
             };
             if let Some(inv_h) = inv_h {
-                r -= if trapezoidal {
-                    2.0 * mv_n[i] * inv_h
-                } else {
-                    mv_n[i] * inv_h
+                r -= match rule {
+                    Rule::BackwardEuler => mv_n[i] * inv_h,
+                    Rule::Trapezoidal => 2.0 * mv_n[i] * inv_h,
+                    Rule::GeneralizedAlpha(_) => hist_p[i] - hist_d[i],
                 };
             }
             if moving {
@@ -321,10 +340,15 @@ impl StepProblem for ImplicitStep<'_> {
         // (with the applied loads: `finish` adds what the reactions do).
         let (damp_m, damp_k) = dynamic.map_or((0.0, 0.0), |(_, m, k)| (m, k));
         let trapezoidal = ops.rule() == Rule::Trapezoidal;
+        let alpha = match ops.rule() {
+            Rule::GeneralizedAlpha(a) => Some(a.at(h)),
+            _ => None,
+        };
         let c = PassCoefficients {
             inv_h: 1.0 / h,
             damp_m,
             damp_k,
+            alpha,
         };
         let inputs = PassInputs {
             du: &w.du,
@@ -335,6 +359,12 @@ impl StepProblem for ImplicitStep<'_> {
             f_int_n: &s.f_int,
             f_ext_n: &s.f_ext,
             free: &ops.free_mask,
+            history: alpha.map(|_| super::residual::History {
+                p: &w.hist_p,
+                q: &w.hist_q,
+                mq: &w.hist_mq,
+                d: &w.hist_d,
+            }),
         };
         // In halves of a fixed tree (`crate::halves`): the same sums in every run, on
         // any number of threads.
@@ -348,13 +378,17 @@ impl StepProblem for ImplicitStep<'_> {
         let leaf = |(lo, [r, f_int, mv, v]): halves::Slices<4>| {
             let inp = inputs.range(lo, lo + r.len());
             let out = PassOutputs { r, f_int, mv, v };
-            match (dynamic.is_some(), elastic, trapezoidal) {
-                (true, true, false) => residual_chunk::<true, true, false>(&inp, out, &c),
-                (true, false, false) => residual_chunk::<true, false, false>(&inp, out, &c),
-                (true, true, true) => residual_chunk::<true, true, true>(&inp, out, &c),
-                (true, false, true) => residual_chunk::<true, false, true>(&inp, out, &c),
-                (false, true, _) => residual_chunk::<false, true, false>(&inp, out, &c),
-                (false, false, _) => residual_chunk::<false, false, false>(&inp, out, &c),
+            match (dynamic.is_some(), elastic, trapezoidal, alpha.is_some()) {
+                (true, true, _, true) => residual_chunk::<true, true, false, true>(&inp, out, &c),
+                (true, false, _, true) => residual_chunk::<true, false, false, true>(&inp, out, &c),
+                (true, true, true, _) => residual_chunk::<true, true, true, false>(&inp, out, &c),
+                (true, false, true, _) => residual_chunk::<true, false, true, false>(&inp, out, &c),
+                (true, true, false, _) => residual_chunk::<true, true, false, false>(&inp, out, &c),
+                (true, false, false, _) => {
+                    residual_chunk::<true, false, false, false>(&inp, out, &c)
+                }
+                (false, true, ..) => residual_chunk::<false, true, false, false>(&inp, out, &c),
+                (false, false, ..) => residual_chunk::<false, false, false, false>(&inp, out, &c),
             }
         };
         let sums = halves::in_halves(
@@ -472,6 +506,9 @@ pub(crate) fn step(
     let h = ops.h();
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
+    if let Rule::GeneralizedAlpha(a) = ops.rule() {
+        alpha_history(ops, &a, s, w);
+    }
     let mut u = std::mem::take(&mut w.u_np1);
     let corrections_before = w.corrections;
     let moving = start_iterate(model, s, t1, &mut u, &mut w.du);
@@ -586,6 +623,41 @@ pub(crate) fn step(
     Ok(StepOutcome::Accepted(report))
 }
 
+/// Generalized-α's vectors of the step's start (`residual::History`), from `v_n`,
+/// `M v_n`, `a_n` and `M a_n`.
+fn alpha_history(ops: &Operators, a: &super::operators::Alpha, s: &State, w: &mut Scratch) {
+    let st = a.at(ops.h());
+    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
+    let n = s.v.len();
+    w.ma_n.resize(n, 0.0);
+    ops.mass.matvec(&ops.asm.pattern, &s.a, &mut w.ma_n);
+    let (v, mv, acc, ma) = (&s.v, &s.mv, &s.a, &w.ma_n);
+    w.hist_p.clear();
+    w.hist_p
+        .extend((0..n).map(|i| st.p_v * mv[i] + st.p_a * ma[i]));
+    w.hist_q.clear();
+    w.hist_q
+        .extend((0..n).map(|i| st.q_v * v[i] + st.q_a * acc[i]));
+    w.hist_mq.clear();
+    w.hist_mq
+        .extend((0..n).map(|i| st.q_v * mv[i] + st.q_a * ma[i]));
+    // C v_{n+1−α_f} less its Δu part: damp_m M(w q + (1 − w) v_n) + damp_k K(…).
+    let wq = st.w;
+    w.hist_d.clear();
+    w.hist_d
+        .extend((0..n).map(|i| damp_m * (wq * w.hist_mq[i] + (1.0 - wq) * mv[i])));
+    if damp_k != 0.0 {
+        let x: Vec<f64> = (0..n)
+            .map(|i| wq * w.hist_q[i] + (1.0 - wq) * v[i])
+            .collect();
+        let mut kx = vec![0.0; n];
+        ops.asm.pattern.matvec(&ops.k, &x, &mut kx);
+        for (d, k) in w.hist_d.iter_mut().zip(&kx) {
+            *d += damp_k * k;
+        }
+    }
+}
+
 /// Sets the start of a step's iteration: `u` is `u_n` with the prescribed values of
 /// `t1`, `du` its increment `Δu_c` (zero on the free dofs). Returns whether a
 /// prescribed value moves.
@@ -639,11 +711,20 @@ fn finish(
         sums.work[2] += w.du[d] * reaction;
     }
     let work = StepWork::from_sums(sums.work);
+    let alpha_f = match ops.rule() {
+        Rule::GeneralizedAlpha(a) => Some(a.alpha_f),
+        _ => None,
+    };
     let (elastic_energy, mut material) = if ops.response == Response::Elastic {
         (
             ops.stored.of(&w.u_np1, &w.f_int_np1),
             Dissipation {
-                numerical: if trapezoidal { 0.0 } else { sums.elastic_loss },
+                numerical: match (trapezoidal, alpha_f) {
+                    (true, _) => 0.0,
+                    // Δu·f_int,n+1−α_f = ΔE_el + (1 − 2α_f) ½Δu·KΔu.
+                    (_, Some(af)) => (1.0 - 2.0 * af) * sums.elastic_loss,
+                    _ => sums.elastic_loss,
+                },
                 ..Default::default()
             },
         )
@@ -652,15 +733,35 @@ fn finish(
     };
     // The trapezoidal rule works with ½Δu·(f_int,n + f_int,n+1) where the points book
     // σ_{n+1}:Δε (their algorithmic loss is backward Euler's), and with the averaged
-    // loads, so the load jump is no loss of it (theory/trapezoidal.md).
+    // loads, so the load jump is no loss of it (theory/trapezoidal.md). Generalized-α
+    // weighs the start by α_f: 2α_f of the jumps, and its inertia's own loss.
     let scheme_loss = if trapezoidal {
         if ops.response != Response::Elastic {
             material.numerical -= sums.internal_jump;
         }
         work.load_jump
+    } else if let Some(af) = alpha_f {
+        if ops.response != Response::Elastic {
+            material.numerical -= 2.0 * af * sums.internal_jump;
+        }
+        sums.scheme_loss + 2.0 * af * work.load_jump
     } else {
         sums.scheme_loss
     };
+    if let Rule::GeneralizedAlpha(a) = ops.rule() {
+        // a_{n+1} from v_{n+1} = v_n + h((1 − γ) a_n + γ a_{n+1}).
+        let h = ops.h();
+        let g = a.gamma;
+        w.a_np1.clear();
+        w.a_np1.extend(
+            w.v_np1
+                .iter()
+                .zip(&s.v)
+                .zip(&s.a)
+                .map(|((v1, v0), a0)| (v1 - v0 - h * (1.0 - g) * a0) / (h * g)),
+        );
+        std::mem::swap(&mut s.a, &mut w.a_np1);
+    }
     s.ledger.record(&StepIncrements {
         kinetic: sums.kinetic,
         elastic: elastic_energy,
@@ -700,7 +801,7 @@ pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, Effec
             h: a.time.dt,
             damp_m: a.damping.zeta + a.damping.rayleigh[0],
             damp_k: a.damping.rayleigh[1],
-            rule: super::operators::Rule::of(a.time.scheme),
+            rule: super::operators::Rule::of(&a.time),
         },
         crate::model::AnalysisKind::Static => Scheme::Static { dt: a.time.dt },
     };
@@ -732,6 +833,40 @@ pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, Effec
     Ok((ops.asm, ops.k, ops.mass, sys))
 }
 
+/// Generalized-α's `a_0`: `M a_0 = f_ext(0) − f_int(u_0) − C v_0` on the free dofs
+/// (zero on the constrained ones), one factorisation of `M` on the system's pattern.
+fn initial_acceleration(
+    model: &Model,
+    ops: &Operators,
+    sys: &mut EffectiveSystem,
+) -> Result<Vec<f64>> {
+    let s = ops.initial_state(model);
+    let n = s.v.len();
+    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
+    let mut kv = vec![0.0; n];
+    if damp_k != 0.0 {
+        ops.asm.pattern.matvec(&ops.k, &s.v, &mut kv);
+    }
+    let free = sys.dofs().free.clone();
+    let mut rhs: Vec<f64> = free
+        .iter()
+        .map(|&d| s.f_ext[d] - s.f_int[d] - damp_m * s.mv[d] - damp_k * kv[d])
+        .collect();
+    sys.refill(1.0, &ops.mass, &[]);
+    if let Factored::NotPositiveDefinite { message, .. } = sys.factorize()? {
+        return Err(Error::Solver {
+            backend: sys.backend(),
+            message: format!("the mass matrix for generalized-α's initial acceleration: {message}"),
+        });
+    }
+    sys.solve(&mut rhs)?;
+    let mut a0 = vec![0.0; n];
+    for (&d, x) in free.iter().zip(rhs) {
+        a0[d] = x;
+    }
+    Ok(a0)
+}
+
 /// The integrator parts every implicit scheme holds.
 pub(crate) struct Core<'m> {
     pub model: &'m Model,
@@ -755,9 +890,16 @@ impl<'m> Core<'m> {
         memory_limit: Option<u64>,
     ) -> Result<Self> {
         let t0 = Instant::now();
-        let ops = Operators::new(model, scheme);
+        let mut ops = Operators::new(model, scheme);
         let assembly_s = t0.elapsed().as_secs_f64();
-        let (sys, factored, kt_at_rest) = ops.initial_system(model, backend, memory_limit)?;
+        let (mut sys, mut factored, kt_at_rest) =
+            ops.initial_system(model, backend, memory_limit)?;
+        if matches!(ops.rule(), super::operators::Rule::GeneralizedAlpha(_))
+            && factored == Factored::Ok
+        {
+            ops.a0 = initial_acceleration(model, &ops, &mut sys)?;
+            factored = ops.refactor(&mut sys, &ops.kt)?;
+        }
         if let Factored::NotPositiveDefinite { dof, message } = factored {
             return Err(Error::Solver {
                 backend: sys.backend(),

@@ -53,7 +53,7 @@ pub(crate) enum Scheme {
 }
 
 /// The rule of an implicit dynamic step.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Rule {
     /// Backward Euler, eq. (9): `v = Δu/h`, the equation at the step's end.
     BackwardEuler,
@@ -61,23 +61,94 @@ pub(crate) enum Rule {
     /// and applied forces averaged over the step, the contact force at its end
     /// (`theory/trapezoidal.md`).
     Trapezoidal,
+    /// Chung and Hulbert's generalized-α (`theory/trapezoidal.md`): the acceleration
+    /// carried, inertia at `n+1−α_m`, damping, internal and applied forces at
+    /// `n+1−α_f`, the contact force at the step's end.
+    GeneralizedAlpha(Alpha),
+}
+
+/// Generalized-α's parameters from `ρ∞` (Chung and Hulbert 1993):
+/// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ − α_m + α_f`,
+/// `β = ¼ (1 − α_m + α_f)²`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Alpha {
+    pub alpha_m: f64,
+    pub alpha_f: f64,
+    pub beta: f64,
+    pub gamma: f64,
+}
+
+impl Alpha {
+    /// The parameters of spectral radius `rho_inf` at infinity.
+    pub fn of(rho_inf: f64) -> Alpha {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        let gamma = 0.5 - alpha_m + alpha_f;
+        let beta = 0.25 * (1.0 - alpha_m + alpha_f).powi(2);
+        Alpha {
+            alpha_m,
+            alpha_f,
+            beta,
+            gamma,
+        }
+    }
+
+    /// The step's coefficients at step `h`.
+    pub fn at(&self, h: f64) -> AlphaStep {
+        let Alpha {
+            alpha_m: am,
+            alpha_f: af,
+            beta: b,
+            gamma: g,
+        } = *self;
+        AlphaStep {
+            c_in: (1.0 - am) / (b * h * h),
+            c_v: g / (b * h),
+            w: 1.0 - af,
+            p_v: (1.0 - am) / (b * h),
+            p_a: (1.0 - am) * (0.5 - b) / b - am,
+            q_v: 1.0 - g / b,
+            q_a: h * (1.0 - g / (2.0 * b)),
+            h,
+            gamma: g,
+        }
+    }
+}
+
+/// Generalized-α's step in terms of `Δu`: `a_{n+1−α_m} = c_in Δu − (p_v v_n + p_a a_n)`,
+/// `v_{n+1} = c_v Δu + q_v v_n + q_a a_n`, the forces' end weight `w = 1 − α_f`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct AlphaStep {
+    pub c_in: f64,
+    pub c_v: f64,
+    pub w: f64,
+    pub p_v: f64,
+    pub p_a: f64,
+    pub q_v: f64,
+    pub q_a: f64,
+    pub h: f64,
+    pub gamma: f64,
 }
 
 impl Rule {
     /// The rule of a dynamic scheme (central differences has none).
-    pub fn of(scheme: crate::model::TimeScheme) -> Rule {
-        match scheme {
+    pub fn of(time: &crate::model::TimeSettings) -> Rule {
+        match time.scheme {
             crate::model::TimeScheme::Trapezoidal => Rule::Trapezoidal,
+            crate::model::TimeScheme::GeneralizedAlpha => {
+                Rule::GeneralizedAlpha(Alpha::of(time.rho_inf))
+            }
             _ => Rule::BackwardEuler,
         }
     }
 
-    /// The weight of the step's end in the internal and applied forces (1 or ½);
-    /// the start has the rest.
+    /// The weight of the step's end in the internal and applied forces (1, ½ or
+    /// `1 − α_f`); the start has the rest.
     pub fn theta(self) -> f64 {
         match self {
             Rule::BackwardEuler => 1.0,
             Rule::Trapezoidal => 0.5,
+            Rule::GeneralizedAlpha(a) => 1.0 - a.alpha_f,
         }
     }
 }
@@ -109,6 +180,9 @@ pub(crate) struct Operators {
     pub seat: f64,
     /// The stored energy of elastic models, translation removed.
     pub stored: crate::energy::StoredEnergy,
+    /// Generalized-α: the initial acceleration (`M a_0 = f_ext − f_int − C v_0` on the
+    /// free dofs), empty otherwise.
+    pub a0: Vec<f64>,
 }
 
 impl Operators {
@@ -147,6 +221,7 @@ impl Operators {
             rate_independent: model.materials.iter().all(|m| m.is_rate_independent()),
             seat: 0.0,
             stored: crate::energy::StoredEnergy::new(&model.mesh),
+            a0: Vec::new(),
             test: Convergence {
                 tolerance: a.iteration.tolerance,
                 displacement_tolerance: a.iteration.displacement_tolerance,
@@ -223,13 +298,21 @@ impl Operators {
             } => {
                 // r = M(v − v_n)/h + C(v + v_n)/2 or C v + θ f_int + …, with
                 // ∂v/∂u = 1/(θh): the mass term 1/(θh²), the damping 1/h, the
-                // internal force's θ.
+                // internal force's θ. Generalized-α: ∂a_{n+1−α_m}/∂u = c_in,
+                // ∂v_{n+1−α_f}/∂u = w c_v.
                 let theta = rule.theta();
-                let c_m = 1.0 / (theta * h * h) + damp_m / h;
+                let (mass, damp) = match rule {
+                    Rule::GeneralizedAlpha(a) => {
+                        let s = a.at(h);
+                        (s.c_in, s.w * s.c_v)
+                    }
+                    _ => (1.0 / (theta * h * h), 1.0 / h),
+                };
+                let c_m = mass + damp_m * damp;
                 let c_k = if c_t == 0.0 {
-                    theta + damp_k / h
+                    theta + damp_k * damp
                 } else {
-                    damp_k / h
+                    damp_k * damp
                 };
                 (c_m, c_k, theta * c_t)
             }
@@ -376,7 +459,7 @@ impl Operators {
             u,
             v,
             mv,
-            a: Vec::new(),
+            a: self.a0.clone(),
             f_int,
             f_ext,
             ledger: Ledger::new(e_kin0, e_el0),

@@ -14,6 +14,19 @@ pub(crate) struct PassCoefficients {
     pub damp_m: f64,
     /// Stiffness-proportional damping.
     pub damp_k: f64,
+    /// Generalized-α's step (`ALPHA` passes only).
+    pub alpha: Option<super::operators::AlphaStep>,
+}
+
+/// Generalized-α's vectors of the step's start, fixed through its iterations:
+/// `a_{n+1−α_m} = c_in Δu − p`, `v_{n+1} = c_v Δu + q`, `M v_{n+1} = c_v M Δu + mq`,
+/// and the damping force's part that does not depend on `Δu`, `d`.
+#[derive(Clone, Copy)]
+pub(crate) struct History<'a> {
+    pub p: &'a [f64],
+    pub q: &'a [f64],
+    pub mq: &'a [f64],
+    pub d: &'a [f64],
 }
 
 /// What the residual pass reads (whole vectors, or one chunk of each).
@@ -35,6 +48,8 @@ pub(crate) struct PassInputs<'a> {
     pub f_ext_n: &'a [f64],
     /// 1 on free dofs, 0 on constrained ones.
     pub free: &'a [f64],
+    /// Generalized-α's vectors of the step's start (`ALPHA` passes only).
+    pub history: Option<History<'a>>,
 }
 
 impl<'a> PassInputs<'a> {
@@ -49,6 +64,12 @@ impl<'a> PassInputs<'a> {
             f_int_n: &self.f_int_n[lo..hi],
             f_ext_n: &self.f_ext_n[lo..hi],
             free: &self.free[lo..hi],
+            history: self.history.map(|h| History {
+                p: &h.p[lo..hi],
+                q: &h.q[lo..hi],
+                mq: &h.mq[lo..hi],
+                d: &h.d[lo..hi],
+            }),
         }
     }
 }
@@ -108,7 +129,12 @@ impl PassSums {
 /// the trapezoidal rule (`TRAP`, with `DYN`: `v = 2Δu/h − v_n`, the internal and
 /// applied forces averaged, `C(v + v_n)/2`). Returns the chunk's [`PassSums`].
 #[inline]
-pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool, const TRAP: bool>(
+pub(crate) fn residual_chunk<
+    const DYN: bool,
+    const ELASTIC: bool,
+    const TRAP: bool,
+    const ALPHA: bool,
+>(
     inp: &PassInputs,
     out: PassOutputs,
     c: &PassCoefficients,
@@ -120,11 +146,39 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool, const TRAP: b
     let (mv_n, v_n, f_int_n) = (&inp.mv_n[..n], &inp.v_n[..n], &inp.f_int_n[..n]);
     let (f_ext_n, free) = (&inp.f_ext_n[..n], &inp.free[..n]);
     let mut acc = PassSums::default();
+    let (alpha, hist) = if ALPHA {
+        (
+            c.alpha.expect("generalized-α coefficients"),
+            inp.history.expect("generalized-α history"),
+        )
+    } else {
+        (
+            super::operators::Alpha::of(1.0).at(1.0),
+            History {
+                p: &[],
+                q: &[],
+                mq: &[],
+                d: &[],
+            },
+        )
+    };
     for i in 0..n {
         if ELASTIC {
             f_int[i] = f_int_n[i] + kdu[i];
         }
-        let (inertia, damping, momenta) = if TRAP {
+        let (inertia, damping, momenta) = if ALPHA {
+            // M a_{n+1−α_m} = c_in M Δu − p; M v_{n+1} = c_v M Δu + mq;
+            // C v_{n+1−α_f} = w c_v C Δu + d.
+            let m_du = mv[i];
+            mv[i] = alpha.c_v * m_du + hist.mq[i];
+            v[i] = alpha.c_v * du[i] + hist.q[i];
+            let wc = alpha.w * alpha.c_v;
+            (
+                alpha.c_in * m_du - hist.p[i],
+                c.damp_m * wc * m_du + c.damp_k * wc * kdu[i] + hist.d[i],
+                (mv[i].abs() + mv_n[i].abs()) * c.inv_h,
+            )
+        } else if TRAP {
             // M v = 2 M Δu/h − M v_n; C (v + v_n)/2 = C Δu/h.
             let m_du_h = mv[i] * c.inv_h;
             mv[i] = 2.0 * m_du_h - mv_n[i];
@@ -146,7 +200,12 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool, const TRAP: b
             (0.0, 0.0, 0.0)
         };
         let fi = f_int[i];
-        r[i] = if TRAP {
+        r[i] = if ALPHA {
+            let w = alpha.w;
+            inertia + damping + w * fi + (1.0 - w) * f_int_n[i]
+                - w * f_ext[i]
+                - (1.0 - w) * f_ext_n[i]
+        } else if TRAP {
             inertia + damping + 0.5 * (fi + f_int_n[i]) - 0.5 * (f_ext[i] + f_ext_n[i])
         } else {
             inertia + damping + fi - f_ext[i]
@@ -164,7 +223,11 @@ pub(crate) fn residual_chunk<const DYN: bool, const ELASTIC: bool, const TRAP: b
         if DYN {
             acc.kinetic += 0.5 * v[i] * mv[i];
         }
-        if TRAP {
+        if ALPHA {
+            // The inertia's work less the kinetic energy's change: the scheme's loss.
+            acc.internal_jump += 0.5 * du[i] * (fi - f_int_n[i]);
+            acc.scheme_loss += du[i] * inertia - 0.5 * (v[i] * mv[i] - v_n[i] * mv_n[i]);
+        } else if TRAP {
             acc.internal_jump += 0.5 * du[i] * (fi - f_int_n[i]);
         } else if DYN {
             acc.scheme_loss += 0.5 * (v[i] - v_n[i]) * (mv[i] - mv_n[i]);

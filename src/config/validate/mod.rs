@@ -198,6 +198,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 kind: a.kind,
                 scheme: a.scheme,
                 omega: a.omega.unwrap_or(DEFAULT_OMEGA),
+                rho_inf: a.rho_inf.unwrap_or(DEFAULT_RHO_INF),
                 dt: a.dt.unwrap_or(f64::NAN),
                 t_end: a.t_end,
                 lumped_mass: explicit || a.mass == Some(super::MassKind::Lumped),
@@ -491,6 +492,9 @@ fn unread_keys(a: &super::AnalysisSpec) -> Vec<String> {
     w
 }
 
+/// Generalized-α's default spectral radius at infinity.
+const DEFAULT_RHO_INF: f64 = 0.8;
+
 /// The paper's default fraction of the critical step.
 const DEFAULT_OMEGA: f64 = 0.9;
 
@@ -581,6 +585,21 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
             "analysis.mass",
             "central differences need the lumped mass (they invert it per dof); omit `mass`",
         ));
+    }
+    if let Some(r) = a.rho_inf {
+        if a.scheme != TimeScheme::GeneralizedAlpha {
+            return Err(Error::config(
+                "analysis.rho_inf",
+                "is generalized-α's spectral radius at infinity (scheme = \"generalized_alpha\"); \
+                 the other schemes read no rho_inf",
+            ));
+        }
+        if !(0.0..=1.0).contains(&r) {
+            return Err(Error::config(
+                "analysis.rho_inf",
+                format!("{r:?} is outside [0, 1] (1 damps nothing, 0 the most)"),
+            ));
+        }
     }
     if let Some(w) = a.omega {
         if !explicit {
