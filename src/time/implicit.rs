@@ -60,13 +60,8 @@ pub(crate) struct Scratch {
     kt_du: Vec<f64>,
     /// The residual (all dofs).
     r: Vec<f64>,
-    /// Generalized-α: the step's start vectors (`residual::History`), `M a_n`, and
-    /// the new acceleration.
-    hist_p: Vec<f64>,
-    hist_q: Vec<f64>,
-    hist_mq: Vec<f64>,
-    hist_d: Vec<f64>,
-    ma_n: Vec<f64>,
+    /// Generalized-α: the step's start vectors, and the new acceleration.
+    alpha: super::generalized_alpha::StartVectors,
     a_np1: Vec<f64>,
     /// Tangent of the last evaluation (state-dependent materials).
     kt: Vec<f64>,
@@ -124,11 +119,7 @@ impl Scratch {
             m_du: z(),
             kt_du: z(),
             r: z(),
-            hist_p: Vec::new(),
-            hist_q: Vec::new(),
-            hist_mq: Vec::new(),
-            hist_d: Vec::new(),
-            ma_n: Vec::new(),
+            alpha: Default::default(),
             a_np1: Vec::new(),
             kt: if matches!(ops.response, Response::StateDependent(_)) {
                 vec![0.0; ops.asm.pattern.nnz()]
@@ -208,7 +199,7 @@ impl StepProblem for ImplicitStep<'_> {
         let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext_np1, &w.m_du, &w.kdu, &w.kt_du);
         let (f_int_n, f_ext_n) = (&s.f_int, &s.f_ext);
         let rule = ops.rule();
-        let (hist_p, hist_d) = (&w.hist_p, &w.hist_d);
+        let (hist_p, hist_d) = (&w.alpha.p, &w.alpha.d);
         let value = |i: usize| {
             // The residual at Δu = Δu_c: the forces at the step's end (averaged with
             // the start's by the trapezoidal rule and generalized-α), the momentum of
@@ -359,12 +350,7 @@ impl StepProblem for ImplicitStep<'_> {
             f_int_n: &s.f_int,
             f_ext_n: &s.f_ext,
             free: &ops.free_mask,
-            history: alpha.map(|_| super::residual::History {
-                p: &w.hist_p,
-                q: &w.hist_q,
-                mq: &w.hist_mq,
-                d: &w.hist_d,
-            }),
+            history: alpha.map(|_| w.alpha.history()),
         };
         // In halves of a fixed tree (`crate::halves`): the same sums in every run, on
         // any number of threads.
@@ -507,7 +493,7 @@ pub(crate) fn step(
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
     if let Rule::GeneralizedAlpha(a) = ops.rule() {
-        alpha_history(ops, &a, s, w);
+        super::generalized_alpha::history(ops, &a, s, &mut w.alpha);
     }
     let mut u = std::mem::take(&mut w.u_np1);
     let corrections_before = w.corrections;
@@ -621,41 +607,6 @@ pub(crate) fn step(
         });
     }
     Ok(StepOutcome::Accepted(report))
-}
-
-/// Generalized-α's vectors of the step's start (`residual::History`), from `v_n`,
-/// `M v_n`, `a_n` and `M a_n`.
-fn alpha_history(ops: &Operators, a: &super::operators::Alpha, s: &State, w: &mut Scratch) {
-    let st = a.at(ops.h());
-    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
-    let n = s.v.len();
-    w.ma_n.resize(n, 0.0);
-    ops.mass.matvec(&ops.asm.pattern, &s.a, &mut w.ma_n);
-    let (v, mv, acc, ma) = (&s.v, &s.mv, &s.a, &w.ma_n);
-    w.hist_p.clear();
-    w.hist_p
-        .extend((0..n).map(|i| st.p_v * mv[i] + st.p_a * ma[i]));
-    w.hist_q.clear();
-    w.hist_q
-        .extend((0..n).map(|i| st.q_v * v[i] + st.q_a * acc[i]));
-    w.hist_mq.clear();
-    w.hist_mq
-        .extend((0..n).map(|i| st.q_v * mv[i] + st.q_a * ma[i]));
-    // C v_{n+1−α_f} less its Δu part: damp_m M(w q + (1 − w) v_n) + damp_k K(…).
-    let wq = st.w;
-    w.hist_d.clear();
-    w.hist_d
-        .extend((0..n).map(|i| damp_m * (wq * w.hist_mq[i] + (1.0 - wq) * mv[i])));
-    if damp_k != 0.0 {
-        let x: Vec<f64> = (0..n)
-            .map(|i| wq * w.hist_q[i] + (1.0 - wq) * v[i])
-            .collect();
-        let mut kx = vec![0.0; n];
-        ops.asm.pattern.matvec(&ops.k, &x, &mut kx);
-        for (d, k) in w.hist_d.iter_mut().zip(&kx) {
-            *d += damp_k * k;
-        }
-    }
 }
 
 /// Sets the start of a step's iteration: `u` is `u_n` with the prescribed values of
@@ -833,40 +784,6 @@ pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, Effec
     Ok((ops.asm, ops.k, ops.mass, sys))
 }
 
-/// Generalized-α's `a_0`: `M a_0 = f_ext(0) − f_int(u_0) − C v_0` on the free dofs
-/// (zero on the constrained ones), one factorisation of `M` on the system's pattern.
-fn initial_acceleration(
-    model: &Model,
-    ops: &Operators,
-    sys: &mut EffectiveSystem,
-) -> Result<Vec<f64>> {
-    let s = ops.initial_state(model);
-    let n = s.v.len();
-    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
-    let mut kv = vec![0.0; n];
-    if damp_k != 0.0 {
-        ops.asm.pattern.matvec(&ops.k, &s.v, &mut kv);
-    }
-    let free = sys.dofs().free.clone();
-    let mut rhs: Vec<f64> = free
-        .iter()
-        .map(|&d| s.f_ext[d] - s.f_int[d] - damp_m * s.mv[d] - damp_k * kv[d])
-        .collect();
-    sys.refill(1.0, &ops.mass, &[]);
-    if let Factored::NotPositiveDefinite { message, .. } = sys.factorize()? {
-        return Err(Error::Solver {
-            backend: sys.backend(),
-            message: format!("the mass matrix for generalized-α's initial acceleration: {message}"),
-        });
-    }
-    sys.solve(&mut rhs)?;
-    let mut a0 = vec![0.0; n];
-    for (&d, x) in free.iter().zip(rhs) {
-        a0[d] = x;
-    }
-    Ok(a0)
-}
-
 /// The integrator parts every implicit scheme holds.
 pub(crate) struct Core<'m> {
     pub model: &'m Model,
@@ -897,7 +814,7 @@ impl<'m> Core<'m> {
         if matches!(ops.rule(), super::operators::Rule::GeneralizedAlpha(_))
             && factored == Factored::Ok
         {
-            ops.a0 = initial_acceleration(model, &ops, &mut sys)?;
+            ops.a0 = super::generalized_alpha::initial_acceleration(model, &ops, &mut sys)?;
             factored = ops.refactor(&mut sys, &ops.kt)?;
         }
         if let Factored::NotPositiveDefinite { dof, message } = factored {

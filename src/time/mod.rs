@@ -13,6 +13,7 @@ pub mod central_difference;
 pub mod cfl;
 mod diagnostics;
 pub mod forces;
+mod generalized_alpha;
 mod implicit;
 pub mod march;
 pub mod nodal;

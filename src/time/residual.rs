@@ -15,7 +15,7 @@ pub(crate) struct PassCoefficients {
     /// Stiffness-proportional damping.
     pub damp_k: f64,
     /// Generalized-α's step (`ALPHA` passes only).
-    pub alpha: Option<super::operators::AlphaStep>,
+    pub alpha: Option<super::generalized_alpha::AlphaStep>,
 }
 
 /// Generalized-α's vectors of the step's start, fixed through its iterations:
@@ -153,7 +153,7 @@ pub(crate) fn residual_chunk<
         )
     } else {
         (
-            super::operators::Alpha::of(1.0).at(1.0),
+            super::generalized_alpha::Alpha::of(1.0).at(1.0),
             History {
                 p: &[],
                 q: &[],

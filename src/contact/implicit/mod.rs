@@ -36,6 +36,15 @@ use crate::system::EffectiveSystem;
 use super::state::Key;
 pub use super::state::{ContactState, PairRecord};
 
+/// A sparse row of `G` times a vector over the free dofs.
+fn row_dot(row: &nalgebra_sparse::csr::CsrRow<'_, f64>, x: &[f64]) -> f64 {
+    row.col_indices()
+        .iter()
+        .zip(row.values())
+        .map(|(&e, v)| v * x[e])
+        .sum()
+}
+
 /// The slaves (pair, side, node) of a sorted list of constraint keys, distinct.
 fn slaves(keys: &[Key]) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
     let mut last = None;
@@ -462,13 +471,7 @@ impl<'m> ContactCorrection<'m> {
         self.gaps.clear();
         for (i, c) in self.cands.iter().enumerate() {
             let row = g.row(i);
-            let dot = |x: &[f64]| {
-                row.col_indices()
-                    .iter()
-                    .zip(row.values())
-                    .map(|(&e, v)| v * x[e])
-                    .sum::<f64>()
-            };
+            let dot = |x: &[f64]| row_dot(&row, x);
             // The gap at u: at u + hv less its linearised change over hv.
             let gap = if leading {
                 c.gap - dot(&self.lead)
@@ -506,13 +509,7 @@ impl<'m> ContactCorrection<'m> {
                 if mu > 0.0 {
                     let slip = self.slip(c, u);
                     for (t, s) in slip.iter().enumerate().take(tdim) {
-                        let row = g.row(n_cands + tdim * i + t);
-                        let moved: f64 = row
-                            .col_indices()
-                            .iter()
-                            .zip(row.values())
-                            .map(|(&e, v)| v * self.delta0[e])
-                            .sum();
+                        let moved = row_dot(&g.row(n_cands + tdim * i + t), &self.delta0);
                         self.rows.push(n_cands + tdim * i + t);
                         self.c.push(s + moved);
                     }
@@ -543,13 +540,7 @@ impl<'m> ContactCorrection<'m> {
             if row.nnz() == 0 || inside.binary_search(&i).is_ok() {
                 continue;
             }
-            let moved: f64 = row
-                .col_indices()
-                .iter()
-                .zip(row.values())
-                .map(|(&e, v)| v * self.delta0[e])
-                .sum();
-            if self.gaps[i] + moved < -floor {
+            if self.gaps[i] + row_dot(&row, &self.delta0) < -floor {
                 self.forced.push(i);
             }
         }
