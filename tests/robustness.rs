@@ -1671,3 +1671,34 @@ fn a_solid_resting_or_grazing_at_a_zero_gap_keeps_its_steps() {
         assert!(rel.abs() < 1e-8, "{what}: ledger {rel:e}");
     }
 }
+
+#[test]
+fn a_material_file_type_error_names_the_key_inside_the_material() {
+    // The `model` tag hides the key from serde's path; the message names it, as a
+    // scenario's `materials.<name>.<key>` does.
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/materials/mazars_tension.toml"),
+    )
+    .unwrap();
+    for (from, to, key) in [
+        ("nu = 0.2", "nu = \"abc\"", "material.nu"),
+        ("E = 33e9", "E = [1, 2]", "material.E"),
+    ] {
+        let bad = text.replacen(from, to, 1);
+        assert_ne!(bad, text);
+        let dir = tempfile::tempdir().unwrap();
+        let sc = scenario(dir.path(), "m.toml", &bad);
+        let out = dir.path().join("out");
+        let (ok, _, err) = rothe(&[
+            "material",
+            sc.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!ok && !err.contains("panicked"), "{err}");
+        assert!(
+            err.contains(&format!("{key} (line")),
+            "`{key}` not in: {err}"
+        );
+    }
+}

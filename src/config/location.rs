@@ -5,32 +5,44 @@
 use crate::error::Error;
 
 /// A material is read through its `model` tag, which hides the key inside it from
-/// the path serde reports (`materials.steel`): the path with the key whose value is
-/// what `message` complains of appended, when one key's is (`table` gives the
-/// scenario as read).
+/// the path serde reports (`materials.steel` in a scenario, `material` in a
+/// material file): the path with the key whose value is what `message` complains of
+/// appended, when one key's is (`table` gives the text as read).
 pub(super) fn within_material(
     path: String,
     message: &str,
     table: impl FnOnce() -> Option<toml::Table>,
 ) -> String {
-    let Some(name) = path.strip_prefix("materials.").filter(|n| !n.contains('.')) else {
-        return path;
+    // A scenario's `materials.<name>`, or a material file's one `material`.
+    let lookup: Vec<String> = if path == "material" {
+        vec!["material".into()]
+    } else {
+        match path.strip_prefix("materials.").filter(|n| !n.contains('.')) {
+            Some(name) => vec!["materials".into(), name.into()],
+            None => return path,
+        }
     };
-    match table().and_then(|t| key_of_unexpected(&t, name, message)) {
+    let found = table().and_then(|t| {
+        let mut v = t.get(&lookup[0])?;
+        for k in &lookup[1..] {
+            v = v.get(k)?;
+        }
+        key_of_unexpected(v.as_table()?, message)
+    });
+    match found {
         Some(key) => format!("{path}.{key}"),
         None => path,
     }
 }
 
-/// The key (dotted, within the material's table) of material `name` whose value is
-/// the one a "invalid type: <what>, expected ..." message names, when exactly one
-/// key's value is.
-fn key_of_unexpected(table: &toml::Table, name: &str, message: &str) -> Option<String> {
+/// The key (dotted, within the material's table) whose value is the one a
+/// "invalid type: <what>, expected ..." message names, when exactly one key's value
+/// is.
+fn key_of_unexpected(material: &toml::Table, message: &str) -> Option<String> {
     let what = message
         .strip_prefix("invalid type: ")?
         .split(", expected")
         .next()?;
-    let material = table.get("materials")?.get(name)?.as_table()?;
     fn describe(v: &toml::Value) -> String {
         match v {
             toml::Value::String(s) => format!("string {s:?}"),
