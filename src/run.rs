@@ -138,6 +138,10 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         steps: 0,
         t_end: 0.0,
         dt: a.time.dt,
+        scheme: (a.time.kind == AnalysisKind::Dynamic).then_some(a.time.scheme),
+        rho_inf: (a.time.kind == AnalysisKind::Dynamic
+            && a.time.scheme == TimeScheme::GeneralizedAlpha)
+            .then_some(a.time.rho_inf),
         materials: model
             .materials
             .iter()

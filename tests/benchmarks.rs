@@ -273,6 +273,10 @@ fn benchmark_1_by_the_trapezoidal_rule_loses_only_the_impact() {
             &out,
         );
         assert_ledger_and_checks(&s, "trapezoidal");
+        // summary.json says which scheme ran.
+        assert_eq!(s.scheme, Some(rothe::model::TimeScheme::Trapezoidal));
+        let json = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        assert!(json.contains("\"scheme\": \"trapezoidal\""), "{json}");
         let d = &s.energy.dissipated;
         let k = s.energy.kinetic_0;
         eprintln!(

@@ -283,6 +283,13 @@ pub struct Summary {
     pub t_end: f64,
     /// Step size.
     pub dt: f64,
+    /// The time scheme of a dynamic run (`backward_euler`, `trapezoidal`,
+    /// `generalized_alpha`, `central_difference`); absent in statics.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scheme: Option<crate::model::TimeScheme>,
+    /// Generalized-α's spectral radius at infinity.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rho_inf: Option<f64>,
     /// The materials by name: model and regularisation.
     pub materials: BTreeMap<String, MaterialSummary>,
     /// Probe extremes.
