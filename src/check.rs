@@ -45,6 +45,8 @@ pub struct Report {
     pub scheme: Option<crate::model::TimeScheme>,
     /// Generalized-α's spectral radius at infinity.
     pub rho_inf: f64,
+    /// The second-order schemes' contact predictor.
+    pub contact_predictor: crate::model::ContactPredictor,
     /// How an implicit step of damage or plasticity iterates: the method and the
     /// kept factor's rate (`None` when every material has a constant tangent or the
     /// scheme is explicit).
@@ -201,6 +203,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
         scheme: (a.time.kind == crate::model::AnalysisKind::Dynamic).then_some(a.time.scheme),
         rho_inf: a.time.rho_inf,
+        contact_predictor: a.time.contact_predictor,
         iteration: (a.time.scheme.is_implicit()
             && model.materials.iter().any(|m| !m.has_constant_tangent()))
         .then_some((a.iteration.method, a.iteration.refactor_rate)),
@@ -303,6 +306,13 @@ impl fmt::Display for Report {
                         "central differences (explicit, lumped mass, kinematic contact)".into(),
                 }
             )?;
+            if self.contact_predictor == crate::model::ContactPredictor::Stabilised {
+                writeln!(
+                    f,
+                    "predictor   contact-stabilised (the free flight projected onto the \
+                     admissible set before each step; its loss in D_predictor)"
+                )?;
+            }
         }
         if let Some((method, rate)) = self.iteration {
             let method = match method {

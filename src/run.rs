@@ -142,6 +142,8 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
         rho_inf: (a.time.kind == AnalysisKind::Dynamic
             && a.time.scheme == TimeScheme::GeneralizedAlpha)
             .then_some(a.time.rho_inf),
+        contact_predictor: (a.time.contact_predictor != crate::model::ContactPredictor::None)
+            .then_some(a.time.contact_predictor),
         materials: model
             .materials
             .iter()

@@ -301,6 +301,53 @@ fn compare_sets_the_implicit_and_explicit_ledgers_side_by_side() {
 }
 
 #[test]
+fn compare_takes_a_second_order_scheme_with_its_keys_to_the_implicit_run_only() {
+    // generalized-α with its radius and the contact predictor: the explicit run
+    // reads neither (they are refused there), so they stay with the implicit one.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let (ok, md, err) = rothe(&[
+        "compare",
+        example("benchmarks/two_blocks.toml").to_str().unwrap(),
+        "--implicit-scheme",
+        "generalized_alpha",
+        "--set",
+        "analysis.rho_inf=0.5",
+        "--set",
+        "analysis.contact_predictor=stabilised",
+        "--set",
+        "meshing.element_size=0.2",
+        "--set",
+        "analysis.t_end=3e-3",
+        "--set",
+        "analysis.vtk_every=0",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    let row = csv
+        .lines()
+        .find(|l| l.starts_with("D_predictor [J]"))
+        .unwrap_or_else(|| panic!("no D_predictor row:\n{md}"));
+    let v: Vec<f64> = row
+        .split(',')
+        .skip(1)
+        .take(2)
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert!(v[0] > 0.0 && v[1] == 0.0, "{v:?}");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("runs/implicit/summary.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(summary["scheme"], "generalized_alpha");
+    assert_eq!(summary["rho_inf"], 0.5);
+    assert_eq!(summary["contact_predictor"], "stabilised");
+}
+
+#[test]
 fn plot_draws_a_runs_charts_and_variants_are_checked() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");

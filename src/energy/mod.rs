@@ -7,6 +7,9 @@
 //!
 //! `ΔE_kin + ΔE_el + ΔD_viscous + ΔD_damage + ΔD_plastic + ΔD_contact + ΔD_mass + ΔD_num = ΔW_ext`
 //!
+//! (with friction `ΔD_friction`, and with the contact predictor of the second-order
+//! schemes `ΔD_predictor`, on the left too)
+//!
 //! with `ΔW_ext = ½Δu·(f_ext⁰+f_ext¹)` (trapezoidal), `ΔD_mass = Δu·C v₁` and the
 //! scheme's own loss `ΔD_num = (scheme's kinetic loss) + (material algorithmic loss)
 //! − ½Δu·(f_ext¹−f_ext⁰)`. The balance residual is the left side minus the right side;
@@ -42,6 +45,9 @@ pub struct Dissipation {
     pub contact: f64,
     /// Friction: the work of the tangential contact forces on the slip, `≥ 0`.
     pub friction: f64,
+    /// The contact-stabilised predictor: the kinetic energy its projection of the
+    /// free flight onto the admissible set removes before a step.
+    pub predictor: f64,
     /// Mass and Rayleigh damping `∫ v·C v dt`.
     pub mass: f64,
     /// The time scheme's own numerical loss. At a material point:
@@ -59,6 +65,7 @@ impl Dissipation {
             + self.plastic
             + self.contact
             + self.friction
+            + self.predictor
             + self.mass
             + self.numerical
     }
@@ -76,19 +83,21 @@ impl Dissipation {
             plastic: w * self.plastic,
             contact: w * self.contact,
             friction: w * self.friction,
+            predictor: w * self.predictor,
             mass: w * self.mass,
             numerical: w * self.numerical,
         }
     }
 
     /// The lines as `(name, value)` pairs, in the order of `history.csv`.
-    pub fn lines(&self) -> [(&'static str, f64); 7] {
+    pub fn lines(&self) -> [(&'static str, f64); 8] {
         [
             ("viscous", self.viscous),
             ("damage", self.damage),
             ("plastic", self.plastic),
             ("contact", self.contact),
             ("friction", self.friction),
+            ("predictor", self.predictor),
             ("mass", self.mass),
             ("numerical", self.numerical),
         ]
@@ -102,6 +111,7 @@ impl AddAssign for Dissipation {
         self.plastic += o.plastic;
         self.contact += o.contact;
         self.friction += o.friction;
+        self.predictor += o.predictor;
         self.mass += o.mass;
         self.numerical += o.numerical;
     }
@@ -133,6 +143,8 @@ pub struct StepIncrements {
     pub contact: f64,
     /// Energy taken out by friction in the step.
     pub friction: f64,
+    /// Kinetic energy the contact predictor removed before the step.
+    pub predictor: f64,
 }
 
 /// The running ledger. Fields are read through accessors; only [`Ledger::record`]
@@ -173,6 +185,7 @@ impl Ledger {
         let mut step = s.material;
         step.contact += s.contact;
         step.friction += s.friction;
+        step.predictor += s.predictor;
         step.mass += s.work.damping;
         step.numerical += s.scheme_loss - s.work.load_jump;
         self.dissipated += step;
@@ -330,6 +343,7 @@ mod tests {
             plastic: 3.0,
             contact: 4.0,
             friction: 7.0,
+            predictor: 8.0,
             mass: 5.0,
             numerical: 6.0,
         };
@@ -337,7 +351,8 @@ mod tests {
         b += a;
         assert_eq!(b.plastic, 4.5);
         assert_eq!(b.friction, 10.5);
-        assert_eq!((a + a).total(), 56.0);
+        assert_eq!(b.predictor, 12.0);
+        assert_eq!((a + a).total(), 72.0);
         assert_eq!(a.material(), 6.0);
     }
 
@@ -360,6 +375,7 @@ mod tests {
             scheme_loss: 0.5,
             contact: 1.0,
             friction: 0.0,
+            predictor: 0.0,
         });
         // ΔE_kin + ΔE_el + D − W = −6 + 3 + (1 + 1 + 1) − 0 = 0.
         assert_eq!(l.residual(), 0.0);

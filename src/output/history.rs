@@ -8,7 +8,7 @@ use crate::energy::Ledger;
 use crate::error::{Error, Result};
 
 /// The fixed ledger columns.
-pub const LEDGER_COLUMNS: [&str; 13] = [
+pub const LEDGER_COLUMNS: [&str; 14] = [
     "t",
     "E_kin",
     "E_int",
@@ -19,6 +19,7 @@ pub const LEDGER_COLUMNS: [&str; 13] = [
     "D_plastic",
     "D_contact",
     "D_friction",
+    "D_predictor",
     "D_mass",
     "D_num",
     "residual",
@@ -79,9 +80,9 @@ impl History {
     ) -> Result<()> {
         let d = l.dissipated();
         let mut line = format!(
-            "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
+            "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
             l.kinetic(), l.internal(), l.external_work(), l.elastic(), d.viscous, d.damage, d.plastic,
-            d.contact, d.friction, d.mass, d.numerical, l.residual()
+            d.contact, d.friction, d.predictor, d.mass, d.numerical, l.residual()
         );
         for p in probes {
             line.push_str(&format!(",{:.12e},{:.12e}", p[0], p[1]));

@@ -290,6 +290,9 @@ pub struct Summary {
     /// Generalized-α's spectral radius at infinity.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rho_inf: Option<f64>,
+    /// `stabilised` when the contact-stabilised predictor ran (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_predictor: Option<crate::model::ContactPredictor>,
     /// The materials by name: model and regularisation.
     pub materials: BTreeMap<String, MaterialSummary>,
     /// Probe extremes.

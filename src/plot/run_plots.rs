@@ -9,12 +9,13 @@ use super::history::History;
 use crate::error::{Error, Result};
 
 /// The dissipation lines of the ledger, with their legend labels.
-const DISSIPATION: [(&str, &str); 7] = [
+const DISSIPATION: [(&str, &str); 8] = [
     ("D_viscous", "D_viscous (viscous)"),
     ("D_damage", "D_damage (damage)"),
     ("D_plastic", "D_plastic (plastic)"),
     ("D_contact", "D_contact (contact)"),
     ("D_friction", "D_friction (friction)"),
+    ("D_predictor", "D_predictor (contact predictor)"),
     ("D_mass", "D_mass (mass damping)"),
     ("D_num", "D_num (numerical)"),
 ];

@@ -138,23 +138,25 @@ impl RunData {
 }
 
 /// The dissipation lines of `summary.json`.
-pub const DISSIPATION_LINES: [&str; 7] = [
+pub const DISSIPATION_LINES: [&str; 8] = [
     "viscous",
     "damage",
     "plastic",
     "contact",
     "friction",
+    "predictor",
     "mass",
     "numerical",
 ];
 
 /// The dissipation columns of `history.csv`.
-pub const DISSIPATION_COLUMNS: [&str; 7] = [
+pub const DISSIPATION_COLUMNS: [&str; 8] = [
     "D_viscous",
     "D_damage",
     "D_plastic",
     "D_contact",
     "D_friction",
+    "D_predictor",
     "D_mass",
     "D_num",
 ];

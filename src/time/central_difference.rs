@@ -410,6 +410,7 @@ impl Integrator for CentralDifference<'_> {
             // The kinematic method's impacts, friction interpolation included.
             contact,
             friction: 0.0,
+            predictor: 0.0,
         });
         if let Some((quantity, value)) = ledger.first_non_finite() {
             let outcome = Outcome::NonFinite {

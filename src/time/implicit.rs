@@ -18,6 +18,7 @@ use super::diagnostics::{describe, likely_cause};
 use super::forces::external_force;
 use super::nodal::{MassProduct, NodalState};
 use super::operators::{Operators, Response, Rule, Scheme};
+use super::predictor::Predictor;
 use super::residual::{residual_chunk, PassCoefficients, PassInputs, PassOutputs, PassSums};
 use super::{Rejection, State, StepOutcome, StepReport};
 use crate::assembly::internal::{new_stores, PointPass, PointTotals};
@@ -27,7 +28,7 @@ use crate::energy::{Dissipation, StepIncrements, StepWork};
 use crate::error::{Error, Result};
 use crate::halves;
 use crate::linsolve::Backend;
-use crate::model::{IterationMethod, Model};
+use crate::model::{ContactPredictor, IterationMethod, Model};
 use crate::nonlinear::{
     self, Convergence, Correction, Evaluation, LinearCorrection, Outcome, StepProblem,
 };
@@ -487,11 +488,27 @@ pub(crate) fn step(
     sys: &mut EffectiveSystem,
     w: &mut Scratch,
     correction: &mut Corrector,
+    mut predictor: Option<&mut Predictor>,
     s: &mut State,
 ) -> Result<StepOutcome> {
     let h = ops.h();
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
+    // The contact-stabilised predictor: the step starts from the velocity of the
+    // free flight projected onto the admissible set (restored if the step fails).
+    let mut predicted = 0.0;
+    if let Some(p) = predictor.as_deref_mut() {
+        match p.project(ops, s)? {
+            Ok(loss) => predicted = loss,
+            Err(outcome) => {
+                let message = format!(
+                    "the contact predictor's projection of the free flight: {}",
+                    describe(model, &outcome, t1, h)
+                );
+                return Ok(StepOutcome::Rejected(Rejection { outcome, message }));
+            }
+        }
+    }
     if let Rule::GeneralizedAlpha(a) = ops.rule() {
         super::generalized_alpha::history(ops, &a, s, &mut w.alpha);
     }
@@ -586,9 +603,15 @@ pub(crate) fn step(
                 value,
             };
             let message = describe(model, &outcome, t1, h);
+            if let Some(p) = predictor {
+                p.restore(s);
+            }
             return Ok(StepOutcome::Rejected(Rejection { outcome, message }));
         }
         other => {
+            if let Some(p) = predictor {
+                p.restore(s);
+            }
             let message = describe(model, &other, t1, h);
             return Ok(StepOutcome::Rejected(Rejection {
                 outcome: other,
@@ -597,7 +620,7 @@ pub(crate) fn step(
         }
     };
     let contact = correction.finish(&w.du, s);
-    finish(ops, sys.dofs(), w, s, t1, contact);
+    finish(ops, sys.dofs(), w, s, t1, contact, predicted);
     if let Some((quantity, value)) = s.ledger.first_non_finite() {
         return Err(Error::NonFinite {
             quantity: format!("the ledger line {quantity}"),
@@ -648,6 +671,7 @@ fn finish(
     s: &mut State,
     t1: f64,
     (contact, friction): (f64, f64),
+    predictor: f64,
 ) {
     let mut sums = w.ledger_sums;
     let trapezoidal = ops.rule() == Rule::Trapezoidal;
@@ -721,6 +745,7 @@ fn finish(
         scheme_loss,
         contact,
         friction,
+        predictor,
     });
     std::mem::swap(&mut s.u, &mut w.u_np1);
     std::mem::swap(&mut s.f_int, &mut w.f_int_np1);
@@ -791,6 +816,8 @@ pub(crate) struct Core<'m> {
     pub sys: EffectiveSystem,
     pub scratch: Scratch,
     pub correction: Corrector<'m>,
+    /// The contact-stabilised predictor, when the scenario asks for it.
+    pub predictor: Option<Predictor<'m>>,
     pub assembly_s: f64,
     /// Time inside steps besides solves and refactorisations.
     pub step_other_s: f64,
@@ -828,6 +855,10 @@ impl<'m> Core<'m> {
                 ),
             });
         }
+        let predictor = (ops.dynamic().is_some()
+            && model.analysis.time.contact_predictor == ContactPredictor::Stabilised)
+            .then(|| Predictor::new(model, &ops, backend))
+            .transpose()?;
         let mut scratch = Scratch::new(model.mesh.n_dofs(), &ops, sys.dofs().n_free());
         if let Some(kt) = kt_at_rest {
             // The factor holds the tangent at rest: kept while the points stay there.
@@ -844,6 +875,7 @@ impl<'m> Core<'m> {
             } else {
                 Corrector::Contact(Box::new(ContactCorrection::new(model)))
             },
+            predictor,
             assembly_s,
             step_other_s: 0.0,
         })
@@ -859,6 +891,7 @@ impl<'m> Core<'m> {
             &mut self.sys,
             &mut self.scratch,
             &mut self.correction,
+            self.predictor.as_mut(),
             s,
         );
         let after = self.sys.timing();

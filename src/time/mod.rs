@@ -18,6 +18,7 @@ mod implicit;
 pub mod march;
 pub mod nodal;
 mod operators;
+mod predictor;
 mod residual;
 pub use implicit::first_matrices;
 pub mod statics;

@@ -31,6 +31,7 @@ pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness:
                 scheme: rothe::model::TimeScheme::BackwardEuler,
                 omega: 0.9,
                 rho_inf: 0.8,
+                contact_predictor: Default::default(),
                 dt: 1.0,
                 t_end: 1.0,
                 lumped_mass: false,

@@ -157,6 +157,15 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let loads = constraints::loads(s, &mesh, &bodies)?;
     let probes = constraints::probes(s, &mesh)?;
     let (contacts, shortest) = contacts::contacts(s, &mesh, a.scheme)?;
+    if a.contact_predictor == Some(crate::model::ContactPredictor::Stabilised)
+        && contacts.is_empty()
+    {
+        return Err(Error::config(
+            "analysis.contact_predictor",
+            "\"stabilised\" projects the free flight onto the contact constraints, and the \
+             scenario has no contact pair; remove the key",
+        ));
+    }
     if a.contact_qp == Some(crate::model::ContactQp::Full)
         && a.scheme != TimeScheme::CentralDifference
     {
@@ -199,6 +208,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 scheme: a.scheme,
                 omega: a.omega.unwrap_or(DEFAULT_OMEGA),
                 rho_inf: a.rho_inf.unwrap_or(DEFAULT_RHO_INF),
+                contact_predictor: a.contact_predictor.unwrap_or_default(),
                 dt: a.dt.unwrap_or(f64::NAN),
                 t_end: a.t_end,
                 lumped_mass: explicit || a.mass == Some(super::MassKind::Lumped),
@@ -600,6 +610,21 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
                 format!("{r:?} is outside [0, 1] (1 damps nothing, 0 the most)"),
             ));
         }
+    }
+    if a.contact_predictor == Some(crate::model::ContactPredictor::Stabilised)
+        && (a.kind == AnalysisKind::Static
+            || !matches!(
+                a.scheme,
+                TimeScheme::Trapezoidal | TimeScheme::GeneralizedAlpha
+            ))
+    {
+        return Err(Error::config(
+            "analysis.contact_predictor",
+            "\"stabilised\" is the predictor of the second-order implicit schemes \
+             (scheme = \"trapezoidal\" or \"generalized_alpha\"): backward Euler's contact \
+             takes no rebound to stabilise, central differences have their kinematic contact, \
+             a static analysis has no free flight",
+        ));
     }
     if let Some(w) = a.omega {
         if !explicit {

@@ -240,6 +240,18 @@ impl<'m> ContactCorrection<'m> {
         }
     }
 
+    /// The same correction without friction: impenetrability only (the contact
+    /// predictor's projection).
+    pub fn frictionless(mut self) -> Self {
+        self.frictional = false;
+        self
+    }
+
+    /// Whether any constraint carries a force at the last iterate.
+    pub fn has_forces(&self) -> bool {
+        !self.lambda.is_empty()
+    }
+
     /// Starts a step from the contact state of the last one: its multipliers are the
     /// first guess of the forces, its active set the reference of the first QP.
     pub fn begin_step(&mut self, committed: &ContactState, u: &[f64], lead: Option<(f64, &[f64])>) {
