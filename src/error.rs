@@ -72,6 +72,22 @@ pub enum Error {
     /// what the others gave was collected.
     #[error("{0}")]
     RunsFailed(String),
+    /// The run's observer asked it to stop (a progress callback), after `step`.
+    #[error("stopped by the caller after step {step} (t = {t:.6e} s)")]
+    Stopped {
+        /// The last accepted step.
+        step: usize,
+        /// Its time.
+        t: f64,
+    },
+    /// The run was interrupted (Ctrl-C) after `step`.
+    #[error("interrupted after step {step} (t = {t:.6e} s)")]
+    Interrupted {
+        /// The last accepted step.
+        step: usize,
+        /// Its time.
+        t: f64,
+    },
     /// A bug: something that must not happen did (a panic caught at the top).
     #[error("internal error (please report it with the input file): {0}")]
     Internal(String),

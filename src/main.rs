@@ -309,6 +309,7 @@ fn run_command(
             memory_limit: scenario.options().memory_limit,
             record_fields,
             overwrite,
+            hooks: Default::default(),
         },
     )?;
     eprintln!(

@@ -7,7 +7,7 @@
 //! run is caught and reported as an internal error, with `status = "failed"`.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -46,6 +46,79 @@ pub struct RunOptions {
     /// Remove an earlier run's files from `out` (otherwise they are refused:
     /// [`crate::output::prepare`]).
     pub overwrite: bool,
+    /// What a caller embedding the run keeps and watches (the Python module);
+    /// the command line's runs take the default.
+    pub hooks: Hooks,
+}
+
+/// What an embedding caller asks of a run besides its files.
+#[derive(Clone, Debug, Default)]
+pub struct Hooks {
+    /// Write nothing (`out` is ignored): the run lives in memory only.
+    pub no_files: bool,
+    /// Keep the history's columns (and, with `record_fields`, every displacement)
+    /// in memory for [`run_kept`] to return.
+    pub keep: bool,
+    /// Called after every accepted step; its answer may stop the run.
+    pub observer: Option<Observer>,
+}
+
+/// What an observer sees after an accepted step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepInfo {
+    /// The step just accepted.
+    pub step: usize,
+    /// Steps the run plans (`t_end / dt`).
+    pub steps: usize,
+    /// Its time (s).
+    pub t: f64,
+    /// Corrections the step took.
+    pub iterations: usize,
+    /// Kinetic energy (J).
+    pub kinetic: f64,
+    /// Stored energy (J).
+    pub elastic: f64,
+    /// Work of the loads and reactions (J).
+    pub external_work: f64,
+    /// Every dissipation line summed (J).
+    pub dissipated: f64,
+}
+
+/// An observer's answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Control {
+    /// Go on.
+    Continue,
+    /// Stop cleanly here: the run ends `stopped`, its output valid up to this step.
+    Stop,
+    /// Stop because the user interrupted: the run ends `failed` (interrupted).
+    Interrupt,
+}
+
+/// A run's observer (shared, callable from the thread the run marches on).
+#[derive(Clone)]
+pub struct Observer(pub std::sync::Arc<dyn Fn(&StepInfo) -> Control + Send + Sync>);
+
+impl std::fmt::Debug for Observer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Observer")
+    }
+}
+
+/// What [`run_kept`] returns besides the summary: the history's columns, the
+/// recorded displacements (one state after the other) and the last state's
+/// displacements and cell fields (stress, then each model's history fields).
+#[derive(Clone, Debug, Default)]
+pub struct Kept {
+    /// `(history.csv column name, values)`.
+    pub columns: Vec<(String, Vec<f64>)>,
+    /// Every recorded state's displacements, `(states × dofs)` row by row (empty
+    /// unless `record_fields`).
+    pub fields: Vec<f64>,
+    /// The last state's displacements.
+    pub u: Vec<f64>,
+    /// The last state's cell fields by name, with their components per cell.
+    pub cells: Vec<(String, usize, Vec<f64>)>,
 }
 
 impl RunOptions {
@@ -59,6 +132,7 @@ impl RunOptions {
             memory_limit: None,
             record_fields: false,
             overwrite: true,
+            hooks: Hooks::default(),
         }
     }
 }
@@ -113,12 +187,37 @@ pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 
 /// Runs `model` and writes `history.csv`, `summary.json` and VTK files to `opts.out`.
 pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
-    let start = Instant::now();
-    crate::output::prepare(&opts.out, opts.overwrite)?;
-    let mut rec = Recorder::new(model, &opts.out)?;
-    if opts.record_fields {
-        rec.record_fields(model, &opts.out)?;
+    run_kept(model, opts).map(|(summary, _)| summary)
+}
+
+/// Writes the summary where the run writes files.
+fn write_summary(summary: &Summary, path: Option<&Path>) -> Result<()> {
+    match path {
+        Some(p) => summary.write(p),
+        None => Ok(()),
     }
+}
+
+/// [`run`], with what `opts.hooks` asks: no files, the history and fields kept in
+/// memory, an observer after every step. A run its observer stops ends `stopped`
+/// (`Ok`); an interrupted one ends `failed` with [`Error::Interrupted`].
+pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
+    let start = Instant::now();
+    let files = !opts.hooks.no_files;
+    if files {
+        crate::output::prepare(&opts.out, opts.overwrite)?;
+    }
+    let mut rec =
+        Recorder::with_sinks(model, files.then_some(opts.out.as_path()), opts.hooks.keep)?;
+    if opts.record_fields {
+        if files {
+            rec.record_fields(model, &opts.out)?;
+        }
+        if opts.hooks.keep {
+            rec.keep_fields();
+        }
+    }
+    let mut kept = Kept::default();
     let a = &model.analysis;
     let volume = crate::check::volume(model);
     for w in model.warnings.iter().chain(&volume.warnings) {
@@ -167,8 +266,9 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
             factor_nnz: None,
         },
     };
-    let summary_path = opts.out.join("summary.json");
-    summary.write(&summary_path)?;
+    let summary_path = files.then(|| opts.out.join("summary.json"));
+    let summary_path = summary_path.as_deref();
+    write_summary(&summary, summary_path)?;
     // The march runs on a worker of the thread pool, so that its parallel passes
     // hand work to the other workers instead of waking the pool from outside and
     // blocking on it for each pass (which costs a pair of futex calls per pass and
@@ -176,34 +276,47 @@ pub fn run(model: &Model, opts: &RunOptions) -> Result<Summary> {
     let result = rayon::scope(|_| {
         catch_unwind(AssertUnwindSafe(|| match (a.time.kind, a.time.scheme) {
             (AnalysisKind::Dynamic, TimeScheme::CentralDifference) => CentralDifference::new(model)
-                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
+                .and_then(|mut i| {
+                    integrate(model, &mut i, opts, &mut rec, &mut summary, &mut kept)
+                }),
             (
                 AnalysisKind::Dynamic,
                 TimeScheme::BackwardEuler | TimeScheme::Trapezoidal | TimeScheme::GeneralizedAlpha,
-            ) => BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit)
-                .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary)),
+            ) => BackwardEuler::with_memory_limit(model, opts.backend, opts.memory_limit).and_then(
+                |mut i| integrate(model, &mut i, opts, &mut rec, &mut summary, &mut kept),
+            ),
             (AnalysisKind::Static, _) => {
-                Statics::with_memory_limit(model, opts.backend, opts.memory_limit)
-                    .and_then(|mut i| integrate(model, &mut i, opts, &mut rec, &mut summary))
+                Statics::with_memory_limit(model, opts.backend, opts.memory_limit).and_then(
+                    |mut i| integrate(model, &mut i, opts, &mut rec, &mut summary, &mut kept),
+                )
             }
         }))
         .unwrap_or_else(|p| Err(Error::Internal(panic_message(p.as_ref()))))
     });
     summary.probes = rec.probes().clone();
     summary.timing.total_s = start.elapsed().as_secs_f64();
+    let (columns, fields) = rec.take_kept();
+    kept.columns = columns;
+    kept.fields = fields;
     match result {
         Ok(()) => {
             summary.status = RunStatus::Completed;
-            summary.write(&summary_path)?;
+            write_summary(&summary, summary_path)?;
             for f in summary.checks.failures() {
                 eprintln!("warning: {}: energy check failed: {f}", opts.out.display());
             }
-            Ok(summary)
+            Ok((summary, kept))
+        }
+        Err(e @ Error::Stopped { .. }) => {
+            summary.status = RunStatus::Stopped;
+            summary.error = Some(e.to_string());
+            write_summary(&summary, summary_path)?;
+            Ok((summary, kept))
         }
         Err(e) => {
             summary.status = RunStatus::Failed;
             summary.error = Some(e.to_string());
-            summary.write(&summary_path)?;
+            write_summary(&summary, summary_path)?;
             Err(e)
         }
     }
@@ -279,6 +392,7 @@ fn integrate<I: Integrator>(
     opts: &RunOptions,
     rec: &mut Recorder,
     summary: &mut Summary,
+    kept: &mut Kept,
 ) -> Result<()> {
     let mut s = integrator.initial_state()?;
     let vtk_every = model.analysis.output.vtk_every;
@@ -291,9 +405,10 @@ fn integrate<I: Integrator>(
     };
     let built = output_points(integrator, &s);
     rec.record(model, &snapshot(&s, built.as_deref(), 0, 0.0))?;
-    let summary_path = opts.out.join("summary.json");
+    let summary_path = (!opts.hooks.no_files).then(|| opts.out.join("summary.json"));
+    let summary_path = summary_path.as_deref();
     fill(summary, &s, integrator, rec);
-    summary.write(&summary_path)?;
+    write_summary(summary, summary_path)?;
     let mut last_write = Instant::now();
     let n_steps = model.analysis.n_steps();
     let pb = progress(n_steps, opts.progress);
@@ -316,8 +431,36 @@ fn integrate<I: Integrator>(
                 if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {
                     fill(summary, s, integrator, rec);
                     counts.fill(summary, step_cuts);
-                    summary.write(&summary_path)?;
+                    write_summary(summary, summary_path)?;
                     last_write = Instant::now();
+                }
+                if let Some(o) = &opts.hooks.observer {
+                    let l = &s.ledger;
+                    let info = StepInfo {
+                        step: s.step,
+                        steps: n_steps,
+                        t: s.t,
+                        iterations: report.iterations,
+                        kinetic: l.kinetic(),
+                        elastic: l.elastic(),
+                        external_work: l.external_work(),
+                        dissipated: l.dissipated().total(),
+                    };
+                    match (o.0)(&info) {
+                        Control::Continue => {}
+                        Control::Stop => {
+                            return Err(Error::Stopped {
+                                step: s.step,
+                                t: s.t,
+                            })
+                        }
+                        Control::Interrupt => {
+                            return Err(Error::Interrupted {
+                                step: s.step,
+                                t: s.t,
+                            })
+                        }
+                    }
                 }
             }
             Marched::Cut { h, reason } => {
@@ -330,5 +473,28 @@ fn integrate<I: Integrator>(
     pb.finish_and_clear();
     fill(summary, &s, integrator, rec);
     counts.fill(summary, step_cuts);
+    if opts.hooks.keep {
+        // The last state's fields, for the caller to read back.
+        let built = if s.points.is_empty() {
+            integrator.output_points(&s)
+        } else {
+            None
+        };
+        let points = built.as_deref().unwrap_or(&s.points);
+        let stress = crate::output::post::cell_stress(model, &s.u, points);
+        kept.cells = vec![(
+            "stress".to_string(),
+            6,
+            stress.iter().flat_map(|c| c.iter().copied()).collect(),
+        )];
+        if !points.is_empty() {
+            kept.cells.extend(
+                crate::output::post::cell_history_fields(model, points)
+                    .into_iter()
+                    .map(|(name, v)| (name.to_string(), 1, v)),
+            );
+        }
+        kept.u.clone_from(&s.u);
+    }
     outcome
 }

@@ -516,6 +516,7 @@ fn full_run_histories_agree() {
             memory_limit: None,
             record_fields: false,
             overwrite: true,
+            hooks: Default::default(),
         };
         let summary = rothe::run::run(&model, &opts).unwrap();
         assert_eq!(summary.status, rothe::output::summary::RunStatus::Completed);

@@ -32,6 +32,7 @@ fn run_text(text: &str, dir: &std::path::Path) -> rothe::Result<rothe::output::s
             memory_limit: None,
             record_fields: false,
             overwrite: true,
+            hooks: Default::default(),
         },
     )
 }

@@ -150,6 +150,7 @@ fn compare_with_references(cases: &[(&str, f64)], kept: bool) {
                 memory_limit: None,
                 record_fields: false,
                 overwrite: true,
+                hooks: Default::default(),
             },
         )
         .unwrap();

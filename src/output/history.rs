@@ -25,12 +25,15 @@ pub const LEDGER_COLUMNS: [&str; 14] = [
     "residual",
 ];
 
-/// Writer of `history.csv`.
+/// Writer of `history.csv`, and keeper of its columns in memory when asked.
 pub struct History {
     path: PathBuf,
-    out: BufWriter<File>,
+    out: Option<BufWriter<File>>,
     /// The mesh's dimension (a solid's probes have a z column).
     dim: usize,
+    /// The column names, and each column's values when kept in memory.
+    names: Vec<String>,
+    columns: Option<Vec<Vec<f64>>>,
 }
 
 impl History {
@@ -40,11 +43,23 @@ impl History {
     /// normal force, the pressed nodes, the friction force and how many pressed
     /// nodes stick and slip).
     pub fn create(path: &Path, probes: &[String], pairs: &[String], dim: usize) -> Result<Self> {
-        let file = File::create(path).map_err(|e| Error::io(path, e))?;
-        let mut h = History {
-            path: path.into(),
-            out: BufWriter::new(file),
-            dim,
+        Self::with_sinks(Some(path), probes, pairs, dim, false)
+    }
+
+    /// A history written to `path` (when given) and kept in memory column by column
+    /// (when `keep`): the values themselves, not their rounded text.
+    pub fn with_sinks(
+        path: Option<&Path>,
+        probes: &[String],
+        pairs: &[String],
+        dim: usize,
+        keep: bool,
+    ) -> Result<Self> {
+        let out = match path {
+            Some(p) => Some(BufWriter::new(
+                File::create(p).map_err(|e| Error::io(p, e))?,
+            )),
+            None => None,
         };
         let mut cols: Vec<String> = LEDGER_COLUMNS.iter().map(|s| s.to_string()).collect();
         cols.push("iterations".into());
@@ -63,9 +78,31 @@ impl History {
             cols.push(format!("{p}_stick"));
             cols.push(format!("{p}_slip"));
         }
-        writeln!(h.out, "{}", cols.join(",")).map_err(|e| Error::io(&h.path, e))?;
-        h.flush()?;
+        let n = cols.len();
+        let mut h = History {
+            path: path.map(Path::to_path_buf).unwrap_or_default(),
+            out,
+            dim,
+            names: cols,
+            columns: keep.then(|| vec![Vec::new(); n]),
+        };
+        h.write_header()?;
         Ok(h)
+    }
+
+    fn write_header(&mut self) -> Result<()> {
+        if let Some(out) = &mut self.out {
+            writeln!(out, "{}", self.names.join(",")).map_err(|e| Error::io(&self.path, e))?;
+        }
+        self.flush()
+    }
+
+    /// The column names and the kept columns (empty unless kept).
+    pub fn take_columns(&mut self) -> Vec<(String, Vec<f64>)> {
+        match self.columns.take() {
+            Some(c) => self.names.iter().cloned().zip(c).collect(),
+            None => Vec::new(),
+        }
     }
 
     /// Appends one row and flushes it.
@@ -79,6 +116,45 @@ impl History {
         pairs: &[crate::contact::PairRecord],
     ) -> Result<()> {
         let d = l.dissipated();
+        if let Some(cols) = &mut self.columns {
+            let mut values = vec![
+                t,
+                l.kinetic(),
+                l.internal(),
+                l.external_work(),
+                l.elastic(),
+                d.viscous,
+                d.damage,
+                d.plastic,
+                d.contact,
+                d.friction,
+                d.predictor,
+                d.mass,
+                d.numerical,
+                l.residual(),
+                iterations as f64,
+                nl_residual,
+            ];
+            for p in probes {
+                values.extend_from_slice(&p[..self.dim]);
+            }
+            for p in pairs {
+                values.extend([
+                    p.force,
+                    p.active as f64,
+                    p.tangential_force,
+                    p.sticking as f64,
+                    p.slipping as f64,
+                ]);
+            }
+            debug_assert_eq!(values.len(), cols.len());
+            for (c, v) in cols.iter_mut().zip(values) {
+                c.push(v);
+            }
+        }
+        let Some(out) = &mut self.out else {
+            return Ok(());
+        };
         let mut line = format!(
             "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
             l.kinetic(), l.internal(), l.external_work(), l.elastic(), d.viscous, d.damage, d.plastic,
@@ -96,11 +172,14 @@ impl History {
                 p.force, p.active, p.tangential_force, p.sticking, p.slipping
             ));
         }
-        writeln!(self.out, "{line}").map_err(|e| Error::io(&self.path, e))?;
+        writeln!(out, "{line}").map_err(|e| Error::io(&self.path, e))?;
         self.flush()
     }
 
     fn flush(&mut self) -> Result<()> {
-        self.out.flush().map_err(|e| Error::io(&self.path, e))
+        match &mut self.out {
+            Some(out) => out.flush().map_err(|e| Error::io(&self.path, e)),
+            None => Ok(()),
+        }
     }
 }

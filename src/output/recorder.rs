@@ -51,24 +51,36 @@ pub struct Recorder {
     last_t: f64,
     empty_pairs: Vec<PairRecord>,
     fields: Option<super::fields::FieldWriter>,
+    /// Every recorded displacement, one state after the other, when kept in memory.
+    kept_fields: Option<Vec<f64>>,
 }
 
 impl Recorder {
     /// Creates `out/history.csv` (and `out/vtk/` when VTK is on).
     pub fn new(model: &Model, out: &Path) -> Result<Self> {
-        std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+        Self::with_sinks(model, Some(out), false)
+    }
+
+    /// A recorder writing into `out` when given (else no file at all) and keeping
+    /// the history's columns in memory when `keep`.
+    pub fn with_sinks(model: &Model, out: Option<&Path>, keep: bool) -> Result<Self> {
+        if let Some(out) = out {
+            std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+        }
         let names: Vec<String> = model.probes.iter().map(|p| p.name.clone()).collect();
         let pair_names: Vec<String> = model.contacts.iter().map(|p| p.name.clone()).collect();
-        let history = History::create(
-            &out.join("history.csv"),
+        let history = History::with_sinks(
+            out.map(|o| o.join("history.csv")).as_deref(),
             &names,
             &pair_names,
             model.mesh.dim,
+            keep,
         )?;
-        let vtk = if model.analysis.output.vtk_every > 0 {
-            Some(VtkSeries::new(out, &model.mesh)?)
-        } else {
-            None
+        let vtk = match out {
+            Some(out) if model.analysis.output.vtk_every > 0 => {
+                Some(VtkSeries::new(out, &model.mesh)?)
+            }
+            _ => None,
         };
         let probes = names
             .iter()
@@ -88,7 +100,21 @@ impl Recorder {
             pair_names,
             last_t: 0.0,
             fields: None,
+            kept_fields: None,
         })
+    }
+
+    /// Also keeps every recorded state's displacement in memory.
+    pub fn keep_fields(&mut self) {
+        self.kept_fields = Some(Vec::new());
+    }
+
+    /// The history's kept columns and the kept displacements (empty when none).
+    pub fn take_kept(&mut self) -> (Vec<(String, Vec<f64>)>, Vec<f64>) {
+        (
+            self.history.take_columns(),
+            self.kept_fields.take().unwrap_or_default(),
+        )
     }
 
     /// Also writes every recorded state's displacement to `out/fields.bin`.
@@ -138,6 +164,9 @@ impl Recorder {
         )?;
         if let Some(f) = &mut self.fields {
             f.append(s.t, s.u)?;
+        }
+        if let Some(f) = &mut self.kept_fields {
+            f.extend_from_slice(s.u);
         }
         if let Some(vtk) = &mut self.vtk {
             if s.step % self.vtk_every == 0 {

@@ -226,7 +226,7 @@ impl MaterialSummary {
 }
 
 /// Where a run stands, as `summary.json` says it (`"running"`, `"completed"`,
-/// `"failed"`).
+/// `"stopped"`, `"failed"`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RunStatus {
@@ -234,8 +234,11 @@ pub enum RunStatus {
     Running,
     /// The run reached its end time.
     Completed,
-    /// The run stopped with an error (`error` says which).
+    /// The run stopped with an error (`error` says which; an interruption is one).
     Failed,
+    /// The caller's observer (a progress callback) stopped the run before its end
+    /// time; what it wrote up to there is valid.
+    Stopped,
 }
 
 impl RunStatus {
@@ -245,14 +248,20 @@ impl RunStatus {
             RunStatus::Running => "running",
             RunStatus::Completed => "completed",
             RunStatus::Failed => "failed",
+            RunStatus::Stopped => "stopped",
         }
     }
 
     /// The status of a `summary.json` value's word, if it is one.
     pub fn parse(word: &str) -> Option<RunStatus> {
-        [RunStatus::Running, RunStatus::Completed, RunStatus::Failed]
-            .into_iter()
-            .find(|s| s.as_str() == word)
+        [
+            RunStatus::Running,
+            RunStatus::Completed,
+            RunStatus::Failed,
+            RunStatus::Stopped,
+        ]
+        .into_iter()
+        .find(|s| s.as_str() == word)
     }
 }
 
