@@ -551,9 +551,26 @@ pub fn load_with_overrides(path: &Path, opts: &LoadOptions, ov: &Overrides) -> R
         },
         other => other,
     };
-    let scenario = parse_with(&text, ov).map_err(in_file)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    validate::build(&scenario, dir, opts).map_err(in_file)
+    from_str_with_overrides(&text, dir, opts, ov).map_err(in_file)
+}
+
+/// Parses and validates scenario text (mesh files relative to `dir`) after its
+/// variants and `ov` are applied: [`load_with_overrides`] without the file.
+pub fn from_str_with_overrides(
+    text: &str,
+    dir: &Path,
+    opts: &LoadOptions,
+    ov: &Overrides,
+) -> Result<Model> {
+    validate::build(&parse_with(text, ov)?, dir, opts)
+}
+
+/// Scenario text as a TOML table after its variants and `ov` are applied (no
+/// validation): [`merged_table`] without the file.
+pub fn merged_table_of(text: &str, ov: &Overrides) -> Result<toml::Table> {
+    let table: toml::Table = toml::from_str(text).map_err(|e| toml_error(text, e))?;
+    overrides::apply(table, ov)
 }
 
 /// The scenario file at `path` as a TOML table after its variants and `ov` are
