@@ -320,8 +320,8 @@ class Run:
 
 
 def _read_table(path: Path) -> Dict[str, np.ndarray]:
-    """A CSV table as a dict of columns: numbers as float arrays, the rest as
-    arrays of str."""
+    """A CSV table as a dict of columns: numbers as float arrays (an empty cell or
+    ``-`` is NaN), the rest as arrays of str."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))
     if not rows:
@@ -331,7 +331,7 @@ def _read_table(path: Path) -> Dict[str, np.ndarray]:
     for j, name in enumerate(header):
         col = [r[j] if j < len(r) else "" for r in body]
         try:
-            table[name] = np.array([float(x) if x != "" else math.nan for x in col])
+            table[name] = np.array([math.nan if x in ("", "-") else float(x) for x in col])
         except ValueError:
             table[name] = np.array(col, dtype=object)
     return table

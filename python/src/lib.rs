@@ -8,8 +8,9 @@
 //! them and reports an internal error.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::create_exception;
@@ -138,39 +139,35 @@ struct Watch {
     callback: Option<Py<PyAny>>,
     /// A pending exception (the callback's own, or KeyboardInterrupt).
     raised: Mutex<Option<PyErr>>,
-    last: Mutex<Instant>,
+    /// Set when the waiting thread saw a signal.
+    interrupt: AtomicBool,
 }
 
-/// How often the run looks for a signal when no callback is called.
+/// How often the waiting thread looks for a signal.
 const SIGNAL_EVERY: Duration = Duration::from_millis(50);
 
 impl Watch {
     fn observe(&self, info: &StepInfo) -> Control {
-        let due = {
-            let mut last = self.last.lock().unwrap_or_else(|p| p.into_inner());
-            if self.callback.is_none() && last.elapsed() < SIGNAL_EVERY {
-                false
+        if self.interrupt.load(Ordering::SeqCst) {
+            // A signal the waiting thread saw (KeyboardInterrupt, or what a
+            // handler raised).
+            let interrupt = Python::attach(|py| {
+                self.raised
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .as_ref()
+                    .is_none_or(|e| e.is_instance_of::<PyKeyboardInterrupt>(py))
+            });
+            return if interrupt {
+                Control::Interrupt
             } else {
-                *last = Instant::now();
-                true
-            }
-        };
-        if !due {
-            return Control::Continue;
-        }
-        Python::attach(|py| {
-            if let Err(e) = py.check_signals() {
-                let interrupt = e.is_instance_of::<PyKeyboardInterrupt>(py);
-                *self.raised.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
-                return if interrupt {
-                    Control::Interrupt
-                } else {
-                    Control::Stop
-                };
-            }
-            let Some(cb) = &self.callback else {
-                return Control::Continue;
+                Control::Stop
             };
+        }
+        let Some(cb) = &self.callback else {
+            return Control::Continue;
+        };
+        Python::attach(|py| {
             let d = PyDict::new(py);
             let fill = || -> PyResult<()> {
                 d.set_item("step", info.step)?;
@@ -307,7 +304,7 @@ impl NativeScenario {
         let watch = Arc::new(Watch {
             callback,
             raised: Mutex::new(None),
-            last: Mutex::new(Instant::now()),
+            interrupt: AtomicBool::new(false),
         });
         let w = watch.clone();
         let observer = Observer(Arc::new(move |info: &StepInfo| w.observe(info)));
@@ -324,14 +321,49 @@ impl NativeScenario {
                 observer: Some(observer),
             },
         };
-        let result = py.detach(
-            move || -> rothe::Result<(rothe::output::summary::Summary, Kept)> {
-                match threads {
-                    Some(n) => rayon_pool(n)?.install(|| rothe::run::run_kept(&model, &opts)),
-                    None => rothe::run::run_kept(&model, &opts),
+        // The run marches on a thread of its own while this one, without the GIL,
+        // waits for it and every `SIGNAL_EVERY` takes the GIL to look for a signal:
+        // Python runs its signal handlers on the main thread only, so a Ctrl-C is
+        // seen here and handed to the run's observer as a flag.
+        type Outcome = rothe::Result<(rothe::output::summary::Summary, Kept)>;
+        let (tx, rx) = std::sync::mpsc::channel::<Outcome>();
+        let work = move || {
+            let r = match threads {
+                Some(n) => {
+                    rayon_pool(n).and_then(|p| p.install(|| rothe::run::run_kept(&model, &opts)))
                 }
-            },
-        );
+                None => rothe::run::run_kept(&model, &opts),
+            };
+            let _ = tx.send(r);
+        };
+        let runner = std::thread::Builder::new()
+            .name("rothe-run".into())
+            .spawn(work)
+            .map_err(|e| Error::new_err(format!("cannot start the run's thread: {e}")))?;
+        let rx = Mutex::new(rx);
+        let result = loop {
+            let next = py.detach(|| {
+                rx.lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .recv_timeout(SIGNAL_EVERY)
+            });
+            match next {
+                Ok(r) => break r,
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    if let Err(e) = py.check_signals() {
+                        watch.interrupt.store(true, Ordering::SeqCst);
+                        let mut raised = watch.raised.lock().unwrap_or_else(|p| p.into_inner());
+                        raised.get_or_insert(e);
+                    }
+                }
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                    break Err(rothe::Error::Internal(
+                        "the run's thread ended without a result".into(),
+                    ))
+                }
+            }
+        };
+        let _ = runner.join();
         // An exception the callback raised (or the interrupt) is the caller's.
         if let Some(e) = watch
             .raised
