@@ -249,7 +249,7 @@ class Run:
     def __init__(self, native: "_rothe.NativeRun"):
         self._native = native
         self.summary: Dict[str, Any] = json.loads(native.summary_json())
-        self.history: Dict[str, np.ndarray] = dict(native.history())
+        self.history: Dict[str, np.ndarray] = dict(native.take_history())
         out = native.out()
         #: The output directory, or None for a run in memory.
         self.out: Optional[Path] = None if out is None else Path(out)

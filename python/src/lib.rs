@@ -373,11 +373,13 @@ impl NativeScenario {
         {
             return Err(e);
         }
-        let (summary, kept) = result.map_err(py_err)?;
+        let (summary, mut kept) = result.map_err(py_err)?;
+        let columns = Mutex::new(std::mem::take(&mut kept.columns));
         let summary_json =
             serde_json::to_string(&summary).map_err(|e| Error::new_err(e.to_string()))?;
         Ok(NativeRun {
             summary_json,
+            columns,
             kept,
             model: self.model.clone(),
             out,
@@ -397,6 +399,8 @@ fn rayon_pool(n: usize) -> rothe::Result<rayon::ThreadPool> {
 #[pyclass(module = "rothe._rothe", frozen)]
 struct NativeRun {
     summary_json: String,
+    /// The history's columns until they are taken.
+    columns: Mutex<Vec<(String, Vec<f64>)>>,
     kept: Kept,
     model: Arc<Model>,
     out: Option<PathBuf>,
@@ -414,12 +418,13 @@ impl NativeRun {
         self.out.clone()
     }
 
-    /// The history's columns as `(name, array)` pairs, in `history.csv`'s order.
-    fn history<'py>(&self, py: Python<'py>) -> Vec<(String, Bound<'py, PyArray1<f64>>)> {
-        self.kept
-            .columns
-            .iter()
-            .map(|(n, v)| (n.clone(), PyArray1::from_slice(py, v)))
+    /// The history's columns as `(name, array)` pairs, in `history.csv`'s order,
+    /// handed over without a copy: a second call returns none.
+    fn take_history<'py>(&self, py: Python<'py>) -> Vec<(String, Bound<'py, PyArray1<f64>>)> {
+        let columns = std::mem::take(&mut *self.columns.lock().unwrap_or_else(|p| p.into_inner()));
+        columns
+            .into_iter()
+            .map(|(n, v)| (n, PyArray1::from_vec(py, v)))
             .collect()
     }
 
