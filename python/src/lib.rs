@@ -74,6 +74,7 @@ struct NativeScenario {
 /// Reads a scenario: `kind` is `path`, `toml` (text) or `json` (a dict's JSON).
 #[pyfunction]
 #[pyo3(signature = (source, kind, dir, variants, unsets, sets, ignore_memory=false))]
+#[allow(clippy::too_many_arguments)]
 fn scenario(
     py: Python<'_>,
     source: String,
