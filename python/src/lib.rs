@@ -215,6 +215,7 @@ impl NativeScenario {
 
     /// The scenario file, the directory meshes are read from, the text and the
     /// overrides (for the studies, which plan from a file).
+    #[allow(clippy::type_complexity)]
     fn source(
         &self,
     ) -> (
