@@ -295,9 +295,11 @@ class Run:
 
     def cell_data(self, name: str) -> np.ndarray:
         """A cell field of the last state ``(cells, components)``, cells in block
-        order: ``stress`` (σxx, σyy, σzz, σyz, σxz, σxy, Pa) for every model;
-        ``damage``, ``eq_plastic_strain`` and ``dissipation_density`` where a
-        model has history. See :meth:`cell_names`."""
+        order: ``stress`` (Pa; in the plane ``σxx, σyy, σxy`` and three zeros, in
+        a solid ``σxx, σyy, σxy, σzz, σyz, σzx``, a bar's axial stress first) for
+        every model; ``damage``, ``equivalent_plastic_strain`` and
+        ``dissipation_density`` (J/m³) where a model has history. See
+        :meth:`cell_names`."""
         v = self._native.cell_data(name)
         if v is None:
             raise Error(f"cell_data: no field `{name}` (this run has: {', '.join(self.cell_names())})")
