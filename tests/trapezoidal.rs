@@ -50,6 +50,16 @@ fix = ["x", "y"]
     )
 }
 
+/// Asserts that `text` is refused with a message holding every one of `words`.
+fn refused(text: String, words: &[&str]) {
+    let e = rothe::config::from_str(&text, Path::new("."))
+        .expect_err("accepted")
+        .to_string();
+    for w in words {
+        assert!(e.contains(w), "`{w}` not in: {e}");
+    }
+}
+
 /// Runs `text` and calls `each` after every step.
 fn run(text: &str, mut each: impl FnMut(&Model, &State)) -> (Model, State) {
     let m = model(text);
@@ -359,14 +369,6 @@ fn generalized_alpha_damps_the_highest_modes_by_rho_inf_per_step() {
 
 #[test]
 fn rho_inf_is_checked_and_read_by_generalized_alpha_only() {
-    let refused = |text: String, words: &[&str]| {
-        let e = rothe::config::from_str(&text, Path::new("."))
-            .expect_err("accepted")
-            .to_string();
-        for w in words {
-            assert!(e.contains(w), "`{w}` not in: {e}");
-        }
-    };
     for bad in ["1.5", "-0.1"] {
         refused(
             cantilever(
@@ -398,14 +400,6 @@ fn the_contact_predictor_is_refused_where_there_is_nothing_to_stabilise() {
     )
     .unwrap();
     let with = |lines: &str| bars.replace("[analysis]", &format!("[analysis]\n{lines}"));
-    let refused = |text: String, words: &[&str]| {
-        let e = rothe::config::from_str(&text, Path::new("."))
-            .expect_err("accepted")
-            .to_string();
-        for w in words {
-            assert!(e.contains(w), "`{w}` not in: {e}");
-        }
-    };
     for scheme in ["backward_euler", "central_difference"] {
         refused(
             with(&format!(
