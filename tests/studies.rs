@@ -249,6 +249,19 @@ fn an_emitted_sweep_run_by_hand_collects_to_the_in_process_tables() {
     assert!(emitted.join("plots/probe_probe.png").is_file());
 }
 
+/// The implicit and explicit values of the row `name` of `compare.csv`.
+fn compare_row(csv: &str, name: &str) -> Vec<f64> {
+    let l = csv
+        .lines()
+        .find(|l| l.starts_with(name))
+        .unwrap_or_else(|| panic!("no row `{name}` in:\n{csv}"));
+    l.split(',')
+        .skip(1)
+        .take(2)
+        .map(|c| c.parse().unwrap())
+        .collect()
+}
+
 #[test]
 fn compare_sets_the_implicit_and_explicit_ledgers_side_by_side() {
     let dir = tempfile::tempdir().unwrap();
@@ -276,14 +289,7 @@ fn compare_sets_the_implicit_and_explicit_ledgers_side_by_side() {
         assert!(md.contains(line), "{line} missing:\n{md}");
     }
     let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
-    let row = |name: &str| -> Vec<f64> {
-        let l = csv.lines().find(|l| l.starts_with(name)).unwrap();
-        l.split(',')
-            .skip(1)
-            .take(2)
-            .map(|c| c.parse().unwrap())
-            .collect()
-    };
+    let row = |name: &str| compare_row(&csv, name);
     let k0 = row("E_kin0 [J]");
     assert_eq!(k0[0], k0[1]);
     // Both ledgers close; both paths lose energy at the impact.
@@ -326,17 +332,9 @@ fn compare_takes_a_second_order_scheme_with_its_keys_to_the_implicit_run_only() 
         "--quiet",
     ]);
     assert!(ok, "{err}");
+    assert!(md.contains("D_predictor [J]"), "{md}");
     let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
-    let row = csv
-        .lines()
-        .find(|l| l.starts_with("D_predictor [J]"))
-        .unwrap_or_else(|| panic!("no D_predictor row:\n{md}"));
-    let v: Vec<f64> = row
-        .split(',')
-        .skip(1)
-        .take(2)
-        .map(|c| c.parse().unwrap())
-        .collect();
+    let v = compare_row(&csv, "D_predictor [J]");
     assert!(v[0] > 0.0 && v[1] == 0.0, "{v:?}");
     let summary: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(out.join("runs/implicit/summary.json")).unwrap(),

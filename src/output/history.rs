@@ -34,6 +34,8 @@ pub struct History {
     /// The column names, and each column's values when kept in memory.
     names: Vec<String>,
     columns: Option<Vec<Vec<f64>>>,
+    /// One row's values, reused from row to row.
+    values: Vec<f64>,
 }
 
 impl History {
@@ -85,6 +87,7 @@ impl History {
             dim,
             names: cols,
             columns: keep.then(|| vec![Vec::new(); n]),
+            values: Vec::with_capacity(n),
         };
         h.write_header()?;
         Ok(h)
@@ -117,7 +120,9 @@ impl History {
     ) -> Result<()> {
         let d = l.dissipated();
         if let Some(cols) = &mut self.columns {
-            let mut values = vec![
+            let values = &mut self.values;
+            values.clear();
+            values.extend([
                 t,
                 l.kinetic(),
                 l.internal(),
@@ -134,7 +139,7 @@ impl History {
                 l.residual(),
                 iterations as f64,
                 nl_residual,
-            ];
+            ]);
             for p in probes {
                 values.extend_from_slice(&p[..self.dim]);
             }
@@ -148,8 +153,8 @@ impl History {
                 ]);
             }
             debug_assert_eq!(values.len(), cols.len());
-            for (c, v) in cols.iter_mut().zip(values) {
-                c.push(v);
+            for (c, v) in cols.iter_mut().zip(values.iter()) {
+                c.push(*v);
             }
         }
         let Some(out) = &mut self.out else {

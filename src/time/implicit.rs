@@ -782,14 +782,7 @@ pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, Effec
         crate::model::AnalysisKind::Static => Scheme::Static { dt: a.time.dt },
     };
     let ops = Operators::new(model, scheme);
-    let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let mut sys = EffectiveSystem::new(
-        &ops.asm.pattern,
-        dofs,
-        Backend::Faer,
-        a.iteration.ordering,
-        &model.mesh.coords,
-    )?;
+    let mut sys = ops.analysed_system(model, Backend::Faer)?;
     let kt = match ops.response {
         Response::StateDependent(_) => {
             let stores = new_stores(&model.mesh, &model.materials);

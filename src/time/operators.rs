@@ -284,14 +284,7 @@ impl Operators {
         backend: Backend,
         memory_limit: Option<u64>,
     ) -> Result<(EffectiveSystem, Factored, Option<Vec<f64>>)> {
-        let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-        let mut sys = EffectiveSystem::new(
-            &self.asm.pattern,
-            dofs,
-            backend,
-            model.analysis.iteration.ordering,
-            &model.mesh.coords,
-        )?;
+        let mut sys = self.analysed_system(model, backend)?;
         // The analysis knows the factor's size: refuse before it is allocated.
         crate::config::memory_estimate(model, sys.factor_nnz())
             .check(memory_limit, "the factorisation")?;
@@ -303,6 +296,19 @@ impl Operators {
             _ => self.refactor(&mut sys, &self.kt)?,
         };
         Ok((sys, factored, None))
+    }
+
+    /// A system on the run's pattern, free dofs and ordering, analysed (values zero
+    /// until refilled): the effective matrix's, or the contact predictor's mass.
+    pub fn analysed_system(&self, model: &Model, backend: Backend) -> Result<EffectiveSystem> {
+        let dofs = DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+        EffectiveSystem::new(
+            &self.asm.pattern,
+            dofs,
+            backend,
+            model.analysis.iteration.ordering,
+            &model.mesh.coords,
+        )
     }
 
     /// The rule of a dynamic step (statics: backward Euler's weights, θ = 1).

@@ -29,7 +29,7 @@ use crate::error::{Error, Result};
 use crate::linsolve::Backend;
 use crate::model::Model;
 use crate::nonlinear::{self, Convergence, Evaluation, Outcome, StepProblem};
-use crate::system::{DofMap, EffectiveSystem, Factored};
+use crate::system::{EffectiveSystem, Factored};
 
 /// The projection's factor, contact correction and vectors.
 pub(crate) struct Predictor<'m> {
@@ -118,14 +118,7 @@ impl<'m> Predictor<'m> {
     /// Factorises the mass on the free dofs (the pattern and ordering the steps use).
     pub fn new(model: &'m Model, ops: &Operators, backend: Backend) -> Result<Self> {
         let n = model.mesh.n_dofs();
-        let dofs = DofMap::new(n, model.constraints.iter().map(|c| c.dof));
-        let mut sys = EffectiveSystem::new(
-            &ops.asm.pattern,
-            dofs,
-            backend,
-            model.analysis.iteration.ordering,
-            &model.mesh.coords,
-        )?;
+        let mut sys = ops.analysed_system(model, backend)?;
         sys.refill(1.0, &ops.mass, &[]);
         if let Factored::NotPositiveDefinite { message, .. } = sys.factorize()? {
             return Err(Error::Solver {
