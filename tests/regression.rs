@@ -12,19 +12,27 @@
 //! `ROTHE_BLESS=1 cargo test --release --test regression` (all of them) or
 //! `ROTHE_BLESS=name,name ...` (those cases only), and say in the commit which
 //! results moved, by how much and why.
+//!
+//! The solid cases (an H8 cantilever, Rankine-Hill in a solid, implicit contact of
+//! two solids with friction, the explicit drop on tetrahedra) were added before the
+//! dimension became one type. A reshaping that must not change results is checked
+//! bit for bit, beyond the tolerances: `ROTHE_BITS=DIR cargo test --release --test
+//! regression -- --ignored bits` writes every case's history columns and final
+//! displacements as the bits of each number (`DIR/NAME.bits`, the kept-factor runs
+//! as `NAME.kept.bits`); run it before and after, then `diff -r` the two folders.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use rothe::linsolve::Backend;
-use rothe::run::{run, RunOptions};
+use rothe::run::{run, run_kept, Hooks, RunOptions};
 
 /// The scenarios and their tolerances: linear runs agree to round-off, runs that
 /// iterate agree far below their equilibrium tolerance (1e-8 on the residual):
 /// the iterations themselves must not change. Runs whose contact forces come from
 /// Clarabel (the cone programs of friction, the explicit impacts)
 /// agree to its tolerance on the scaled data (1e-9), so to 1e-8 of a column.
-const CASES: [(&str, f64); 10] = [
+const CASES: [(&str, f64); 14] = [
     ("elastic_cantilever", 1e-10),
     ("damped_lumped_gravity", 1e-10),
     ("sls_wave_bar", 1e-10),
@@ -35,6 +43,10 @@ const CASES: [(&str, f64); 10] = [
     ("contact_impact", 1e-8),
     ("rigid_line_friction", 1e-8),
     ("explicit_contact_friction", 1e-8),
+    ("solid_elastic_cantilever", 1e-10),
+    ("solid_rankine_hill_cantilever", 1e-9),
+    ("solid_contact_friction", 1e-8),
+    ("solid_explicit_drop", 1e-8),
 ];
 
 /// Columns kept in the references.
@@ -196,4 +208,48 @@ fn compare_with_references(cases: &[(&str, f64)], kept: bool) {
         assert!(want["t"].len() >= 10, "{name}: reference too short");
     }
     eprintln!("largest relative difference from the references: {largest:.2e}");
+}
+
+/// Every case's history columns (all of them, at full precision) and final
+/// displacements as the bits of each number, into `$ROTHE_BITS/NAME.bits` (the
+/// kept-factor runs into `NAME.kept.bits`): the record a reshaping is compared with
+/// bit for bit (`diff -r` of two such folders). Ignored: it asserts nothing by
+/// itself and runs only when asked, with `ROTHE_BITS` set.
+#[test]
+#[ignore]
+fn bits() {
+    let dir_out = PathBuf::from(std::env::var("ROTHE_BITS").expect("ROTHE_BITS=DIR names the folder"));
+    std::fs::create_dir_all(&dir_out).unwrap();
+    let runs = CASES
+        .iter()
+        .map(|&(name, _)| (name, false))
+        .chain(KEPT_CASES.iter().map(|&(name, _)| (name, true)));
+    for (name, kept) in runs {
+        let mut model = rothe::config::load(&dir().join(format!("{name}.toml"))).unwrap();
+        if !kept {
+            model.analysis.iteration.refactor_rate = None;
+        }
+        let opts = RunOptions {
+            out: PathBuf::new(),
+            backend: Backend::Faer,
+            progress: false,
+            memory_limit: None,
+            record_fields: false,
+            overwrite: true,
+            hooks: Hooks {
+                no_files: true,
+                keep: true,
+                observer: None,
+            },
+        };
+        let (_, kept_data) = run_kept(&model, &opts).unwrap();
+        let mut text = String::new();
+        let hex = |v: &[f64]| v.iter().map(|x| format!("{:016x}", x.to_bits())).collect::<Vec<_>>().join(" ");
+        for (col, values) in &kept_data.columns {
+            text += &format!("{col}: {}\n", hex(values));
+        }
+        text += &format!("u: {}\n", hex(&kept_data.u));
+        let file = if kept { format!("{name}.kept.bits") } else { format!("{name}.bits") };
+        std::fs::write(dir_out.join(file), text).unwrap();
+    }
 }
