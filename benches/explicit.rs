@@ -65,7 +65,7 @@ fn element_updates(c: &mut Criterion) {
             let mut f = vec![0.0; n];
             g.throughput(Throughput::Elements(m.mesh.n_elements() as u64));
             if name == "elastic" {
-                let k = asm.stiffness(&m.mesh, &m.materials, m.plane);
+                let k = asm.stiffness(&m.mesh, &m.materials, m.idealisation);
                 g.bench_with_input(BenchmarkId::new(name, label), &size, |b, _| {
                     b.iter(|| asm.pattern.matvec(&k, &u, &mut f))
                 });
@@ -76,7 +76,7 @@ fn element_updates(c: &mut Criterion) {
                         asm.internal_force(
                             &m.mesh,
                             &m.materials,
-                            m.plane,
+                            m.idealisation,
                             PointPass {
                                 u: &u,
                                 dt: m.analysis.time.dt,

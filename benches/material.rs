@@ -3,7 +3,6 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use rothe::config::MaterialSpec;
-use rothe::fe::Plane;
 use rothe::material::StrainStep;
 
 const MODELS: [(&str, &str); 6] = [
@@ -34,15 +33,14 @@ fn updates(c: &mut Criterion) {
         let spec: MaterialSpec =
             toml::from_str(&format!("{text}\nE = 33e9\nnu = 0.2\nrho = 2400.0")).unwrap();
         let m = rothe::config::material(name, "material", &spec).unwrap();
-        let ns = m.n_state();
+        let ns = m.n_state(3);
         g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
             b.iter(|| {
                 let (mut st_n, mut st) = (vec![0.0; ns], vec![0.0; ns]);
                 let mut eps_n = [0.0; 3];
                 let mut acc = 0.0;
                 for eps in &path {
-                    let r = m.update(
-                        Plane::Stress,
+                    let r = m.update::<3, rothe::fe::PlaneStress>(
                         &StrainStep {
                             eps_n,
                             eps: *eps,
@@ -91,7 +89,7 @@ fn solid_pass(c: &mut Criterion) {
                 asm.internal_force(
                     &model.mesh,
                     &model.materials,
-                    model.plane,
+                    model.idealisation,
                     PointPass {
                         u: &u,
                         dt: 1e-5,

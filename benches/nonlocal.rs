@@ -71,7 +71,7 @@ fn passes(c: &mut Criterion) {
                     asm.internal_force(
                         &model.mesh,
                         &model.materials,
-                        model.plane,
+                        model.idealisation,
                         PointPass {
                             u: &u,
                             dt: 1e-6,
@@ -92,7 +92,7 @@ fn passes(c: &mut Criterion) {
                         drop(asm.nonlocal_at(
                             &model.mesh,
                             &model.materials,
-                            model.plane,
+                            model.idealisation,
                             &u,
                             &points,
                         ));

@@ -20,7 +20,7 @@ fn assembly(c: &mut Criterion) {
         let model = rothe::workload::w1(ny).unwrap();
         let asm = Assembler::new(&model.mesh);
         g.bench_with_input(BenchmarkId::new("stiffness", ny), &ny, |b, _| {
-            b.iter(|| asm.stiffness(&model.mesh, &model.materials, model.plane))
+            b.iter(|| asm.stiffness(&model.mesh, &model.materials, model.idealisation))
         });
         g.bench_with_input(BenchmarkId::new("consistent_mass", ny), &ny, |b, _| {
             b.iter(|| asm.mass(&model.mesh, &model.materials, false))
@@ -84,7 +84,7 @@ fn sls(c: &mut Criterion) {
                 asm.internal_force(
                     &model.mesh,
                     &model.materials,
-                    model.plane,
+                    model.idealisation,
                     PointPass {
                         u: &u,
                         dt: 1e-5,

@@ -2,7 +2,7 @@
 //! analysis settings. Built from a scenario file by [`crate::config`] or directly in
 //! code (tests, benches).
 
-use crate::fe::Plane;
+use crate::fe::Idealisation;
 use crate::material::Material;
 use crate::mesh::Mesh;
 
@@ -352,8 +352,9 @@ pub struct Model {
     pub mesh: Mesh,
     /// Material table (blocks refer to it by index).
     pub materials: Vec<Material>,
-    /// Plane stress or plane strain.
-    pub plane: Plane,
+    /// Plane stress, plane strain or solid: the kinematics of every element
+    /// (`fe::kinematics`), and with it the dimension `D` and Voigt size `V`.
+    pub idealisation: Idealisation,
     /// Bodies.
     pub bodies: Vec<Body>,
     /// Prescribed displacement components (fixed supports have value 0).

@@ -167,7 +167,7 @@ pub fn w1_with(ny: usize, model_lines: &str) -> Result<Model> {
 /// solver tests and benches factorise.
 pub fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> crate::linsolve::LowerCsc {
     let asm = crate::assembly::Assembler::new(&model.mesh);
-    let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+    let k = asm.stiffness(&model.mesh, &model.materials, model.idealisation);
     let mass = asm.mass(&model.mesh, &model.materials, false);
     let dofs =
         crate::system::DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));

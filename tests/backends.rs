@@ -119,7 +119,7 @@ use rothe::workload::effective_matrix;
 fn stiffness_matrix(model: &Model) -> LowerCsc {
     let n = model.mesh.n_dofs();
     let asm = Assembler::new(&model.mesh);
-    let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+    let k = asm.stiffness(&model.mesh, &model.materials, model.idealisation);
     let dofs = DofMap::new(n, model.constraints.iter().map(|c| c.dof));
     let mut reduced = ReducedMatrix::new(&asm.pattern, &dofs);
     reduced.fill(&dofs, 0.0, &Mass::Lumped(vec![0.0; n]), &[(1.0, &k)]);

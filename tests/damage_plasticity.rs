@@ -8,7 +8,7 @@ mod common;
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
-use rothe::fe::Plane;
+use rothe::fe::Idealisation;
 use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
 use rothe::material::{Material, Model, StrainStep};
 use rothe::model::TimeFunction;
@@ -125,7 +125,7 @@ fn uniaxial(
     let t_end = points.last().unwrap()[0];
     let p = PathSpec {
         kind: PathKind::UniaxialStress,
-        plane: Plane::Stress,
+        plane: Idealisation::PlaneStress,
         control: Control::Strain,
         amplitude: 1.0,
         function: TimeFunction::Table { points },
@@ -294,8 +294,8 @@ fn rh_point(
     eps_n: [f64; 3],
     eps: [f64; 3],
     state_n: &[f64],
-) -> (rothe::material::PointResponse, Vec<f64>) {
-    common::point_update(m, Plane::Stress, eps_n, eps, state_n)
+) -> (rothe::material::PointResponse<3>, Vec<f64>) {
+    common::point_update::<3, rothe::fe::PlaneStress>(m, eps_n, eps, state_n)
 }
 
 #[test]
@@ -322,8 +322,8 @@ fn rankine_hill_corner_return_satisfies_kkt() {
             "both multipliers positive: {:?}",
             &st[3..]
         );
-        let (s1, s2, th) = rothe::material::principal::principal_stress(&r.sigma);
-        let dep = rothe::material::principal::strain_to_frame(&[st[0], st[1], st[2]], th);
+        let (s1, s2, th) = rothe::fe::principal::principal_stress(&r.sigma);
+        let dep = rothe::fe::principal::strain_to_frame(&[st[0], st[1], st[2]], th);
         assert!(
             dep[2].abs() < 1e-9 * (dep[0].abs() + dep[1].abs()),
             "coaxial"
@@ -388,11 +388,11 @@ proptest! {
             _ => "model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 140.0 }\ncompression = { law = \"ec2\", f_cm = 38e6, eps_c1 = 0.0022, eps_cu1 = 0.0035 }".to_string(),
         };
         let m = mat(&text);
-        let ns = m.n_state();
+        let ns = m.n_state(3);
         let (mut st_n, mut st) = (vec![0.0; ns], vec![0.0; ns]);
         let mut eps_n = [0.0; 3];
         for eps in &path {
-            let r = m.update(Plane::Stress, &StrainStep { eps_n, eps: *eps, dt: 1e-4, length: 0.1 }, &st_n, &mut st);
+            let r = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n, eps: *eps, dt: 1e-4, length: 0.1 }, &st_n, &mut st);
             let d = r.dissipation;
             prop_assert!(d.damage >= 0.0 && d.plastic >= 0.0, "dissipation {:?}", d);
             match m.model {

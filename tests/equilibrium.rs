@@ -235,8 +235,7 @@ fn a_failed_return_is_an_outcome_with_its_element() {
     let soft = "model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 140.0 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = -1.5e9 }\nE = 30e9\nnu = 0.2\nrho = 2400.0";
     let m = model(&cantilever([8, 2], soft, -1e6, "vtk_every = 0"));
     let exhausted = [0.0, 0.0, 0.0, 1.0, 1.0, 0.0];
-    let r = m.materials[0].update(
-        rothe::fe::Plane::Stress,
+    let r = m.materials[0].update::<3, rothe::fe::PlaneStress>(
         &rothe::material::StrainStep {
             eps_n: [0.0; 3],
             eps: [1e-5, -2e-5, 0.0],

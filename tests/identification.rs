@@ -6,7 +6,7 @@
 //! fracture energy whatever its width.
 
 use rothe::config::MaterialSpec;
-use rothe::fe::Plane;
+use rothe::fe::Idealisation;
 use rothe::material::identify::Ec2Class;
 use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
 use rothe::material::{Hardening, Material, Model};
@@ -22,7 +22,7 @@ fn material(text: &str) -> rothe::Result<Material> {
 fn uniaxial(m: &Material, eps_end: f64, n: usize) -> Vec<(f64, f64)> {
     let path = PathSpec {
         kind: PathKind::UniaxialStress,
-        plane: Plane::Stress,
+        plane: Idealisation::PlaneStress,
         control: Control::Strain,
         amplitude: eps_end,
         function: TimeFunction::Ramp { t0: 0.0, t1: 1.0 },
@@ -279,7 +279,7 @@ fn a_crack_band_dissipates_the_fracture_energy_whatever_its_width() {
     for h in [0.05, 0.1] {
         let path = PathSpec {
             kind: PathKind::UniaxialStress,
-            plane: Plane::Stress,
+            plane: Idealisation::PlaneStress,
             control: Control::Strain,
             amplitude: 3e-3,
             function: TimeFunction::Ramp { t0: 0.0, t1: 1.0 },

@@ -7,7 +7,7 @@ mod common;
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
-use rothe::fe::Plane;
+use rothe::fe::Idealisation;
 use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec, PointRecord};
 use rothe::material::{Material, StrainStep};
 use rothe::model::TimeFunction;
@@ -30,7 +30,7 @@ fn path(
 ) -> PathSpec {
     PathSpec {
         kind,
-        plane: Plane::Stress,
+        plane: Idealisation::PlaneStress,
         control,
         amplitude,
         function,
@@ -315,14 +315,14 @@ proptest! {
         theta in 0.0f64..std::f64::consts::PI,
     ) {
         let m = mat(&format!("{text}\nE = {e}\nnu = {nu}\nrho = 1000.0"));
-        let ns = m.n_state();
+        let ns = m.n_state(3);
         let (mut st_n, mut st) = (vec![0.0; ns], vec![0.0; ns]);
         let (mut rt_n, mut rt) = (vec![0.0; ns], vec![0.0; ns]);
         let (mut eps_n, mut reps_n) = ([0.0; 3], [0.0; 3]);
         for eps in &path {
             let reps = rotate(*eps, theta);
-            let r = m.update(Plane::Stress, &StrainStep { eps_n, eps: *eps, dt, length: 0.1 }, &st_n, &mut st);
-            let q = m.update(Plane::Stress, &StrainStep { eps_n: reps_n, eps: reps, dt, length: 0.1 }, &rt_n, &mut rt);
+            let r = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n, eps: *eps, dt, length: 0.1 }, &st_n, &mut st);
+            let q = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n: reps_n, eps: reps, dt, length: 0.1 }, &rt_n, &mut rt);
             let d = r.dissipation;
             prop_assert!(d.viscous >= 0.0 && d.numerical >= 0.0 && d.damage == 0.0 && d.plastic == 0.0);
             let want = rotate_stress(r.sigma, theta);
@@ -348,11 +348,10 @@ fn predicted_stress_is_the_update_at_unchanged_strain() {
         "model = \"maxwell\"\nbeta = 1e-3",
     ] {
         let m = mat(&format!("{text}\nE = {E}\nnu = {NU}\nrho = 2400.0"));
-        let ns = m.n_state();
+        let ns = m.n_state(3);
         let (mut s1, mut s2) = (vec![0.0; ns], vec![0.0; ns]);
         let eps = [1e-4, -3e-5, 5e-5];
-        m.update(
-            Plane::Stress,
+        m.update::<3, rothe::fe::PlaneStress>(
             &StrainStep {
                 eps_n: [0.0; 3],
                 eps,
@@ -363,8 +362,7 @@ fn predicted_stress_is_the_update_at_unchanged_strain() {
             &mut s1,
         );
         let full = m
-            .update(
-                Plane::Stress,
+            .update::<3, rothe::fe::PlaneStress>(
                 &StrainStep {
                     eps_n: eps,
                     eps,
@@ -375,7 +373,7 @@ fn predicted_stress_is_the_update_at_unchanged_strain() {
                 &mut s2,
             )
             .sigma;
-        let quick = m.predicted_stress(Plane::Stress, &eps, &s1, 1e-4);
+        let quick = m.predicted_stress::<3, rothe::fe::PlaneStress>(&eps, &s1, 1e-4);
         for i in 0..3 {
             assert!(
                 (full[i] - quick[i]).abs() <= 1e-12 * full[0].abs(),

@@ -356,7 +356,7 @@ fn averages_keep_uniform_fields_and_ignore_the_numbering() {
 fn one_pass(
     mesh: &Mesh,
     mats: &[Material],
-    plane: rothe::fe::Plane,
+    plane: rothe::fe::Idealisation,
     u: &[f64],
 ) -> (Vec<f64>, Vec<f64>, f64, f64) {
     use rothe::assembly::internal::{new_stores, PointPass};
@@ -415,7 +415,7 @@ fn under_a_uniform_strain_nonlocal_is_local() {
                     .iter()
                     .flat_map(|p| [eps[0] * p[0] + eps[2] * p[1], eps[1] * p[1]])
                     .collect();
-                one_pass(&mesh, &[m], rothe::fe::Plane::Stress, &u)
+                one_pass(&mesh, &[m], rothe::fe::Idealisation::PlaneStress, &u)
             };
             let (dl, fl, psil, wl) = evaluate(None);
             let (dn, fnl, psin, wn) = evaluate(Some(0.1));
@@ -577,7 +577,7 @@ fn under_a_uniform_strain_a_nonlocal_solid_is_local() {
                         p.regularisation = Regularisation::Local;
                     }
                 }
-                one_pass(&mesh, &[m], rothe::fe::Plane::Solid, &u)
+                one_pass(&mesh, &[m], rothe::fe::Idealisation::Solid, &u)
             };
             let (dl, fl, psil, wl) = evaluate(false);
             let (dn, fnl, psin, wn) = evaluate(true);

@@ -218,7 +218,8 @@ fn compare_with_references(cases: &[(&str, f64)], kept: bool) {
 #[test]
 #[ignore]
 fn bits() {
-    let dir_out = PathBuf::from(std::env::var("ROTHE_BITS").expect("ROTHE_BITS=DIR names the folder"));
+    let dir_out =
+        PathBuf::from(std::env::var("ROTHE_BITS").expect("ROTHE_BITS=DIR names the folder"));
     std::fs::create_dir_all(&dir_out).unwrap();
     let runs = CASES
         .iter()
@@ -244,12 +245,21 @@ fn bits() {
         };
         let (_, kept_data) = run_kept(&model, &opts).unwrap();
         let mut text = String::new();
-        let hex = |v: &[f64]| v.iter().map(|x| format!("{:016x}", x.to_bits())).collect::<Vec<_>>().join(" ");
+        let hex = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{:016x}", x.to_bits()))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         for (col, values) in &kept_data.columns {
             text += &format!("{col}: {}\n", hex(values));
         }
         text += &format!("u: {}\n", hex(&kept_data.u));
-        let file = if kept { format!("{name}.kept.bits") } else { format!("{name}.bits") };
+        let file = if kept {
+            format!("{name}.kept.bits")
+        } else {
+            format!("{name}.bits")
+        };
         std::fs::write(dir_out.join(file), text).unwrap();
     }
 }

@@ -8,8 +8,8 @@
 mod common;
 
 use proptest::prelude::*;
-use rothe::fe::Plane;
-use rothe::material::frame::eigen_sym3;
+use rothe::fe::frame::eigen_sym3;
+use rothe::fe::Idealisation;
 use rothe::material::{Material, PointResponse, StrainStep};
 
 const E: f64 = 33e9;
@@ -40,7 +40,7 @@ fn point(
     eps: [f64; 6],
     state_n: &[f64],
 ) -> (PointResponse<6>, Vec<f64>) {
-    common::point_update(m, Plane::Solid, eps_n, eps, state_n)
+    common::point_update::<6, rothe::fe::Solid>(m, eps_n, eps, state_n)
 }
 
 /// The symmetric tensor of a Voigt vector whose shears are `shear` times the
@@ -278,8 +278,7 @@ fn plane_stress_paths_of_a_solid_point_follow_the_plane_model() {
                 let (r6, e6, n6) =
                     mixed(&m, e6n, guess, [true, true, true, false, false, false], &h6);
                 let mut n3 = vec![0.0; 5];
-                let r3 = m.update(
-                    Plane::Stress,
+                let r3 = m.update::<3, rothe::fe::PlaneStress>(
                     &StrainStep {
                         eps_n: e3n,
                         eps: e3,
@@ -477,8 +476,7 @@ fn jacobi_frames_agree_with_the_closed_form_principal_values() {
     // reads agree, so a point judged plastic is returned in a consistent frame.
     let t = tensor(&[3e6, -1e6, 2e6, 5e5, -7e5, 1.5e6], 1.0);
     let (l, _) = eigen_sym3(t);
-    let closed =
-        rothe::material::principal::principal_voigt6(&[3e6, -1e6, 2e6, 5e5, -7e5, 1.5e6], 1.0);
+    let closed = rothe::fe::principal::principal_voigt6(&[3e6, -1e6, 2e6, 5e5, -7e5, 1.5e6], 1.0);
     for i in 0..3 {
         assert!((l[i] - closed[i]).abs() < 1e-8 * 3e6);
     }
@@ -515,8 +513,8 @@ fn plane_strain_point(
     eps_n: [f64; 3],
     eps: [f64; 3],
     state_n: &[f64],
-) -> (PointResponse, Vec<f64>) {
-    common::point_update(m, Plane::Strain, eps_n, eps, state_n)
+) -> (PointResponse<3>, Vec<f64>) {
+    common::point_update::<3, rothe::fe::PlaneStrain>(m, eps_n, eps, state_n)
 }
 
 #[test]
@@ -619,7 +617,7 @@ fn a_plane_strain_rankine_hill_run_closes_its_ledger() {
     .unwrap()
     .replace("[analysis]", "[analysis]\nplane = \"strain\"");
     let model = rothe::config::from_str(&text, std::path::Path::new(".")).unwrap();
-    assert_eq!(model.plane, Plane::Strain);
+    assert_eq!(model.idealisation, Idealisation::PlaneStrain);
     let mut be = BackwardEuler::new(&model, rothe::linsolve::Backend::Faer).unwrap();
     let mut s = be.initial_state();
     for _ in 0..model.analysis.n_steps() {

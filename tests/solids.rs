@@ -6,7 +6,7 @@ mod common;
 
 use common::{load_from, model_of};
 use rothe::assembly::loads::add_face_traction;
-use rothe::fe::{elasticity_solid, Plane};
+use rothe::fe::{Idealisation, StrainSpace};
 use rothe::linsolve::Backend;
 use rothe::mesh::{solid, structured, ElementKind, Part};
 use rothe::model::{Constraint, Model, TimeFunction};
@@ -59,7 +59,7 @@ fn patch_tests_reproduce_a_linear_field_on_distorted_hexahedra_and_tetrahedra() 
     };
     for kind in [ElementKind::Hex8, ElementKind::Tet4] {
         let part = distorted_box(kind);
-        let mut model = model_of(&part, Plane::Solid, 210e9, 0.3, 7850.0, 1.0);
+        let mut model = model_of(&part, Idealisation::Solid, 210e9, 0.3, 7850.0, 1.0);
         let boundary: Vec<usize> = ["left", "right", "bottom", "top", "back", "front"]
             .iter()
             .flat_map(|s| model.mesh.node_sets[&format!("b.{s}")].clone())
@@ -87,7 +87,7 @@ fn patch_tests_reproduce_a_linear_field_on_distorted_hexahedra_and_tetrahedra() 
             b[1][2] + b[2][1],
             b[2][0] + b[0][2],
         ];
-        let c = elasticity_solid(210e9, 0.3);
+        let c = rothe::fe::Solid::elasticity(210e9, 0.3);
         for s in rothe::output::post::cell_stress(&model, &sol.u, &[]) {
             for i in 0..6 {
                 let want: f64 = (0..6).map(|j| c[i][j] * eps[j]).sum();
@@ -105,7 +105,7 @@ fn patch_tests_reproduce_a_linear_field_on_distorted_hexahedra_and_tetrahedra() 
 /// `l x h x t`, clamped at x = 0, under a uniform downward traction `q` on its top.
 fn cantilever_tip(kind: ElementKind, l: f64, h: f64, t: f64, div: [usize; 3], q: f64) -> f64 {
     let part = solid::uniform([0.0; 3], [l, h, t], div, kind);
-    let mut model = model_of(&part, Plane::Solid, 210e9, 0.0, 7850.0, 1.0);
+    let mut model = model_of(&part, Idealisation::Solid, 210e9, 0.0, 7850.0, 1.0);
     let left = model.mesh.node_sets["b.left"].clone();
     for c in 0..3 {
         hold(&mut model, &left, c, |_| 0.0);
@@ -161,7 +161,7 @@ fn a_hexahedral_plate_one_element_thick_matches_plane_stress() {
     // E = 30 GPa, ν = 0.2, q = 1 MPa.
     let (l, h, t, q) = (2.0, 0.5, 0.1, 1e6);
     let plane = structured::rectangle([0.0; 2], [l, h], 16, 4, ElementKind::Quad4);
-    let mut pm = model_of(&plane, Plane::Stress, 30e9, 0.2, 2400.0, t);
+    let mut pm = model_of(&plane, Idealisation::PlaneStress, 30e9, 0.2, 2400.0, t);
     let left = pm.mesh.node_sets["b.left"].clone();
     common::prescribe(&mut pm, &left, 0, |_| 0.0);
     common::prescribe(&mut pm, &left, 1, |_| 0.0);
@@ -179,7 +179,7 @@ fn a_hexahedral_plate_one_element_thick_matches_plane_stress() {
     let tip_plane = right.iter().map(|&n| up[2 * n + 1]).sum::<f64>() / right.len() as f64;
 
     let part = solid::uniform([0.0; 3], [l, h, t], [16, 4, 1], ElementKind::Hex8);
-    let mut sm = model_of(&part, Plane::Solid, 30e9, 0.2, 2400.0, 1.0);
+    let mut sm = model_of(&part, Idealisation::Solid, 30e9, 0.2, 2400.0, 1.0);
     let left = sm.mesh.node_sets["b.left"].clone();
     hold(&mut sm, &left, 0, |_| 0.0);
     hold(&mut sm, &left, 1, |_| 0.0);
@@ -220,7 +220,7 @@ type Both = ([f64; 6], [f64; 3], Vec<f64>, Vec<f64>);
 fn uniaxial_both(m: &rothe::material::Material, path: &[f64]) -> Vec<Both> {
     use rothe::material::StrainStep;
     let nu = m.nu;
-    let ns = m.n_state();
+    let ns = m.n_state(3);
     let (mut h3, mut h6) = (vec![0.0; ns], vec![0.0; ns]);
     let (mut e3n, mut e6n) = ([0.0; 3], [0.0; 6]);
     let mut out = Vec::new();
@@ -228,8 +228,7 @@ fn uniaxial_both(m: &rothe::material::Material, path: &[f64]) -> Vec<Both> {
         let e3 = [e, -nu * e, 0.0];
         let e6 = [e, -nu * e, 0.0, -nu * e, 0.0, 0.0];
         let (mut n3, mut n6) = (vec![0.0; ns], vec![0.0; ns]);
-        let r3 = m.update(
-            Plane::Stress,
+        let r3 = m.update::<3, rothe::fe::PlaneStress>(
             &StrainStep {
                 eps_n: e3n,
                 eps: e3,
@@ -239,8 +238,7 @@ fn uniaxial_both(m: &rothe::material::Material, path: &[f64]) -> Vec<Both> {
             &h3,
             &mut n3,
         );
-        let r6 = m.update(
-            Plane::Solid,
+        let r6 = m.update::<6, rothe::fe::Solid>(
             &StrainStep {
                 eps_n: e6n,
                 eps: e6,
@@ -312,7 +310,7 @@ fn solid_linear_models_are_isotropic_and_their_tangents_are_exact() {
         format!("model = \"mazars\"\n{MAZARS}"),
     ] {
         let m = material(&text);
-        let ns = m.n_state_for(6);
+        let ns = m.n_state(6);
         let hist = vec![1e-5; ns];
         let step6 = |eps: [f64; 6]| StrainStep {
             eps_n: [0.0; 6],
@@ -322,7 +320,7 @@ fn solid_linear_models_are_isotropic_and_their_tangents_are_exact() {
         };
         let update_from = |eps: [f64; 6], h: &[f64]| {
             let mut out = vec![0.0; ns];
-            m.update(Plane::Solid, &step6(eps), h, &mut out)
+            m.update::<6, rothe::fe::Solid>(&step6(eps), h, &mut out)
         };
         let zero = vec![0.0; ns];
         let update6 = |eps: [f64; 6]| update_from(eps, &zero);
@@ -336,16 +334,15 @@ fn solid_linear_models_are_isotropic_and_their_tangents_are_exact() {
         );
         // The plane-strain path.
         let e3 = [2e-5, -1e-5, 3e-5];
-        let mut o3 = vec![0.0; m.n_state()];
-        let r3 = m.update(
-            Plane::Strain,
+        let mut o3 = vec![0.0; m.n_state(3)];
+        let r3 = m.update::<3, rothe::fe::PlaneStrain>(
             &StrainStep {
                 eps_n: [0.0; 3],
                 eps: e3,
                 dt: 1e-3,
                 length: 0.1,
             },
-            &vec![0.0; m.n_state()],
+            &vec![0.0; m.n_state(3)],
             &mut o3,
         );
         let r6 = update6([e3[0], e3[1], e3[2], 0.0, 0.0, 0.0]);
@@ -382,8 +379,7 @@ fn solid_linear_models_are_isotropic_and_their_tangents_are_exact() {
     // Hydrostatic: σ = 3K e.
     let m = material("model = \"elastic\"");
     let e = 1e-4;
-    let r = m.update(
-        Plane::Solid,
+    let r = m.update::<6, rothe::fe::Solid>(
         &StrainStep {
             eps_n: [0.0; 6],
             eps: [e, e, 0.0, e, 0.0, 0.0],
@@ -442,7 +438,7 @@ fn mms_errors(kind: ElementKind, n: usize) -> (f64, f64) {
         })
     };
     let part = solid::uniform([0.0; 3], [1.0; 3], [n, n, n], kind);
-    let mut model = model_of(&part, Plane::Solid, e, nu, 1.0, 1.0);
+    let mut model = model_of(&part, Idealisation::Solid, e, nu, 1.0, 1.0);
     let boundary: Vec<usize> = ["left", "right", "bottom", "top", "back", "front"]
         .iter()
         .flat_map(|s| model.mesh.node_sets[&format!("b.{s}")].clone())
@@ -512,7 +508,7 @@ fn bar_end(cells: usize, dt: f64, steps: usize, p: f64) -> (f64, rothe::time::St
         [cells, 1, 1],
         ElementKind::Hex8,
     );
-    let mut model = model_of(&part, Plane::Solid, 200e9, 0.0, 8000.0, 1.0);
+    let mut model = model_of(&part, Idealisation::Solid, 200e9, 0.0, 8000.0, 1.0);
     let left = model.mesh.node_sets["b.left"].clone();
     for c in 0..3 {
         hold(&mut model, &left, c, |_| 0.0);

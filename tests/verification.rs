@@ -6,7 +6,7 @@ mod common;
 
 use common::{load_from, model_of, orders, prescribe};
 use rothe::assembly::loads::{accurate_rule, add_body_force};
-use rothe::fe::{elasticity, kinematics, Plane};
+use rothe::fe::{kinematics, Idealisation, StrainSpace};
 use rothe::linsolve::Backend;
 use rothe::mesh::{structured, ElementKind, Part};
 use rothe::model::{AnalysisKind, TimeFunction};
@@ -35,7 +35,7 @@ fn patch_test(kind: ElementKind) {
     // complete element (the patch test). Boundary nodes take u = a + B x; the interior
     // nodes are free; the stress must be C ε everywhere. E = 210e9, ν = 0.3, plane stress.
     let part = distorted_patch(kind);
-    let mut model = model_of(&part, Plane::Stress, 210e9, 0.3, 7850.0, 0.1);
+    let mut model = model_of(&part, Idealisation::PlaneStress, 210e9, 0.3, 7850.0, 0.1);
     let exact = |x: [f64; 2]| {
         [
             1e-3 + 2e-4 * x[0] - 1e-4 * x[1],
@@ -55,7 +55,7 @@ fn patch_test(kind: ElementKind) {
         assert!((sol.u[2 * n + 1] - e[1]).abs() < 1e-14, "node {n} uy");
     }
     let eps = [2e-4, 1.5e-4, -1e-4 + 3e-4];
-    let c = elasticity(210e9, 0.3, Plane::Stress);
+    let c = rothe::fe::PlaneStress::elasticity(210e9, 0.3);
     for s in rothe::output::post::cell_stress(&model, &sol.u, &[]) {
         for i in 0..3 {
             let want: f64 = (0..3).map(|j| c[i][j] * eps[j]).sum();
@@ -101,7 +101,7 @@ fn cantilever_static_vs_timoshenko() {
     let mut errs = Vec::new();
     for n in [4usize, 8, 16] {
         let part = structured::rectangle([0.0, 0.0], [l, h], 10 * n, n, ElementKind::Quad4);
-        let mut model = model_of(&part, Plane::Stress, e, nu, 2400.0, t);
+        let mut model = model_of(&part, Idealisation::PlaneStress, e, nu, 2400.0, t);
         let left = model.mesh.node_sets["b.left"].clone();
         prescribe(&mut model, &left, 0, |_| 0.0);
         prescribe(&mut model, &left, 1, |_| 0.0);
@@ -175,11 +175,11 @@ fn mms_orders(kind: ElementKind) -> (Vec<f64>, Vec<f64>) {
     // fixed. Meshes 8², 16², 32²; errors in L2 and the H1 seminorm by a 3x3 / 6-point
     // rule. Linear elements: L2 order 2, H1 order 1.
     let (e, nu) = (1e9, 0.3);
-    let c = elasticity(e, nu, Plane::Stress);
+    let c = rothe::fe::PlaneStress::elasticity(e, nu);
     let (mut l2s, mut h1s) = (Vec::new(), Vec::new());
     for n in [8usize, 16, 32] {
         let part = structured::rectangle([0.0, 0.0], [1.0, 1.0], n, n, kind);
-        let mut model = model_of(&part, Plane::Stress, e, nu, 1.0, 1.0);
+        let mut model = model_of(&part, Idealisation::PlaneStress, e, nu, 1.0, 1.0);
         let boundary: Vec<usize> = ["b.left", "b.right", "b.top", "b.bottom"]
             .iter()
             .flat_map(|s| model.mesh.node_sets[*s].clone())
@@ -250,7 +250,7 @@ fn mms_spatial_order_t3() {
 /// only once `ω_max h ≪ 1`, beyond the steps a test can afford.)
 fn bar_model(lumped: bool, dt: f64, t_end: f64) -> rothe::model::Model {
     let part = structured::rectangle([0.0, 0.0], [1.0, 0.1], 20, 2, ElementKind::Quad4);
-    let mut model = model_of(&part, Plane::Stress, 1e4, 0.0, 1.0, 1.0);
+    let mut model = model_of(&part, Idealisation::PlaneStress, 1e4, 0.0, 1.0, 1.0);
     let left = model.mesh.node_sets["b.left"].clone();
     prescribe(&mut model, &left, 0, |_| 0.0);
     let corner = model.mesh.node_sets["b.bottom_left"].clone();
@@ -592,7 +592,7 @@ fn orderings_give_the_same_solution() {
         rothe::model::Ordering::NestedDissection,
     ] {
         let part = structured::rectangle([0.0, 0.0], [5.0, 0.5], 200, 20, ElementKind::Quad4);
-        let mut model = model_of(&part, Plane::Stress, 30e9, 0.25, 2400.0, 0.1);
+        let mut model = model_of(&part, Idealisation::PlaneStress, 30e9, 0.25, 2400.0, 0.1);
         model.analysis.iteration.ordering = ordering;
         let left = model.mesh.node_sets["b.left"].clone();
         prescribe(&mut model, &left, 0, |_| 0.0);

@@ -9,8 +9,8 @@ use super::nonlocal::DRIVERS;
 use super::{Assembler, SharedValues};
 use crate::energy::Dissipation;
 use crate::fe::{
-    element, kinematics_from, rule_shapes, stiffness_rule, strain, strain_solid, ElementKind,
-    Plane, PointKinematics, MAX_ELEMENT_DOFS, MAX_NODES,
+    element, kinematics_from, rule_shapes, stiffness_rule, ElementKind, Idealisation, Kinematics,
+    PointKinematics, MAX_ELEMENT_DOFS, MAX_NODES,
 };
 use crate::halves::in_halves;
 use crate::material::store::{Committed, Layout, StateStore};
@@ -81,8 +81,8 @@ pub fn new_stores(mesh: &Mesh, materials: &[Material]) -> Vec<StateStore> {
         .map(|b| {
             let mat = &materials[b.material];
             let n = b.elements.len() * points_per_element(b.elements.kind);
-            let ns = mat.n_state_for(v);
-            let mut s = StateStore::with_voigt(n, ns, v);
+            let ns = mat.n_state(v);
+            let mut s = StateStore::new(n, ns, v);
             if ns > 0 {
                 for g in 0..n {
                     mat.init_state(s.history_mut(g));
@@ -113,7 +113,6 @@ impl Shared {
 struct Ctx<'a, const V: usize> {
     mesh: &'a Mesh,
     mat: &'a Material,
-    plane: Plane,
     kind: ElementKind,
     section: f64,
     dt: f64,
@@ -124,7 +123,7 @@ struct Ctx<'a, const V: usize> {
     at_rest: bool,
     /// Keep every history at its committed value (`Material::update_frozen`).
     frozen: bool,
-    /// The material's elasticity matrix in this idealisation.
+    /// The material's elasticity matrix in the run's idealisation.
     c: [[f64; V]; V],
     /// The averaged drivers of the block's points (`nonlocal::DRIVERS` per point)
     /// when its material is nonlocal.
@@ -132,10 +131,10 @@ struct Ctx<'a, const V: usize> {
 }
 
 impl<'a, const V: usize> Ctx<'a, V> {
-    fn new(
+    /// The context of a block of `mat` in the idealisation `K`.
+    fn new<const D: usize, K: Kinematics<D, V>>(
         mesh: &'a Mesh,
         mat: &'a Material,
-        plane: Plane,
         block: &crate::mesh::Block,
         dt: f64,
         predict: bool,
@@ -146,13 +145,12 @@ impl<'a, const V: usize> Ctx<'a, V> {
             frozen: false,
             mesh,
             mat,
-            plane,
             kind: block.elements.kind,
             section: block.section,
             dt,
             predict,
             at_rest,
-            c: mat.c_voigt(plane),
+            c: mat.elasticity::<V, K>(),
         }
     }
 
@@ -176,13 +174,13 @@ struct TrialOut {
     layout: Layout,
 }
 
-/// Evaluates element `e` at displacements `u` in a mesh of dimension `D` with `V`
-/// Voigt components: calls `point(w, &resp, &kin, x, σ_pred)` for each of its
+/// Evaluates element `e` at displacements `u` in the idealisation `K` (a mesh of
+/// dimension `D`, `V` Voigt components): calls `point(w, &resp, &kin, x, σ_pred)` for each of its
 /// points, where `σ_pred` (when `cx.predict`) is the stress of the next step of the
 /// same size at an unchanged strain, from the trial history: for constant-tangent
 /// materials `f_int` of the next step is then `f_pred + K_t Δu` exactly. With
 /// `trial`, the points' trial states are written.
-fn element_points<const D: usize, const V: usize, F>(
+fn element_points<const D: usize, const V: usize, K: Kinematics<D, V>, F>(
     cx: &Ctx<V>,
     committed: Committed,
     nodes: &[usize],
@@ -228,32 +226,18 @@ fn element_points<const D: usize, const V: usize, F>(
     }
     let rule = stiffness_rule(cx.kind);
     let shapes = rule_shapes(cx.kind);
-    // Element size for crack-band regularisation: the square root of its area (the
-    // cube root of its volume, `Σ w det J` over the points, whose kinematics a
-    // solid element evaluates first and keeps).
-    let mut solid_points = [PointKinematics::ZERO; 8];
-    let length = if D == 3 {
-        let mut volume = 0.0;
-        for (q, &(_, wq)) in rule.iter().enumerate() {
-            solid_points[q] = kinematics_from(cx.kind, &x[..nn], &shapes[q]);
-            volume += wq * solid_points[q].det_j;
-        }
-        volume.abs().cbrt()
-    } else {
-        crate::mesh::polygon_area(&x[..nn]).abs().sqrt()
-    };
-    let ns = cx.mat.n_state_for(V);
+    let mut points = [PointKinematics::ZERO; 8];
+    for (q, shape) in shapes.iter().enumerate() {
+        points[q] = kinematics_from(cx.kind, &x[..nn], shape);
+    }
+    // Element size for crack-band regularisation.
+    let length = K::band_length(&x[..nn], &points[..rule.len()], rule);
+    let ns = cx.mat.n_state(V);
     let mut scratch = [0.0; MAX_STATE];
     for (q, &(_, wq)) in rule.iter().enumerate() {
         let g = e * rule.len() + q;
-        let plane_point;
-        let k = if D == 3 {
-            &solid_points[q]
-        } else {
-            plane_point = kinematics_from(cx.kind, &x[..nn], &shapes[q]);
-            &plane_point
-        };
-        let eps = strain_v::<V>(k, nn, &ue);
+        let k = &points[q];
+        let eps = K::strain(k, nn, &ue);
         let (eps_n, dt) = if cx.at_rest {
             // A vanishing step: rates are zero and history does not evolve.
             (eps, f64::MIN_POSITIVE)
@@ -275,11 +259,10 @@ fn element_points<const D: usize, const V: usize, F>(
                 // parts of the trial buffer (see `Layout`).
                 let hist = unsafe { t.base.slice(t.layout.history() + g * ns, ns) };
                 let r = if cx.frozen {
-                    cx.mat
-                        .update_frozen(&cx.c, cx.plane, &step, history_n, hist)
+                    cx.mat.update_frozen::<V, K>(&cx.c, &step, history_n, hist)
                 } else {
                     cx.mat
-                        .update_driven(&cx.c, cx.plane, &step, averaged, history_n, hist)
+                        .update_driven::<V, K>(&cx.c, &step, averaged, history_n, hist)
                 };
                 unsafe {
                     write_v(t.base.slice(t.layout.eps() + V * g, V), &eps);
@@ -290,33 +273,16 @@ fn element_points<const D: usize, const V: usize, F>(
                 if cx.predict {
                     pred = cx
                         .mat
-                        .predicted_stress_with(&cx.c, cx.plane, &eps, hist, cx.dt);
+                        .predicted_stress_with::<V, K>(&cx.c, &eps, hist, cx.dt);
                 }
                 r
             }
-            None => cx.mat.update_driven(
-                &cx.c,
-                cx.plane,
-                &step,
-                averaged,
-                history_n,
-                &mut scratch[..ns],
-            ),
+            None => {
+                cx.mat
+                    .update_driven::<V, K>(&cx.c, &step, averaged, history_n, &mut scratch[..ns])
+            }
         };
         point(wq * k.det_j * cx.section, &resp, Some(k), &x[..nn], pred);
-    }
-}
-
-/// The strain of `V` Voigt components at a point (`V = 3`: the plane's, `6`: a
-/// solid's) from the element displacements `ue`.
-#[inline(always)]
-pub(crate) fn strain_v<const V: usize>(k: &PointKinematics, nn: usize, ue: &[f64]) -> [f64; V] {
-    if V == 6 {
-        let e = strain_solid(k, nn, ue);
-        std::array::from_fn(|i| e[i])
-    } else {
-        let e = strain(k, nn, ue);
-        std::array::from_fn(|i| e[i])
     }
 }
 
@@ -345,34 +311,25 @@ fn write_v<const V: usize>(out: &mut [f64], v: &[f64; V]) {
 }
 
 /// Adds one point's `w Bᵀ D B` (continuum) or sets the bar stiffness `E A / L`
-/// (bars have one point) in the element matrix `ke` (mesh dimension `dim`).
+/// (bars have one point) in the element matrix `ke`.
 #[inline]
-fn add_point_tangent<const V: usize>(
+fn add_point_tangent<const D: usize, const V: usize, K: Kinematics<D, V>>(
     k: Option<&PointKinematics>,
     x: &[[f64; 3]],
     nn: usize,
-    dim: usize,
     w: f64,
     d: &[[f64; V]; V],
     ke: &mut [f64],
 ) {
     match k {
-        Some(k) if V == 6 => {
-            let d6: [[f64; 6]; 6] = std::array::from_fn(|i| std::array::from_fn(|j| d[i][j]));
-            element::add_btdb_solid(k, nn, &d6, w, ke)
-        }
-        Some(k) => {
-            let d3: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| d[i][j]));
-            element::add_btdb(k, nn, &d3, w, ke)
-        }
-        None => element::bar_stiffness(x, dim, d[0][0] * w / element::bar_axis(x).1, ke),
+        Some(k) => K::add_btdb(k, nn, d, w, ke),
+        None => element::bar_stiffness(x, D, d[0][0] * w / element::bar_axis(x).1, ke),
     }
 }
 
-/// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`, in
-/// a mesh of dimension `D`.
+/// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`.
 #[inline]
-fn add_bt_sigma<const D: usize, const V: usize>(
+fn add_bt_sigma<const D: usize, const V: usize, K: Kinematics<D, V>>(
     k: Option<&PointKinematics>,
     x: &[[f64; 3]],
     nn: usize,
@@ -381,21 +338,7 @@ fn add_bt_sigma<const D: usize, const V: usize>(
     fe: &mut [f64; MAX_ELEMENT_DOFS],
 ) {
     match k {
-        Some(k) if D == 3 => {
-            for a in 0..nn {
-                let [dx, dy, dz] = k.dndx[a];
-                fe[3 * a] += w * (dx * sigma[0] + dy * sigma[2] + dz * sigma[5]);
-                fe[3 * a + 1] += w * (dy * sigma[1] + dx * sigma[2] + dz * sigma[4]);
-                fe[3 * a + 2] += w * (dz * sigma[3] + dy * sigma[4] + dx * sigma[5]);
-            }
-        }
-        Some(k) => {
-            for a in 0..nn {
-                let (dx, dy) = (k.dndx[a][0], k.dndx[a][1]);
-                fe[2 * a] += w * (dx * sigma[0] + dy * sigma[2]);
-                fe[2 * a + 1] += w * (dy * sigma[1] + dx * sigma[2]);
-            }
-        }
+        Some(k) => K::add_bt_sigma(k, nn, w, sigma, fe),
         None => {
             let (ax, l) = element::bar_axis(x);
             let n = sigma[0] * w / l;
@@ -443,7 +386,7 @@ impl Assembler {
         &self,
         mesh: &Mesh,
         materials: &[Material],
-        plane: Plane,
+        idealisation: Idealisation,
         pass: PointPass,
         stores: &mut [StateStore],
         f: &mut [f64],
@@ -451,40 +394,24 @@ impl Assembler {
         tangent: Option<&mut [f64]>,
         tangent_base: Option<&[f64]>,
     ) -> PointTotals {
-        if mesh.dim == 3 {
-            self.internal_force_d::<3, 6>(
-                mesh,
-                materials,
-                plane,
-                pass,
-                stores,
-                f,
-                f_pred,
-                tangent,
-                tangent_base,
-            )
-        } else {
-            self.internal_force_d::<2, 3>(
-                mesh,
-                materials,
-                plane,
-                pass,
-                stores,
-                f,
-                f_pred,
-                tangent,
-                tangent_base,
-            )
-        }
+        crate::dispatch_kinematics!(idealisation, <D, V, K> => self.internal_force_k::<D, V, K>(
+            mesh,
+            materials,
+            pass,
+            stores,
+            f,
+            f_pred,
+            tangent,
+            tangent_base,
+        ))
     }
 
-    /// [`Assembler::internal_force`] in dimension `D` with `V` Voigt components.
+    /// [`Assembler::internal_force`] in the idealisation `K`.
     #[allow(clippy::too_many_arguments)]
-    fn internal_force_d<const D: usize, const V: usize>(
+    fn internal_force_k<const D: usize, const V: usize, K: Kinematics<D, V>>(
         &self,
         mesh: &Mesh,
         materials: &[Material],
-        plane: Plane,
         pass: PointPass,
         stores: &mut [StateStore],
         f: &mut [f64],
@@ -495,7 +422,8 @@ impl Assembler {
         let u = pass.u;
         // Nonlocal materials: their drivers averaged at `u` first (one more pass; a
         // frozen pass reads none).
-        let nonlocal = (!pass.frozen).then(|| self.nonlocal_at(mesh, materials, plane, u, stores));
+        let nonlocal =
+            (!pass.frozen).then(|| self.nonlocal_at_k::<D, V, K>(mesh, materials, u, stores));
         f.fill(0.0);
         let kp = tangent.as_mut().map(|k| {
             match tangent_base {
@@ -519,10 +447,9 @@ impl Assembler {
                 base: Shared(trial_buf.as_mut_ptr()),
                 layout,
             };
-            let cx = Ctx::<V>::new(
+            let cx = Ctx::<V>::new::<D, K>(
                 mesh,
                 &materials[block.material],
-                plane,
                 block,
                 pass.dt,
                 predict,
@@ -556,7 +483,7 @@ impl Assembler {
                         }
                         let mut changed = !by_delta;
                         let mut q = 0;
-                        element_points::<D, V, _>(
+                        element_points::<D, V, K, _>(
                             &cx,
                             committed,
                             nodes,
@@ -574,17 +501,23 @@ impl Assembler {
                                     });
                                 }
                                 q += 1;
-                                add_bt_sigma::<D, V>(k, x, nodes.len(), w, &r.sigma, &mut fe);
+                                add_bt_sigma::<D, V, K>(k, x, nodes.len(), w, &r.sigma, &mut fe);
                                 if predict {
-                                    add_bt_sigma::<D, V>(k, x, nodes.len(), w, &sp, &mut fe_pred);
+                                    add_bt_sigma::<D, V, K>(
+                                        k,
+                                        x,
+                                        nodes.len(),
+                                        w,
+                                        &sp,
+                                        &mut fe_pred,
+                                    );
                                 }
                                 if block_tangent {
                                     if !by_delta {
-                                        add_point_tangent(
+                                        add_point_tangent::<D, V, K>(
                                             k,
                                             x,
                                             nodes.len(),
-                                            D,
                                             w,
                                             &r.tangent,
                                             &mut ke,
@@ -596,7 +529,14 @@ impl Assembler {
                                                 *a -= b;
                                             }
                                         }
-                                        add_point_tangent(k, x, nodes.len(), D, w, &d, &mut ke);
+                                        add_point_tangent::<D, V, K>(
+                                            k,
+                                            x,
+                                            nodes.len(),
+                                            w,
+                                            &d,
+                                            &mut ke,
+                                        );
                                         changed = true;
                                     }
                                 }
@@ -643,52 +583,41 @@ impl Assembler {
         &self,
         mesh: &Mesh,
         materials: &[Material],
-        plane: Plane,
+        idealisation: Idealisation,
         u: &[f64],
         dt: f64,
         stores: &[StateStore],
     ) -> Vec<f64> {
-        if mesh.dim == 3 {
-            self.tangent_d::<3, 6>(mesh, materials, plane, u, dt, stores)
-        } else {
-            self.tangent_d::<2, 3>(mesh, materials, plane, u, dt, stores)
-        }
+        crate::dispatch_kinematics!(idealisation, <D, V, K> =>
+            self.tangent_k::<D, V, K>(mesh, materials, u, dt, stores))
     }
 
-    /// [`Assembler::tangent`] in dimension `D` with `V` Voigt components.
-    fn tangent_d<const D: usize, const V: usize>(
+    /// [`Assembler::tangent`] in the idealisation `K`.
+    fn tangent_k<const D: usize, const V: usize, K: Kinematics<D, V>>(
         &self,
         mesh: &Mesh,
         materials: &[Material],
-        plane: Plane,
         u: &[f64],
         dt: f64,
         stores: &[StateStore],
     ) -> Vec<f64> {
-        let nonlocal = self.nonlocal_at(mesh, materials, plane, u, stores);
+        let nonlocal = self.nonlocal_at_k::<D, V, K>(mesh, materials, u, stores);
         self.assemble(mesh, |bi, e, _x, ke| {
             let block = &mesh.blocks[bi];
-            let cx = Ctx::<V>::new(
-                mesh,
-                &materials[block.material],
-                plane,
-                block,
-                dt,
-                false,
-                false,
-            )
-            .with_drivers(nonlocal.as_ref().and_then(|n| n.block(mesh, bi)));
+            let cx =
+                Ctx::<V>::new::<D, K>(mesh, &materials[block.material], block, dt, false, false)
+                    .with_drivers(nonlocal.as_ref().and_then(|n| n.block(mesh, bi)));
             let nodes = block.elements.element(e);
             let nd = D * nodes.len();
             ke[..nd * nd].fill(0.0);
-            element_points::<D, V, _>(
+            element_points::<D, V, K, _>(
                 &cx,
                 stores[bi].committed(),
                 nodes,
                 u,
                 e,
                 None,
-                |w, r, k, x, _| add_point_tangent(k, x, nodes.len(), D, w, &r.tangent, ke),
+                |w, r, k, x, _| add_point_tangent::<D, V, K>(k, x, nodes.len(), w, &r.tangent, ke),
             );
         })
     }

@@ -11,8 +11,8 @@ pub mod pattern;
 
 use rayon::prelude::*;
 
-use crate::fe::element::{self, Voigt};
-use crate::fe::{Plane, MAX_ELEMENT_DOFS, MAX_NODES};
+use crate::fe::element;
+use crate::fe::{Idealisation, Kinematics, MAX_ELEMENT_DOFS, MAX_NODES};
 use crate::material::Material;
 use crate::mesh::{ElementKind, Mesh};
 pub use pattern::{Pattern, Stored};
@@ -201,7 +201,19 @@ impl Assembler {
         &self,
         mesh: &Mesh,
         materials: &[Material],
-        plane: Plane,
+        idealisation: Idealisation,
+        u: &[f64],
+        stores: &[crate::material::store::StateStore],
+    ) -> std::sync::MutexGuard<'_, Option<nonlocal::Nonlocal>> {
+        crate::dispatch_kinematics!(idealisation, <D, V, K> =>
+            self.nonlocal_at_k::<D, V, K>(mesh, materials, u, stores))
+    }
+
+    /// [`Assembler::nonlocal_at`] in the idealisation `K`.
+    pub(crate) fn nonlocal_at_k<const D: usize, const V: usize, K: Kinematics<D, V>>(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
         u: &[f64],
         stores: &[crate::material::store::StateStore],
     ) -> std::sync::MutexGuard<'_, Option<nonlocal::Nonlocal>> {
@@ -220,7 +232,7 @@ impl Assembler {
             *guard = nonlocal::Nonlocal::build(mesh, materials);
         }
         if let Some(n) = guard.as_mut() {
-            n.evaluate(mesh, materials, plane, u, stores);
+            n.evaluate::<D, V, K>(mesh, materials, u, stores);
         }
         guard
     }
@@ -289,42 +301,47 @@ impl Assembler {
     }
 
     /// Elastic stiffness `K` (bars: `EA/L` along the axis).
-    pub fn stiffness(&self, mesh: &Mesh, materials: &[Material], plane: Plane) -> Vec<f64> {
-        if mesh.dim == 3 {
-            let ds: Vec<_> = materials.iter().map(|m| m.c_solid()).collect();
-            return self.elastic_matrix(mesh, materials, &ds);
-        }
-        let ds: Vec<[[f64; 3]; 3]> = materials.iter().map(|m| m.c(plane)).collect();
-        self.elastic_matrix(mesh, materials, &ds)
+    pub fn stiffness(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        idealisation: Idealisation,
+    ) -> Vec<f64> {
+        crate::dispatch_kinematics!(idealisation, <D, V, K> => self.stiffness_of::<D, V, K>(
+            mesh,
+            materials,
+            |_| true,
+            |m| m.elasticity::<V, K>(),
+        ))
     }
 
-    /// `Σ ∫ Bᵀ D B t dA` with the elasticity `ds[material]`, bars `E A / L`.
-    fn elastic_matrix<D: Voigt>(&self, mesh: &Mesh, materials: &[Material], ds: &[D]) -> Vec<f64> {
-        let dim = mesh.dim;
+    /// A stiffness-like matrix in the idealisation `K`: `Σ ∫ Bᵀ D B t dA` with
+    /// `D = d(material)` over the blocks `in_block` selects (bars `E A / L`), zero
+    /// elsewhere: the elastic stiffness, or a viscosity matrix with `d` the
+    /// material's `η`.
+    pub fn stiffness_of<const D: usize, const V: usize, K: Kinematics<D, V>>(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        in_block: impl Fn(usize) -> bool + Sync,
+        d: impl Fn(&Material) -> [[f64; V]; V],
+    ) -> Vec<f64> {
+        let ds: Vec<[[f64; V]; V]> = materials.iter().map(d).collect();
         self.assemble(mesh, |bi, _e, x, ke| {
             let block = &mesh.blocks[bi];
-            let mat = &materials[block.material];
-            match block.elements.kind {
-                ElementKind::Bar2 => element::bar_stiffness(x, dim, mat.e * block.section, ke),
-                kind => {
-                    element::continuum_stiffness(kind, x, &ds[block.material], block.section, ke)
-                }
+            let kind = block.elements.kind;
+            if !in_block(bi) {
+                let nd = D * kind.nodes();
+                ke[..nd * nd].fill(0.0);
+                return;
             }
-        })
-    }
-
-    /// A stiffness-like matrix `∫ Bᵀ D B t dA` with one `D` per material (bars skipped),
-    /// for viscosity matrices and the like.
-    pub fn continuum_matrix<D: Voigt>(&self, mesh: &Mesh, d_of_material: &[D]) -> Vec<f64> {
-        let nd = 2 * mesh.dim;
-        self.assemble(mesh, |bi, _e, x, ke| {
-            let block = &mesh.blocks[bi];
-            match block.elements.kind {
-                ElementKind::Bar2 => ke[..nd * nd].fill(0.0),
-                kind => element::continuum_stiffness(
+            let mat = &materials[block.material];
+            match kind {
+                ElementKind::Bar2 => element::bar_stiffness(x, D, mat.e * block.section, ke),
+                kind => element::continuum_stiffness::<D, V, K>(
                     kind,
                     x,
-                    &d_of_material[block.material],
+                    &ds[block.material],
                     block.section,
                     ke,
                 ),

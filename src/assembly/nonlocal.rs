@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
-use crate::fe::{kinematics, stiffness_rule, ElementKind, Plane};
+use crate::fe::{kinematics, stiffness_rule, ElementKind, Kinematics};
 use crate::material::store::StateStore;
 use crate::material::{mazars, Material, MazarsVariant, Model};
 use crate::mesh::Mesh;
@@ -420,28 +420,11 @@ impl NonlocalTable {
     }
 
     /// The drivers of every member at displacements `u` (their own, not averaged),
-    /// on the thread pool.
-    pub fn local_drivers(
+    /// in the idealisation `K`, on the thread pool.
+    pub fn local_drivers<const D: usize, const V: usize, K: Kinematics<D, V>>(
         &self,
         mesh: &Mesh,
         materials: &[Material],
-        plane: Plane,
-        u: &[f64],
-        local: &mut [f64],
-    ) {
-        if mesh.dim == 3 {
-            self.local_drivers_d::<3, 6>(mesh, materials, plane, u, local)
-        } else {
-            self.local_drivers_d::<2, 3>(mesh, materials, plane, u, local)
-        }
-    }
-
-    /// [`NonlocalTable::local_drivers`] in dimension `D` with `V` Voigt components.
-    fn local_drivers_d<const D: usize, const V: usize>(
-        &self,
-        mesh: &Mesh,
-        materials: &[Material],
-        plane: Plane,
         u: &[f64],
         local: &mut [f64],
     ) {
@@ -464,8 +447,8 @@ impl NonlocalTable {
                             super::internal::gather::<D>(mesh, b.elements.element(e), u);
                         for (q, &(xi, _)) in stiffness_rule(kind).iter().enumerate() {
                             let kin = kinematics(kind, &x[..nn], xi);
-                            let eps = super::internal::strain_v::<V>(&kin, nn, &ue);
-                            let d = mazars::drivers(p, mat.nu, plane, &eps);
+                            let eps = K::strain(&kin, nn, &ue);
+                            let d = mazars::drivers::<V, K>(p, mat.nu, &eps);
                             el[DRIVERS * q] = d[0];
                             el[DRIVERS * q + 1] = d[1];
                         }
@@ -509,16 +492,15 @@ impl Nonlocal {
     /// point whose bound (the largest driver within its reach) stays at or below its
     /// history maxima (and thresholds) would take the same damage from any average
     /// below the bound, so it gets `-∞` instead, which the update reads the same way.
-    pub fn evaluate(
+    pub fn evaluate<const D: usize, const V: usize, K: Kinematics<D, V>>(
         &mut self,
         mesh: &Mesh,
         materials: &[Material],
-        plane: Plane,
         u: &[f64],
         stores: &[StateStore],
     ) {
         let t = &self.table;
-        t.local_drivers(mesh, materials, plane, u, &mut self.local);
+        t.local_drivers::<D, V, K>(mesh, materials, u, &mut self.local);
         let needed = |i: usize, bound: [f64; 2]| {
             let bi = t.block[i] as usize;
             let Model::Mazars(p) = &materials[mesh.blocks[bi].material].model else {

@@ -68,7 +68,7 @@ pub use overrides::Overrides;
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
-use crate::fe::Plane;
+use crate::fe::Idealisation;
 use crate::model::{AnalysisKind, Model, TimeFunction};
 use location::{field_path, line_column, toml_error, within_material};
 
@@ -213,7 +213,7 @@ pub struct AnalysisSpec {
     /// `stress` (default: the paper's walls) or `strain`; `solid` names what a
     /// three-dimensional mesh is anyway (a plane mesh refuses it).
     #[serde(default)]
-    pub plane: Option<Plane>,
+    pub plane: Option<Idealisation>,
     /// `consistent` (default for the implicit schemes: the paper's Galerkin mass) or
     /// `lumped` (the only one central differences take, and their default).
     #[serde(default)]

@@ -3,68 +3,7 @@
 //! caller-owned slices (row-major `n_dof x n_dof`, `n_dof = dim x nodes`), so the
 //! assembly loop allocates nothing.
 
-use super::{kinematics, mass_rule, stiffness_rule, ElementKind, PointKinematics};
-
-/// An elasticity matrix in Voigt form: the plane's 3x3 or the solid's 6x6. Its
-/// `Bᵀ D B` and `Bᵀ σ` are the element kernels of its dimension.
-pub trait Voigt: Copy + Sync {
-    /// Adds `w Bᵀ D B` at one point to the element matrix `ke` (row-major).
-    fn add_btdb(&self, k: &PointKinematics, nn: usize, w: f64, ke: &mut [f64]);
-}
-
-impl Voigt for [[f64; 3]; 3] {
-    #[inline]
-    fn add_btdb(&self, k: &PointKinematics, nn: usize, w: f64, ke: &mut [f64]) {
-        add_btdb(k, nn, self, w, ke)
-    }
-}
-
-impl Voigt for [[f64; 6]; 6] {
-    #[inline]
-    fn add_btdb(&self, k: &PointKinematics, nn: usize, w: f64, ke: &mut [f64]) {
-        add_btdb_solid(k, nn, self, w, ke)
-    }
-}
-
-/// The rows of `B` of node `a` of a solid: `B_a` is 6x3, row `i` the Voigt
-/// component `i` (order of `fe`).
-#[inline]
-fn b_solid(g: [f64; 3]) -> [[f64; 3]; 6] {
-    let [x, y, z] = g;
-    [
-        [x, 0.0, 0.0],
-        [0.0, y, 0.0],
-        [y, x, 0.0],
-        [0.0, 0.0, z],
-        [0.0, z, y],
-        [z, 0.0, x],
-    ]
-}
-
-/// Adds `w Bᵀ D B` of a solid at one point to `ke` (row-major, `3nn x 3nn`).
-#[inline]
-pub fn add_btdb_solid(k: &PointKinematics, nn: usize, d: &[[f64; 6]; 6], w: f64, ke: &mut [f64]) {
-    let nd = 3 * nn;
-    for b in 0..nn {
-        let bb = b_solid(k.dndx[b]);
-        // D B_b (6x3)
-        let mut db = [[0.0; 3]; 6];
-        for i in 0..6 {
-            for j in 0..3 {
-                db[i][j] = (0..6).map(|l| d[i][l] * bb[l][j]).sum();
-            }
-        }
-        for a in 0..nn {
-            let ba = b_solid(k.dndx[a]);
-            for r in 0..3 {
-                for c in 0..3 {
-                    let v: f64 = (0..6).map(|l| ba[l][r] * db[l][c]).sum();
-                    ke[(3 * a + r) * nd + 3 * b + c] += w * v;
-                }
-            }
-        }
-    }
-}
+use super::{kinematics, mass_rule, stiffness_rule, ElementKind, Kinematics};
 
 /// The measure of a continuum element: its area (plane kinds, from the Jacobian) or
 /// volume (solids), signed by the Jacobian.
@@ -75,51 +14,21 @@ pub fn measure(kind: ElementKind, x: &[[f64; 3]]) -> f64 {
         .sum()
 }
 
-/// Adds `w Bᵀ D B` at one point to the element matrix `ke` (row-major, `2nn x 2nn`).
-#[inline]
-pub fn add_btdb(k: &PointKinematics, nn: usize, d: &[[f64; 3]; 3], w: f64, ke: &mut [f64]) {
-    let nd = 2 * nn;
-    for a in 0..nn {
-        let (ax, ay) = (k.dndx[a][0], k.dndx[a][1]);
-        // Rows of Bᵀ for node a: dof x -> [ax, 0, ay], dof y -> [0, ay, ax]
-        // (D B)_b columns: for node b, x: D[:,0]*bx + D[:,2]*by, y: D[:,1]*by + D[:,2]*bx
-        for b in 0..nn {
-            let (bx, by) = (k.dndx[b][0], k.dndx[b][1]);
-            let mut dbx = [0.0; 3];
-            let mut dby = [0.0; 3];
-            for i in 0..3 {
-                dbx[i] = d[i][0] * bx + d[i][2] * by;
-                dby[i] = d[i][1] * by + d[i][2] * bx;
-            }
-            let kxx = ax * dbx[0] + ay * dbx[2];
-            let kxy = ax * dby[0] + ay * dby[2];
-            let kyx = ay * dbx[1] + ax * dbx[2];
-            let kyy = ay * dby[1] + ax * dby[2];
-            let r = 2 * a;
-            let c = 2 * b;
-            ke[r * nd + c] += w * kxx;
-            ke[r * nd + c + 1] += w * kxy;
-            ke[(r + 1) * nd + c] += w * kyx;
-            ke[(r + 1) * nd + c + 1] += w * kyy;
-        }
-    }
-}
-
 /// Continuum element stiffness `∫ Bᵀ D B t dA` (plane, `t` the thickness) or
 /// `∫ Bᵀ D B dV` (solid, `t = 1`) into `ke` (zeroed here).
-pub fn continuum_stiffness<D: Voigt>(
+pub fn continuum_stiffness<const D: usize, const V: usize, K: Kinematics<D, V>>(
     kind: ElementKind,
     x: &[[f64; 3]],
-    d: &D,
+    d: &[[f64; V]; V],
     thickness: f64,
     ke: &mut [f64],
 ) {
     let nn = kind.nodes();
-    let nd = kind.dim() * nn;
+    let nd = D * nn;
     ke[..nd * nd].fill(0.0);
     for &(xi, w) in stiffness_rule(kind) {
         let k = kinematics(kind, x, xi);
-        d.add_btdb(&k, nn, w * k.det_j * thickness, ke);
+        K::add_btdb(&k, nn, d, w * k.det_j * thickness, ke);
     }
 }
 

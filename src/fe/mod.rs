@@ -10,6 +10,13 @@
 //! `theory/solids.md`.
 
 pub mod element;
+pub mod frame;
+pub mod kinematics;
+pub mod principal;
+
+pub use kinematics::{
+    FrameUser, Idealisation, Kinematics, PlaneStrain, PlaneStress, Solid, StrainSpace,
+};
 
 /// The element types rothe knows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -134,30 +141,6 @@ const HEX_CORNERS: [[f64; 3]; 8] = [
     [1.0, 1.0, 1.0],
     [-1.0, 1.0, 1.0],
 ];
-
-/// In-plane idealisation of the third direction.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum Plane {
-    /// `σ_zz = 0`: thin walls (the paper's "shell" elements); a thickness multiplies.
-    #[default]
-    Stress,
-    /// `ε_zz = 0`: long bodies; the thickness is the length represented.
-    Strain,
-    /// No idealisation: a three-dimensional solid (six strain components).
-    Solid,
-}
-
-impl Plane {
-    /// The number of Voigt components of strain and stress: 3 in the plane, 6 in
-    /// a solid.
-    pub fn voigt(self) -> usize {
-        match self {
-            Plane::Stress | Plane::Strain => 3,
-            Plane::Solid => 6,
-        }
-    }
-}
 
 /// A quadrature point: reference coordinates (plane kinds keep the third zero) and
 /// weight.
@@ -480,75 +463,14 @@ pub fn jacobian_range(kind: ElementKind, x: &[[f64; 3]]) -> (f64, f64) {
         })
 }
 
-/// Isotropic linear elasticity matrix (Voigt, engineering shear) for `plane`.
-pub fn elasticity(e: f64, nu: f64, plane: Plane) -> [[f64; 3]; 3] {
-    match plane {
-        Plane::Stress => {
-            let c = e / (1.0 - nu * nu);
-            [
-                [c, c * nu, 0.0],
-                [c * nu, c, 0.0],
-                [0.0, 0.0, c * 0.5 * (1.0 - nu)],
-            ]
-        }
-        Plane::Strain => {
-            let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
-            [
-                [c * (1.0 - nu), c * nu, 0.0],
-                [c * nu, c * (1.0 - nu), 0.0],
-                [0.0, 0.0, c * 0.5 * (1.0 - 2.0 * nu)],
-            ]
-        }
-        Plane::Solid => panic!("a solid's elasticity has six components: `elasticity_solid`"),
-    }
-}
-
-/// Isotropic linear elasticity of a solid (Voigt order of the module, engineering
-/// shears): `λ` on the normal block, `λ + 2μ` on its diagonal, `μ` on the shears.
-pub fn elasticity_solid(e: f64, nu: f64) -> [[f64; 6]; 6] {
-    let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-    let mu = 0.5 * e / (1.0 + nu);
-    let mut c = [[0.0; 6]; 6];
-    for i in [0, 1, 3] {
-        for j in [0, 1, 3] {
-            c[i][j] = lambda;
-        }
-        c[i][i] = lambda + 2.0 * mu;
-    }
-    for i in [2, 4, 5] {
-        c[i][i] = mu;
-    }
-    c
-}
-
-/// Strain `[ε_xx, ε_yy, γ_xy, ε_zz, γ_yz, γ_zx]` at a point of a solid from the
-/// element displacements `ue` (three per node).
+/// The signed area of the polygon `x` (positive when its vertices run
+/// counter-clockwise).
 #[inline]
-pub fn strain_solid(k: &PointKinematics, nn: usize, ue: &[f64]) -> [f64; 6] {
-    let mut eps = [0.0; 6];
-    for a in 0..nn {
-        let [dx, dy, dz] = k.dndx[a];
-        let (ux, uy, uz) = (ue[3 * a], ue[3 * a + 1], ue[3 * a + 2]);
-        eps[0] += dx * ux;
-        eps[1] += dy * uy;
-        eps[2] += dy * ux + dx * uy;
-        eps[3] += dz * uz;
-        eps[4] += dz * uy + dy * uz;
-        eps[5] += dx * uz + dz * ux;
-    }
-    eps
-}
-
-/// Strain `[ε_xx, ε_yy, γ_xy]` at a point from the element displacements `ue`.
-#[inline]
-pub fn strain(k: &PointKinematics, nn: usize, ue: &[f64]) -> [f64; 3] {
-    let mut eps = [0.0; 3];
-    for a in 0..nn {
-        let (dx, dy) = (k.dndx[a][0], k.dndx[a][1]);
-        let (ux, uy) = (ue[2 * a], ue[2 * a + 1]);
-        eps[0] += dx * ux;
-        eps[1] += dy * uy;
-        eps[2] += dy * ux + dx * uy;
-    }
-    eps
+pub fn polygon_area(x: &[[f64; 3]]) -> f64 {
+    0.5 * (0..x.len())
+        .map(|a| {
+            let b = (a + 1) % x.len();
+            x[a][0] * x[b][1] - x[b][0] * x[a][1]
+        })
+        .sum::<f64>()
 }

@@ -24,7 +24,7 @@
 //! (`theory/damage.md`).
 
 use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
-use crate::fe::Plane;
+use crate::fe::StrainSpace;
 
 /// Which Mazars law (`variant = "paper" | "classic"` in a scenario).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize)]
@@ -131,53 +131,16 @@ pub fn damage_law(kappa: f64, kappa0: f64, a: f64, b: f64) -> f64 {
     }
 }
 
-/// Three principal strains: in a solid (`V = 6`) the eigenvalues of the strain
-/// tensor; in the plane (`V = 3`) the two in-plane ones and the out-of-plane one.
-fn principal3<const V: usize>(eps: &[f64; V], nu: f64, plane: Plane) -> [f64; 3] {
-    if V == 6 {
-        return super::principal::principal_voigt6(eps, 0.5);
-    }
-    let (e1, e2) = super::principal::principal_values(eps[0], eps[1], 0.5 * eps[2]);
-    let ezz = match plane {
-        Plane::Stress => -nu / (1.0 - nu) * (eps[0] + eps[1]),
-        Plane::Strain => 0.0,
-        Plane::Solid => unreachable!("a solid's Voigt vector has six components"),
-    };
-    [e1, e2, ezz]
-}
-
-/// Three principal effective stresses `C ε` (in the plane the third is the
-/// out-of-plane one).
-fn principal_stress3<const V: usize>(
-    c: &[[f64; V]; V],
-    eps: &[f64; V],
-    nu: f64,
-    plane: Plane,
-) -> [f64; 3] {
-    let s = mul3(c, eps);
-    if V == 6 {
-        return super::principal::principal_voigt6(&s, 1.0);
-    }
-    let (s1, s2) = super::principal::principal_values(s[0], s[1], s[2]);
-    let szz = match plane {
-        Plane::Stress => 0.0,
-        Plane::Strain => nu * (s[0] + s[1]),
-        Plane::Solid => unreachable!("a solid's Voigt vector has six components"),
-    };
-    [s1, s2, szz]
-}
-
 /// The equivalent strains that drive the damage at strain `eps`, the quantities a
 /// nonlocal material averages: `[ε_t, ε_c]` of eq. (11) (paper) or `[ε̃, 0]`,
 /// `ε̃ = √Σ⟨ε_i⟩₊²` (classic).
 #[inline]
-pub fn drivers<const V: usize>(
+pub fn drivers<const V: usize, K: StrainSpace<V>>(
     p: &MazarsParams,
     nu: f64,
-    plane: Plane,
     eps: &[f64; V],
 ) -> [f64; 2] {
-    drivers_of(p, nu, &principal3(eps, nu, plane))
+    drivers_of(p, nu, &K::principal_strains(eps, nu))
 }
 
 /// [`drivers`] from the three principal strains `e`.
@@ -206,11 +169,10 @@ fn drivers_of(p: &MazarsParams, nu: f64, e: &[f64; 3]) -> [f64; 2] {
 /// by the triaxiality `r` (paper) and the weights `α_t, α_c` (classic) are the
 /// point's own.
 #[allow(clippy::too_many_arguments)]
-fn damage<const V: usize>(
+fn damage<const V: usize, K: StrainSpace<V>>(
     p: &MazarsParams,
     c: &[[f64; V]; V],
     nu: f64,
-    plane: Plane,
     eps: &[f64; V],
     e: &[f64; 3],
     drv: [f64; 2],
@@ -222,7 +184,7 @@ fn damage<const V: usize>(
         MazarsVariant::Paper => {
             let kt = k1.max(drv[0]).max(p.eps_t0);
             let kc = k2.max(drv[1]).max(p.eps_c0);
-            let s = principal_stress3(c, eps, nu, plane);
+            let s = K::principal_stresses(&mul3(c, eps), nu);
             let den: f64 = s.iter().map(|x| x.abs()).sum();
             let r = if den > 0.0 {
                 s.iter().map(|x| x.max(0.0)).sum::<f64>() / den
@@ -241,8 +203,8 @@ fn damage<const V: usize>(
             let dt = damage_law(kappa, p.eps_t0, a_t, b_t);
             let dc = damage_law(kappa, p.eps_t0, p.a_c, p.b_c);
             // Weights from the strains of the positive / negative effective stresses.
-            let s = principal_stress3(c, eps, nu, plane);
-            let ee = e_modulus(c, nu, plane);
+            let s = K::principal_stresses(&mul3(c, eps), nu);
+            let ee = K::young(c, nu);
             let (sp, sn): (f64, f64) = (
                 s.iter().map(|x| x.max(0.0)).sum(),
                 s.iter().map(|x| x.min(0.0)).sum(),
@@ -264,31 +226,21 @@ fn damage<const V: usize>(
     }
 }
 
-/// Young's modulus back from `C` (for the classic split and the crack band): a
-/// solid's `C_xx = λ + 2μ` is the plane strain one.
-pub fn e_modulus<const V: usize>(c: &[[f64; V]; V], nu: f64, plane: Plane) -> f64 {
-    match plane {
-        Plane::Stress => c[0][0] * (1.0 - nu * nu),
-        Plane::Strain | Plane::Solid => c[0][0] * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu),
-    }
-}
-
 /// Mazars update. State: `[k1, k2, D]` (paper: `ε_t*, ε_c*`; classic: `κ, 0`).
 /// `averaged` holds the nonlocal average of the [`drivers`] at this point (`None`:
 /// the point's own).
 #[allow(clippy::too_many_arguments)]
-pub fn update<const V: usize>(
+pub fn update<const V: usize, K: StrainSpace<V>>(
     p: &MazarsParams,
     c: &[[f64; V]; V],
     nu: f64,
-    plane: Plane,
     step: &StrainStep<V>,
     averaged: Option<[f64; 2]>,
     state_n: &[f64],
     state: &mut [f64],
 ) -> PointResponse<V> {
     let (k1n, k2n, dn) = (state_n[0], state_n[1], state_n[2]);
-    let e = principal3(&step.eps, nu, plane);
+    let e = K::principal_strains(&step.eps, nu);
     let drv = averaged.unwrap_or_else(|| drivers_of(p, nu, &e));
     // Below both thresholds, now and before: the damage law gives 0 (its argument
     // is its threshold), so the point keeps its damage without the principal
@@ -304,8 +256,8 @@ pub fn update<const V: usize>(
         state[2] = d;
         return secant_response(c, step, dn, d);
     }
-    let law = p.tension_law(e_modulus(c, nu, plane), step.length);
-    let (dcand, k1, k2) = damage(p, c, nu, plane, &step.eps, &e, drv, law, k1n, k2n);
+    let law = p.tension_law(K::young(c, nu), step.length);
+    let (dcand, k1, k2) = damage::<V, K>(p, c, nu, &step.eps, &e, drv, law, k1n, k2n);
     let d = dcand.max(dn).clamp(0.0, p.d_max);
     state[0] = k1;
     state[1] = k2;

@@ -6,16 +6,15 @@
 //! ([`PointResponse`]), and writes the trial state. The caller commits trial states
 //! only when a step is accepted ([`store::StateStore`]), so iterations and step
 //! cuts leave no trace. Every model shares the isotropic elasticity `C(E, ν)` of
-//! the plane idealisation chosen for the run.
+//! the idealisation chosen for the run: each function is generic over its
+//! [`StrainSpace`] `K` (plane stress, plane strain or solid, `V` Voigt components).
 
 pub mod elastic;
-pub mod frame;
 pub mod hardening;
 pub mod identify;
 pub mod linalg;
 pub mod mazars;
 pub mod point_driver;
-pub mod principal;
 pub mod rankine_hill;
 pub mod store;
 pub mod viscoelastic;
@@ -24,7 +23,7 @@ pub use hardening::Hardening;
 pub use mazars::{MazarsParams, MazarsVariant, Regularisation};
 pub use rankine_hill::RankineHillParams;
 
-use crate::fe::{elasticity, Plane};
+use crate::fe::StrainSpace;
 
 /// Dissipation increments of one step at one point, per unit volume (the `contact`
 /// and `mass` lines stay zero at a material point).
@@ -45,7 +44,7 @@ pub enum PointStatus {
 /// What one material update returns: `V = 3` Voigt components in the plane, 6 in a
 /// solid (the order of `fe`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PointResponse<const V: usize = 3> {
+pub struct PointResponse<const V: usize> {
     /// Stress `[σ_xx, σ_yy, σ_xy(, σ_zz, σ_yz, σ_zx)]` at the new step.
     pub sigma: [f64; V],
     /// Consistent tangent `∂σ_{n+1}/∂ε_{n+1}`.
@@ -72,7 +71,7 @@ impl<const V: usize> Default for PointResponse<V> {
 
 /// The strain step a material point is asked to take (`V` Voigt components).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StrainStep<const V: usize = 3> {
+pub struct StrainStep<const V: usize> {
     /// Strain at the last committed step.
     pub eps_n: [f64; V],
     /// Strain at the new step.
@@ -244,33 +243,16 @@ impl Material {
         }
     }
 
-    /// Elasticity matrix `C` in the plane idealisation `plane`.
-    pub fn c(&self, plane: Plane) -> [[f64; 3]; 3] {
-        elasticity(self.e, self.nu, plane)
-    }
-
-    /// Elasticity matrix `C` of a solid (six Voigt components, order of `fe`).
-    pub fn c_solid(&self) -> [[f64; 6]; 6] {
-        crate::fe::elasticity_solid(self.e, self.nu)
-    }
-
-    /// Elasticity matrix with `V` Voigt components: the plane's `C` for `V = 3`, the
-    /// solid's for `V = 6`.
-    pub fn c_voigt<const V: usize>(&self, plane: Plane) -> [[f64; V]; V] {
-        if V == 6 {
-            let c = self.c_solid();
-            std::array::from_fn(|i| std::array::from_fn(|j| c[i][j]))
-        } else {
-            let c = self.c(plane);
-            std::array::from_fn(|i| std::array::from_fn(|j| c[i][j]))
-        }
+    /// Elasticity matrix `C` of the idealisation `K`.
+    pub fn elasticity<const V: usize, K: StrainSpace<V>>(&self) -> [[f64; V]; V] {
+        K::elasticity(self.e, self.nu)
     }
 
     /// The stiffness the material shows to a sudden strain (what an explicit step
     /// sees): `C`, and `(1 + α) C` for the standard linear solid (`α C` without the
     /// parallel spring), whose Maxwell branch answers at once.
-    pub fn instantaneous_stiffness<const V: usize>(&self, plane: Plane) -> [[f64; V]; V] {
-        let c = self.c_voigt::<V>(plane);
+    pub fn instantaneous_stiffness<const V: usize, K: StrainSpace<V>>(&self) -> [[f64; V]; V] {
+        let c = self.elasticity::<V, K>();
         match self.model {
             Model::Sls {
                 alpha, parallel, ..
@@ -284,15 +266,10 @@ impl Material {
 
     /// The viscosity `η` of a Kelvin-Voigt material (`σ_v = η ε̇`, Voigt form on
     /// engineering strain), `None` for the others.
-    pub fn viscosity(&self, plane: Plane) -> Option<[[f64; 3]; 3]> {
-        self.viscosity_voigt(plane)
-    }
-
-    /// [`Material::viscosity`] with `V` Voigt components (a solid's for `V = 6`).
-    pub fn viscosity_voigt<const V: usize>(&self, plane: Plane) -> Option<[[f64; V]; V]> {
+    pub fn viscosity<const V: usize, K: StrainSpace<V>>(&self) -> Option<[[f64; V]; V]> {
         match self.model {
             Model::KelvinVoigt(Viscosity::Proportional(alpha)) => {
-                Some(self.c_voigt::<V>(plane).map(|row| row.map(|x| alpha * x)))
+                Some(self.elasticity::<V, K>().map(|row| row.map(|x| alpha * x)))
             }
             Model::KelvinVoigt(Viscosity::Identity(beta)) => {
                 Some(viscoelastic::identity_viscosity(beta))
@@ -318,14 +295,9 @@ impl Material {
         )
     }
 
-    /// Number of history values stored per Gauss point (at most [`MAX_STATE`]).
-    pub fn n_state(&self) -> usize {
-        self.n_state_for(3)
-    }
-
-    /// Number of history values per point with `voigt` strain components (a
-    /// standard linear solid keeps one dashpot strain per component).
-    pub fn n_state_for(&self, voigt: usize) -> usize {
+    /// Number of history values per point with `voigt` strain components (at most
+    /// [`MAX_STATE`]; a standard linear solid keeps one dashpot strain per component).
+    pub fn n_state(&self, voigt: usize) -> usize {
         match self.model {
             Model::Elastic | Model::KelvinVoigt(_) => 0,
             Model::Sls { .. } => voigt,
@@ -339,12 +311,11 @@ impl Material {
 
     /// Names of the history values of a point with `voigt` strain components
     /// (columns of `rothe material` output).
-    pub fn state_names_for(&self, voigt: usize) -> &'static [&'static str] {
-        if voigt == 3 {
-            return self.state_names();
-        }
-        match self.model {
-            Model::Sls { .. } => &[
+    pub fn state_names(&self, voigt: usize) -> &'static [&'static str] {
+        match (&self.model, voigt) {
+            (Model::Elastic | Model::KelvinVoigt(_), _) => &[],
+            (Model::Sls { .. }, 3) => &["eps_d_xx", "eps_d_yy", "gamma_d_xy"],
+            (Model::Sls { .. }, _) => &[
                 "eps_d_xx",
                 "eps_d_yy",
                 "gamma_d_xy",
@@ -352,7 +323,23 @@ impl Material {
                 "gamma_d_yz",
                 "gamma_d_zx",
             ],
-            Model::RankineHill(_) => &[
+            (
+                Model::Mazars(MazarsParams {
+                    variant: MazarsVariant::Paper,
+                    ..
+                }),
+                _,
+            ) => &["eps_t_max", "eps_c_max", "damage"],
+            (Model::Mazars(_), _) => &["kappa", "unused", "damage"],
+            (Model::RankineHill(_), 3) => &[
+                "eps_p_xx",
+                "eps_p_yy",
+                "gamma_p_xy",
+                "kappa_t",
+                "kappa_c",
+                "eps_p_zz",
+            ],
+            (Model::RankineHill(_), _) => &[
                 "eps_p_xx",
                 "eps_p_yy",
                 "gamma_p_xy",
@@ -361,29 +348,6 @@ impl Material {
                 "gamma_p_zx",
                 "kappa_t",
                 "kappa_c",
-            ],
-            _ => self.state_names(),
-        }
-    }
-
-    /// Names of the history values of a plane point (columns of `rothe material`
-    /// output).
-    pub fn state_names(&self) -> &'static [&'static str] {
-        match self.model {
-            Model::Elastic | Model::KelvinVoigt(_) => &[],
-            Model::Sls { .. } => &["eps_d_xx", "eps_d_yy", "gamma_d_xy"],
-            Model::Mazars(MazarsParams {
-                variant: MazarsVariant::Paper,
-                ..
-            }) => &["eps_t_max", "eps_c_max", "damage"],
-            Model::Mazars(_) => &["kappa", "unused", "damage"],
-            Model::RankineHill(_) => &[
-                "eps_p_xx",
-                "eps_p_yy",
-                "gamma_p_xy",
-                "kappa_t",
-                "kappa_c",
-                "eps_p_zz",
             ],
         }
     }
@@ -416,22 +380,21 @@ impl Material {
     /// `state` (the trial state of the step just taken): what `update` would return
     /// with `eps_n = eps`, computed without the energy terms. For constant-tangent
     /// models the next step's stress is this plus `tangent · Δε`.
-    pub fn predicted_stress<const V: usize>(
+    pub fn predicted_stress<const V: usize, K: StrainSpace<V>>(
         &self,
-        plane: Plane,
         eps: &[f64; V],
         state: &[f64],
         dt: f64,
     ) -> [f64; V] {
-        self.predicted_stress_with(&self.c_voigt(plane), plane, eps, state, dt)
+        self.predicted_stress_with::<V, K>(&self.elasticity::<V, K>(), eps, state, dt)
     }
 
-    /// [`Material::predicted_stress`] with the elasticity matrix `c = self.c(plane)`
-    /// computed by the caller (once per element block in the Gauss-point loop).
-    pub fn predicted_stress_with<const V: usize>(
+    /// [`Material::predicted_stress`] with the elasticity matrix
+    /// `c = self.elasticity::<V, K>()` computed by the caller (once per element block
+    /// in the Gauss-point loop).
+    pub fn predicted_stress_with<const V: usize, K: StrainSpace<V>>(
         &self,
         c: &[[f64; V]; V],
-        plane: Plane,
         eps: &[f64; V],
         state: &[f64],
         dt: f64,
@@ -448,9 +411,8 @@ impl Material {
             }
             Model::Elastic | Model::KelvinVoigt(_) | Model::RankineHill(_) => {
                 let mut st = [0.0; MAX_STATE];
-                self.update_with(
+                self.update_with::<V, K>(
                     c,
-                    plane,
                     &StrainStep {
                         eps_n: *eps,
                         eps: *eps,
@@ -458,7 +420,7 @@ impl Material {
                         length: 1.0,
                     },
                     state,
-                    &mut st[..self.n_state_for(V)],
+                    &mut st[..self.n_state(V)],
                 )
                 .sigma
             }
@@ -477,44 +439,41 @@ impl Material {
         }
     }
 
-    /// The material update (see the module docs).
-    pub fn update<const V: usize>(
+    /// The material update (see the module docs) in the idealisation `K`.
+    pub fn update<const V: usize, K: StrainSpace<V>>(
         &self,
-        plane: Plane,
         step: &StrainStep<V>,
         state_n: &[f64],
         state: &mut [f64],
     ) -> PointResponse<V> {
-        self.update_with(&self.c_voigt(plane), plane, step, state_n, state)
+        self.update_with::<V, K>(&self.elasticity::<V, K>(), step, state_n, state)
     }
 
-    /// [`Material::update`] with the elasticity matrix `c = self.c(plane)` computed by
-    /// the caller (once per element block in the Gauss-point loop).
-    pub fn update_with<const V: usize>(
+    /// [`Material::update`] with the elasticity matrix `c = self.elasticity::<V, K>()`
+    /// computed by the caller (once per element block in the Gauss-point loop).
+    pub fn update_with<const V: usize, K: StrainSpace<V>>(
         &self,
         c: &[[f64; V]; V],
-        plane: Plane,
         step: &StrainStep<V>,
         state_n: &[f64],
         state: &mut [f64],
     ) -> PointResponse<V> {
-        self.update_driven(c, plane, step, None, state_n, state)
+        self.update_driven::<V, K>(c, step, None, state_n, state)
     }
 
     /// [`Material::update_with`] with every history frozen at its committed value
     /// where the model has such a form (Mazars: `D = D⁰`, the secant of the last
     /// step, the paper's first estimate); the ordinary update for the others.
-    pub fn update_frozen<const V: usize>(
+    pub fn update_frozen<const V: usize, K: StrainSpace<V>>(
         &self,
         c: &[[f64; V]; V],
-        plane: Plane,
         step: &StrainStep<V>,
         state_n: &[f64],
         state: &mut [f64],
     ) -> PointResponse<V> {
         match self.model {
             Model::Mazars(_) => mazars::frozen(c, step, state_n, state),
-            _ => self.update_with(c, plane, step, state_n, state),
+            _ => self.update_with::<V, K>(c, step, state_n, state),
         }
     }
 
@@ -527,12 +486,9 @@ impl Material {
     /// [`Material::update_with`] where the damage of a nonlocal material is driven by
     /// `averaged`, the nonlocal average of its equivalent strains at this point
     /// ([`mazars::drivers`]); `None` (and every other model) takes the point's own.
-    /// `V = 3` in the plane, `6` in a solid; Rankine-Hill is the plane's (validation
-    /// keeps it there).
-    pub fn update_driven<const V: usize>(
+    pub fn update_driven<const V: usize, K: StrainSpace<V>>(
         &self,
         c: &[[f64; V]; V],
-        plane: Plane,
         step: &StrainStep<V>,
         averaged: Option<[f64; 2]>,
         state_n: &[f64],
@@ -562,105 +518,13 @@ impl Material {
                 state,
             ),
             Model::Mazars(p) => {
-                mazars::update(&p, &c, self.nu, plane, step, averaged, state_n, state)
+                mazars::update::<V, K>(&p, &c, self.nu, step, averaged, state_n, state)
             }
             Model::RankineHill(p) => {
-                if V == 3 && plane == Plane::Strain {
-                    self.rankine_hill_plane_strain(&p, step, state_n, state)
-                } else if V == 3 {
-                    rankine_hill_as::<V, 3, 2, frame::PlaneFrame>(
-                        &p, &c, self.e, self.nu, step, state_n, state,
-                    )
-                } else {
-                    rankine_hill_as::<V, 6, 3, frame::SolidFrame>(
-                        &p, &c, self.e, self.nu, step, state_n, state,
-                    )
-                }
+                rankine_hill::update_in::<V, K>(&p, &c, self.e, self.nu, step, state_n, state)
             }
         }
     }
-}
-
-impl Material {
-    /// Rankine-Hill in plane strain: the solid's return with `ε_zz = γ_yz = γ_zx = 0`
-    /// (the out-of-plane axis stays principal, so the plastic strain keeps no
-    /// out-of-plane shear). The plane state `[εᵖ_xx, εᵖ_yy, γᵖ_xy, κ_t, κ_c, εᵖ_zz]`
-    /// is the solid's `[εᵖ (6), κ_t, κ_c]` rearranged; the stress and tangent are the
-    /// in-plane rows and columns (`σ_zz` is carried by the state, not output).
-    fn rankine_hill_plane_strain<const V: usize>(
-        &self,
-        p: &RankineHillParams,
-        step: &StrainStep<V>,
-        state_n: &[f64],
-        state: &mut [f64],
-    ) -> PointResponse<V> {
-        let widen = |e: &[f64; V]| [e[0], e[1], e[2], 0.0, 0.0, 0.0];
-        let solid_step = StrainStep {
-            eps_n: widen(&step.eps_n),
-            eps: widen(&step.eps),
-            dt: step.dt,
-            length: step.length,
-        };
-        let s = state_n;
-        let solid_n = [s[0], s[1], s[2], s[5], 0.0, 0.0, s[3], s[4]];
-        let mut solid = [0.0; 8];
-        let r = rankine_hill::update::<6, 3, frame::SolidFrame>(
-            p,
-            &self.c_solid(),
-            self.e,
-            self.nu,
-            &solid_step,
-            &solid_n,
-            &mut solid,
-        );
-        for (k, &i) in [0, 1, 2, 6, 7, 3].iter().enumerate() {
-            state[k] = solid[i];
-        }
-        PointResponse {
-            sigma: std::array::from_fn(|i| r.sigma[i]),
-            tangent: std::array::from_fn(|i| std::array::from_fn(|j| r.tangent[i][j])),
-            psi: r.psi,
-            dissipation: r.dissipation,
-            status: r.status,
-        }
-    }
-}
-
-/// The Rankine-Hill update of a `V`-component point through the return written for
-/// the frame `F` of `W == V` components (the const dispatch copies between the
-/// equal sizes).
-fn rankine_hill_as<const V: usize, const W: usize, const P: usize, F: frame::Frame<W, P>>(
-    p: &RankineHillParams,
-    c: &[[f64; V]; V],
-    e: f64,
-    nu: f64,
-    step: &StrainStep<V>,
-    state_n: &[f64],
-    state: &mut [f64],
-) -> PointResponse<V> {
-    let cw: [[f64; W]; W] = cast(&c.map(|row| cast(&row)));
-    let sw = StrainStep {
-        eps_n: cast(&step.eps_n),
-        eps: cast(&step.eps),
-        dt: step.dt,
-        length: step.length,
-    };
-    let r = rankine_hill::update::<W, P, F>(p, &cw, e, nu, &sw, state_n, state);
-    PointResponse {
-        sigma: cast(&r.sigma),
-        tangent: cast(&r.tangent.map(|row| cast(&row))),
-        psi: r.psi,
-        dissipation: r.dissipation,
-        status: r.status,
-    }
-}
-
-/// `x` as an array of `B` entries where `A == B` (the const dispatch of a model
-/// written for one Voigt size; a size mismatch is a programming error).
-#[inline]
-fn cast<T: Copy, const A: usize, const B: usize>(x: &[T; A]) -> [T; B] {
-    assert_eq!(A, B, "Voigt sizes agree");
-    std::array::from_fn(|i| x[i])
 }
 
 /// `x` to four significant digits, in plain notation between 10⁻³ and 10⁵.

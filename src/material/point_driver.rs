@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use crate::config::MaterialSpec;
 use crate::error::{Error, Result};
-use crate::fe::Plane;
+use crate::fe::{Idealisation, PlaneStrain, PlaneStress, Solid, StrainSpace};
 use crate::material::linalg::{solve_in_place, MAX_DIM};
 use crate::material::{Material, PointResponse, StrainStep};
 use crate::model::TimeFunction;
@@ -72,7 +72,7 @@ pub struct PathSpec {
     pub kind: PathKind,
     /// Plane stress (default), plane strain, or a solid's point (six components).
     #[serde(default)]
-    pub plane: Plane,
+    pub plane: Idealisation,
     /// Strain or stress control of the loaded components.
     #[serde(default)]
     pub control: Control,
@@ -239,17 +239,42 @@ const MAX_POINT_STEPS: f64 = 1e8;
 
 /// Runs a plane path and returns one record per step (the first at `t = 0`).
 pub fn run_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord>> {
-    collect_path::<3>(mat, p)
+    match p.plane {
+        Idealisation::PlaneStress => collect_path::<3, PlaneStress>(mat, p),
+        Idealisation::PlaneStrain => collect_path::<3, PlaneStrain>(mat, p),
+        Idealisation::Solid => Err(wrong_size(p, 3)),
+    }
 }
 
 /// Runs a solid point's path (`plane = "solid"`) and returns one record per step.
 pub fn run_solid_path(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord<6>>> {
-    collect_path::<6>(mat, p)
+    match p.plane {
+        Idealisation::Solid => collect_path::<6, Solid>(mat, p),
+        _ => Err(wrong_size(p, 6)),
+    }
 }
 
-fn collect_path<const V: usize>(mat: &Material, p: &PathSpec) -> Result<Vec<PointRecord<V>>> {
+/// The error of a path driven with `v` strain components that its `plane` does not
+/// have (after the checks of the path itself, which come first).
+fn wrong_size(p: &PathSpec, v: usize) -> Error {
+    if let Err(e) = check(p) {
+        return e;
+    }
+    Error::config(
+        "path.plane",
+        format!(
+            "a point of {} strain components driven as one of {v}",
+            p.plane.voigt()
+        ),
+    )
+}
+
+fn collect_path<const V: usize, K: StrainSpace<V>>(
+    mat: &Material,
+    p: &PathSpec,
+) -> Result<Vec<PointRecord<V>>> {
     let mut out = Vec::new();
-    drive::<V, _>(mat, p, |r| {
+    drive::<V, K, _>(mat, p, |r| {
         out.push(r.clone());
         Ok(())
     })?;
@@ -262,26 +287,25 @@ pub fn run_path_with<F>(mat: &Material, p: &PathSpec, sink: F) -> Result<usize>
 where
     F: FnMut(&PointRecord) -> Result<()>,
 {
-    drive::<3, F>(mat, p, sink)
+    match p.plane {
+        Idealisation::PlaneStress => drive::<3, PlaneStress, F>(mat, p, sink),
+        Idealisation::PlaneStrain => drive::<3, PlaneStrain, F>(mat, p, sink),
+        Idealisation::Solid => Err(wrong_size(p, 3)),
+    }
 }
 
-/// The path of a point with `V` strain components (the path's `plane` must say as
-/// many).
-fn drive<const V: usize, F>(mat: &Material, p: &PathSpec, mut sink: F) -> Result<usize>
+/// The path of a point of the idealisation `K` (`V` strain components; the
+/// callers pick `K` from the path's `plane`).
+fn drive<const V: usize, K: StrainSpace<V>, F>(
+    mat: &Material,
+    p: &PathSpec,
+    mut sink: F,
+) -> Result<usize>
 where
     F: FnMut(&PointRecord<V>) -> Result<()>,
 {
     check(p)?;
-    if p.plane.voigt() != V {
-        return Err(Error::config(
-            "path.plane",
-            format!(
-                "a point of {} strain components driven as one of {V}",
-                p.plane.voigt()
-            ),
-        ));
-    }
-    let ns = mat.n_state_for(V);
+    let ns = mat.n_state(V);
     let mut state_n = vec![0.0; ns];
     mat.init_state(&mut state_n);
     let mut state = state_n.clone();
@@ -316,8 +340,7 @@ where
         let mut resp;
         let mut it = 0;
         loop {
-            resp = mat.update(
-                p.plane,
+            resp = mat.update::<V, K>(
                 &StrainStep {
                     eps_n,
                     eps,
@@ -424,15 +447,15 @@ pub fn run_file(file: &Path, out: &Path, announce: impl FnOnce(&Material)) -> Re
     check(&spec.path).map_err(|e| Error::config(file.display().to_string(), e.to_string()))?;
     announce(&mat);
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    if spec.path.plane.voigt() == 6 {
-        write_csv::<6>(&mat, &spec.path, out)
-    } else {
-        write_csv::<3>(&mat, &spec.path, out)
-    }
+    crate::dispatch_kinematics!(spec.path.plane, <D, V, K> => write_csv::<V, K>(&mat, &spec.path, out))
 }
 
 /// Runs the path of a point with `V` strain components and writes `material.csv`.
-fn write_csv<const V: usize>(mat: &Material, p: &PathSpec, out: &Path) -> Result<usize> {
+fn write_csv<const V: usize, K: StrainSpace<V>>(
+    mat: &Material,
+    p: &PathSpec,
+    out: &Path,
+) -> Result<usize> {
     let path = out.join("material.csv");
     let mut w =
         std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| Error::io(&path, e))?);
@@ -453,12 +476,12 @@ fn write_csv<const V: usize>(mat: &Material, p: &PathSpec, out: &Path) -> Result
     header.extend(strains);
     header.extend(stresses);
     header.push("psi");
-    header.extend(mat.state_names_for(V));
+    header.extend(mat.state_names(V));
     header.extend(["D_viscous", "D_damage", "D_plastic", "D_num", "work"]);
     let io = |e| Error::io(&path, e);
     writeln!(w, "{}", header.join(",")).map_err(io)?;
     let mut line = String::new();
-    let steps = drive::<V, _>(mat, p, |r| {
+    let steps = drive::<V, K, _>(mat, p, |r| {
         line.clear();
         let values = std::iter::once(r.t)
             .chain(r.eps)

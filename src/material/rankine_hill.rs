@@ -10,14 +10,15 @@
 //! `κ_c = Δλ_VM`. Closest-point projection by Newton on `(σ, Δλ_active)` with an
 //! active-set loop over the faces, the corners (R1+VM, R1+R2, R1+R2+VM, ...) and in
 //! a solid the apex R1+R2+R3; consistent tangent from the local Jacobian plus the
-//! spectral shear terms, rotated out of the frame ([`super::frame`]). Plastic dissipation: the paper's trapezoid
+//! spectral shear terms, rotated out of the frame ([`crate::fe::frame`]). Plastic dissipation: the paper's trapezoid
 //! `½(σⁿ + σⁿ⁺¹):Δεᵖ` evaluated per surface as `½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ`, each stress
 //! paired with its own flow direction. See `theory/plasticity.md`.
 
-use super::frame::Frame;
 use super::hardening::{Hardening, PreparedLaw};
 use super::linalg::{inverse, solve_in_place, Small, MAX_DIM};
 use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep, MAX_STATE};
+use crate::fe::frame::{Frame, SolidFrame};
+use crate::fe::{FrameUser, Idealisation, Solid, StrainSpace};
 
 /// Rankine-Hill parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -365,6 +366,90 @@ impl<const P: usize> Ctx<'_, P> {
 
 /// The most substeps a strain increment is split into when its return fails.
 const MAX_SUBSTEPS: usize = 64;
+
+/// The update of a point of the idealisation `K`: the return in `K`'s principal
+/// frame ([`StrainSpace::with_frame`]); in plane strain, the solid's return with
+/// `ε_zz = γ_yz = γ_zx = 0` (the out-of-plane axis stays principal, so the plastic
+/// strain keeps no out-of-plane shear). The plane-strain state
+/// `[εᵖ_xx, εᵖ_yy, γᵖ_xy, κ_t, κ_c, εᵖ_zz]` is the solid's `[εᵖ (6), κ_t, κ_c]`
+/// rearranged; its stress and tangent are the in-plane rows and columns (`σ_zz` is
+/// carried by the state, not output).
+pub fn update_in<const V: usize, K: StrainSpace<V>>(
+    p: &RankineHillParams,
+    c: &[[f64; V]; V],
+    e: f64,
+    nu: f64,
+    step: &StrainStep<V>,
+    state_n: &[f64],
+    state: &mut [f64],
+) -> PointResponse<V> {
+    if K::IDEALISATION != Idealisation::PlaneStrain {
+        return K::with_frame(FramedReturn {
+            p,
+            c,
+            e,
+            nu,
+            step,
+            state_n,
+            state,
+        });
+    }
+    let widen = |x: &[f64; V]| [x[0], x[1], x[2], 0.0, 0.0, 0.0];
+    let solid_step = StrainStep {
+        eps_n: widen(&step.eps_n),
+        eps: widen(&step.eps),
+        dt: step.dt,
+        length: step.length,
+    };
+    let s = state_n;
+    let solid_n = [s[0], s[1], s[2], s[5], 0.0, 0.0, s[3], s[4]];
+    let mut solid = [0.0; 8];
+    let r = update::<6, 3, SolidFrame>(
+        p,
+        &Solid::elasticity(e, nu),
+        e,
+        nu,
+        &solid_step,
+        &solid_n,
+        &mut solid,
+    );
+    for (k, &i) in [0, 1, 2, 6, 7, 3].iter().enumerate() {
+        state[k] = solid[i];
+    }
+    PointResponse {
+        sigma: std::array::from_fn(|i| r.sigma[i]),
+        tangent: std::array::from_fn(|i| std::array::from_fn(|j| r.tangent[i][j])),
+        psi: r.psi,
+        dissipation: r.dissipation,
+        status: r.status,
+    }
+}
+
+/// The arguments of a return, run in the principal frame its space hands it.
+struct FramedReturn<'a, const V: usize> {
+    p: &'a RankineHillParams,
+    c: &'a [[f64; V]; V],
+    e: f64,
+    nu: f64,
+    step: &'a StrainStep<V>,
+    state_n: &'a [f64],
+    state: &'a mut [f64],
+}
+
+impl<const V: usize> FrameUser<V> for FramedReturn<'_, V> {
+    type Output = PointResponse<V>;
+    fn run<const P: usize, F: Frame<V, P>>(self) -> PointResponse<V> {
+        update::<V, P, F>(
+            self.p,
+            self.c,
+            self.e,
+            self.nu,
+            self.step,
+            self.state_n,
+            self.state,
+        )
+    }
+}
 
 /// Rankine-Hill update in the plane (`V = 3`, `P = 2`, plane stress) or a solid
 /// (`V = 6`, `P = 3`). State: the plastic strain (`V` Voigt components), `κ_t`,

@@ -57,15 +57,9 @@ impl Layout {
 }
 
 impl StateStore {
-    /// Storage for `n_points` plane points with `n_state` history values each, all
-    /// zero.
-    pub fn new(n_points: usize, n_state: usize) -> Self {
-        Self::with_voigt(n_points, n_state, 3)
-    }
-
     /// Storage for `n_points` points of `voigt` strain components with `n_state`
     /// history values each, all zero.
-    pub fn with_voigt(n_points: usize, n_state: usize, voigt: usize) -> Self {
+    pub fn new(n_points: usize, n_state: usize, voigt: usize) -> Self {
         let len = Layout {
             n_points,
             n_state,

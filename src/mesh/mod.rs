@@ -13,7 +13,7 @@ pub mod structured;
 use std::collections::BTreeMap;
 
 use crate::error::{Error, Result};
-pub use crate::fe::ElementKind;
+pub use crate::fe::{polygon_area, ElementKind};
 
 /// Elements of one kind with flattened connectivity (`nodes()` indices per element).
 #[derive(Clone, Debug, PartialEq)]
@@ -75,18 +75,6 @@ pub fn distance(p: Point, q: Point) -> f64 {
 #[inline]
 pub fn xy(p: Point) -> [f64; 2] {
     [p[0], p[1]]
-}
-
-/// The signed area of the polygon `x` (positive when its vertices run
-/// counter-clockwise).
-#[inline]
-pub fn polygon_area(x: &[Point]) -> f64 {
-    0.5 * (0..x.len())
-        .map(|a| {
-            let b = (a + 1) % x.len();
-            x[a][0] * x[b][1] - x[b][0] * x[a][1]
-        })
-        .sum::<f64>()
 }
 
 /// The shape of a continuum element, from the Jacobian of its reference map at its

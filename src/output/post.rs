@@ -9,9 +9,7 @@
 
 use crate::assembly::internal::points_per_element;
 use crate::assembly::{element_coords, element_values};
-use crate::fe::{
-    element, kinematics, stiffness_rule, strain, strain_solid, ElementKind, MAX_NODES,
-};
+use crate::fe::{element, kinematics, stiffness_rule, ElementKind, Kinematics, MAX_NODES};
 use crate::material::mul3;
 use crate::material::store::StateStore;
 use crate::mesh::Mesh;
@@ -63,12 +61,9 @@ fn element_mean<const V: usize>(
 /// from the committed Gauss-point stresses when `points` holds them, else `C ε(u)`.
 pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64; 6]> {
     let mesh = &model.mesh;
-    let dim = mesh.dim;
-    let pad = |s: [f64; 3]| [s[0], s[1], s[2], 0.0, 0.0, 0.0];
     let mut out = Vec::with_capacity(mesh.n_elements());
     for (bi, block) in mesh.blocks.iter().enumerate() {
-        let kind = block.elements.kind;
-        let ng = kind.points();
+        let ng = block.elements.kind.points();
         if let Some(store) = points.get(bi) {
             let c = store.committed();
             for e in 0..block.elements.len() {
@@ -76,35 +71,48 @@ pub fn cell_stress(model: &Model, u: &[f64], points: &[StateStore]) -> Vec<[f64;
             }
             continue;
         }
-        let mat = &model.materials[block.material];
-        let nn = kind.nodes();
-        for e in 0..block.elements.len() {
-            let nodes = block.elements.element(e);
-            let x = element_coords(mesh, nodes);
-            let ue = element_values(u, nodes, dim);
-            if kind == ElementKind::Bar2 {
-                let eps = element::bar_strain(&x[..2], dim, &ue[..2 * dim]);
-                out.push(pad([mat.e * eps, 0.0, 0.0]));
-                continue;
-            }
-            let rule = stiffness_rule(kind);
-            if kind.dim() == 3 {
-                let d = mat.c_solid();
-                out.push(element_mean(mesh, bi, e, ng, |g| {
-                    let k = kinematics(kind, &x[..nn], rule[g - e * ng].0);
-                    let eps = strain_solid(&k, nn, &ue);
-                    std::array::from_fn(|i| (0..6).map(|j| d[i][j] * eps[j]).sum())
-                }));
-                continue;
-            }
-            let d = mat.c(model.plane);
-            out.push(pad(element_mean(mesh, bi, e, ng, |g| {
-                let k = kinematics(kind, &x[..nn], rule[g - e * ng].0);
-                mul3(&d, &strain(&k, nn, &ue))
-            })));
-        }
+        crate::dispatch_kinematics!(model.idealisation, <D, V, K> =>
+            elastic_cell_stress::<D, V, K>(model, u, bi, &mut out));
     }
     out
+}
+
+/// The element-mean `C ε(u)` of block `bi`'s elements in the idealisation `K`
+/// (bars: `E ε` in the first slot), padded to six components, onto `out`.
+fn elastic_cell_stress<const D: usize, const V: usize, K: Kinematics<D, V>>(
+    model: &Model,
+    u: &[f64],
+    bi: usize,
+    out: &mut Vec<[f64; 6]>,
+) {
+    let mesh = &model.mesh;
+    let block = &mesh.blocks[bi];
+    let kind = block.elements.kind;
+    let (ng, nn) = (kind.points(), kind.nodes());
+    let mat = &model.materials[block.material];
+    let pad = |s: [f64; V]| -> [f64; 6] { std::array::from_fn(|i| if i < V { s[i] } else { 0.0 }) };
+    let d = mat.elasticity::<V, K>();
+    for e in 0..block.elements.len() {
+        let nodes = block.elements.element(e);
+        let x = element_coords(mesh, nodes);
+        let ue = element_values(u, nodes, D);
+        if kind == ElementKind::Bar2 {
+            let eps = element::bar_strain(&x[..2], D, &ue[..2 * D]);
+            out.push(pad(std::array::from_fn(|i| {
+                if i == 0 {
+                    mat.e * eps
+                } else {
+                    0.0
+                }
+            })));
+            continue;
+        }
+        let rule = stiffness_rule(kind);
+        out.push(pad(element_mean(mesh, bi, e, ng, |g| {
+            let k = kinematics(kind, &x[..nn], rule[g - e * ng].0);
+            mul3(&d, &K::strain(&k, nn, &ue))
+        })));
+    }
 }
 
 /// Element means of the point fields of materials with history: damage, equivalent

@@ -75,7 +75,7 @@ impl<'m> CentralDifference<'m> {
         let t0 = Instant::now();
         let a = &model.analysis;
         let asm = Assembler::new(&model.mesh);
-        let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+        let k = asm.stiffness(&model.mesh, &model.materials, model.idealisation);
         let mass = asm.mass(&model.mesh, &model.materials, true);
         let m = match &mass {
             Mass::Lumped(d) => d.clone(),
@@ -164,7 +164,7 @@ impl<'m> CentralDifference<'m> {
             Some(self.asm.internal_force(
                 &self.model.mesh,
                 &self.model.materials,
-                self.model.plane,
+                self.model.idealisation,
                 PointPass {
                     u,
                     dt: self.h,

@@ -3,8 +3,7 @@
 //! `c = sqrt(E(1−ν) / (ρ(1+ν)(1−2ν)))` of the paper's formula (ω = 1 here), and
 //! `c = sqrt(E/ρ)` for bars.
 
-use crate::fe::element::Voigt;
-use crate::fe::MAX_ELEMENT_DOFS;
+use crate::fe::{Kinematics, MAX_ELEMENT_DOFS};
 
 /// The size of the largest element matrix.
 const ELEMENT_MATRIX: usize = MAX_ELEMENT_DOFS * MAX_ELEMENT_DOFS;
@@ -89,22 +88,14 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
                 let el = ElementStep {
                     kind: b.elements.kind,
                     x: &x,
-                    dim: mesh.dim,
                     material: m,
                     section: b.section,
                     a_k,
                 };
-                if mesh.dim == 3 {
-                    el.limit(
-                        &m.instantaneous_stiffness::<6>(model.plane),
-                        m.viscosity_voigt::<6>(model.plane),
-                    )
-                } else {
-                    el.limit(
-                        &m.instantaneous_stiffness::<3>(model.plane),
-                        m.viscosity(model.plane),
-                    )
-                }
+                crate::dispatch_kinematics!(model.idealisation, <D, V, K> => el.limit::<D, V, K>(
+                    &m.instantaneous_stiffness::<V, K>(),
+                    m.viscosity::<V, K>(),
+                ))
             });
             if dt.is_finite() && best.is_none_or(|s| dt < s.dt) {
                 {
@@ -124,7 +115,6 @@ pub fn stable_step(model: &Model) -> Option<CriticalStep> {
 struct ElementStep<'a> {
     kind: ElementKind,
     x: &'a [[f64; 3]],
-    dim: usize,
     material: &'a crate::material::Material,
     section: f64,
     /// Rayleigh's stiffness coefficient.
@@ -133,9 +123,13 @@ struct ElementStep<'a> {
 
 impl ElementStep<'_> {
     /// The damped limit `2/ω` of the element with instantaneous stiffness `d` and
-    /// viscosity `eta` (either Voigt size), lumped mass.
-    fn limit<M: Voigt>(&self, d: &M, eta: Option<M>) -> f64 {
-        let (m, x, dim) = (self.material, self.x, self.dim);
+    /// viscosity `eta` in the idealisation `K`, lumped mass.
+    fn limit<const D: usize, const V: usize, K: Kinematics<D, V>>(
+        &self,
+        d: &[[f64; V]; V],
+        eta: Option<[[f64; V]; V]>,
+    ) -> f64 {
+        let (m, x, dim) = (self.material, self.x, D);
         let nd = dim * x.len();
         let mut ke = [0.0; ELEMENT_MATRIX];
         let mut me = [0.0; ELEMENT_MATRIX];
@@ -145,7 +139,13 @@ impl ElementStep<'_> {
                 crate::fe::element::bar_mass(x, dim, m.rho * self.section, &mut me);
             }
             kind => {
-                crate::fe::element::continuum_stiffness(kind, x, d, self.section, &mut ke);
+                crate::fe::element::continuum_stiffness::<D, V, K>(
+                    kind,
+                    x,
+                    d,
+                    self.section,
+                    &mut ke,
+                );
                 crate::fe::element::continuum_mass(kind, x, m.rho * self.section, &mut me);
             }
         }
@@ -173,7 +173,13 @@ impl ElementStep<'_> {
         let mut c_max = self.a_k * omega2;
         if let (Some(eta), true) = (eta, self.kind != ElementKind::Bar2) {
             let mut ce = [0.0; ELEMENT_MATRIX];
-            crate::fe::element::continuum_stiffness(self.kind, x, &eta, self.section, &mut ce);
+            crate::fe::element::continuum_stiffness::<D, V, K>(
+                self.kind,
+                x,
+                &eta,
+                self.section,
+                &mut ce,
+            );
             c_max += scaled(&ce);
         }
         damped_limit(omega, c_max)
@@ -188,7 +194,7 @@ impl ElementStep<'_> {
 /// limit a run at a larger step exceeds. For studies and tests of the estimates.
 pub fn mesh_stable_step(model: &Model, iterations: usize) -> f64 {
     let asm = crate::assembly::Assembler::new(&model.mesh);
-    let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+    let k = asm.stiffness(&model.mesh, &model.materials, model.idealisation);
     let m = asm
         .mass(&model.mesh, &model.materials, true)
         .row_sums(&asm.pattern);

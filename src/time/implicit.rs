@@ -790,7 +790,7 @@ pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, Effec
             ops.asm.tangent(
                 &model.mesh,
                 &model.materials,
-                model.plane,
+                model.idealisation,
                 &u0,
                 ops.h(),
                 &stores,

@@ -20,10 +20,10 @@
 
 use rayon::prelude::*;
 
-use crate::assembly::internal::{new_stores, points_per_element, strain_v};
+use crate::assembly::internal::{new_stores, points_per_element};
 use crate::assembly::{element_coords, element_values, Assembler, Mass, Pattern};
 use crate::energy::Dissipation;
-use crate::fe::{element, kinematics, stiffness_rule, ElementKind};
+use crate::fe::{element, kinematics, stiffness_rule, ElementKind, Kinematics};
 use crate::halves::{add, in_halves, split_slices, Slices, VECTOR_LEAF};
 use crate::material::store::StateStore;
 use crate::material::{mul3, Model as Law, Viscosity};
@@ -164,24 +164,8 @@ impl NodalLaws {
             .enumerate()
             .map(|(g, &(law, material))| {
                 let in_group = |bi: usize| block_group[bi] == g;
-                let plane = model.plane;
-                let solid = model.mesh.dim == 3;
-                let k = (!single).then(|| {
-                    if solid {
-                        group_matrix(model, asm, in_group, |m| m.c_voigt::<6>(plane))
-                    } else {
-                        group_matrix(model, asm, in_group, |m| m.c(plane))
-                    }
-                });
-                let v = match law {
-                    GroupLaw::MatrixVoigt if solid => group_matrix(model, asm, in_group, |m| {
-                        m.viscosity_voigt::<6>(plane).unwrap_or_default()
-                    }),
-                    GroupLaw::MatrixVoigt => group_matrix(model, asm, in_group, |m| {
-                        m.viscosity(plane).unwrap_or_default()
-                    }),
-                    _ => Vec::new(),
-                };
+                let (k, v) = crate::dispatch_kinematics!(model.idealisation, <D, V, K> =>
+                    group_matrices::<D, V, K>(model, asm, &in_group, law, single));
                 Group {
                     law,
                     material,
@@ -340,15 +324,11 @@ impl NodalLaws {
     /// cumulative dissipation density, a sum over every step, is not a function of
     /// the fields: it is NaN (the ledger holds the totals).
     pub fn materialise(&self, model: &Model, u: &[f64], s: &NodalState) -> Vec<StateStore> {
-        if model.mesh.dim == 3 {
-            self.materialise_d::<3, 6>(model, u, s)
-        } else {
-            self.materialise_d::<2, 3>(model, u, s)
-        }
+        crate::dispatch_kinematics!(model.idealisation, <D, V, K> => self.materialise_k::<D, V, K>(model, u, s))
     }
 
-    /// [`NodalLaws::materialise`] in dimension `D` with `V` Voigt components.
-    fn materialise_d<const D: usize, const V: usize>(
+    /// [`NodalLaws::materialise`] in the idealisation `K`.
+    fn materialise_k<const D: usize, const V: usize, K: Kinematics<D, V>>(
         &self,
         model: &Model,
         u: &[f64],
@@ -361,7 +341,7 @@ impl NodalLaws {
             let kind = block.elements.kind;
             let nn = kind.nodes();
             let ng = points_per_element(kind);
-            let c: [[f64; V]; V] = mat.c_voigt(model.plane);
+            let c: [[f64; V]; V] = mat.elasticity::<V, K>();
             let (law, fields) = self.law_of_block(model, bi, s);
             let rule = stiffness_rule(kind);
             let gather = |field: &[f64], nodes: &[usize]| element_values(field, nodes, D);
@@ -384,22 +364,21 @@ impl NodalLaws {
                 }
                 for (q, &(xi, _)) in rule.iter().enumerate() {
                     let kin = kinematics(kind, &x[..nn], xi);
-                    let eps = strain_v::<V>(&kin, nn, &ue);
+                    let eps = K::strain(&kin, nn, &ue);
                     let ce = mul3(&c, &eps);
                     let g = e * ng + q;
                     match law {
                         GroupLaw::Elastic => store.set_committed(g, &eps, &ce, f64::NAN, &[]),
                         GroupLaw::ProportionalVoigt { .. } | GroupLaw::MatrixVoigt => {
-                            let eta: [[f64; V]; V] = mat
-                                .viscosity_voigt(model.plane)
-                                .expect("a Kelvin-Voigt material");
-                            let rate = strain_v::<V>(&kin, nn, &de).map(|x| x / s.h);
+                            let eta: [[f64; V]; V] =
+                                mat.viscosity::<V, K>().expect("a Kelvin-Voigt material");
+                            let rate = K::strain(&kin, nn, &de).map(|x| x / s.h);
                             let sv = mul3(&eta, &rate);
                             let sigma: [f64; V] = std::array::from_fn(|i| ce[i] + sv[i]);
                             store.set_committed(g, &eps, &sigma, f64::NAN, &[]);
                         }
                         GroupLaw::Sls { alpha, p, .. } => {
-                            let ed = strain_v::<V>(&kin, nn, &ude);
+                            let ed = K::strain(&kin, nn, &ude);
                             let ced = mul3(&c, &ed);
                             let sigma: [f64; V] =
                                 std::array::from_fn(|i| p * ce[i] + alpha * (ce[i] - ced[i]));
@@ -434,30 +413,27 @@ impl NodalLaws {
     }
 }
 
-/// `∫ Bᵀ D B` over the blocks `in_group` holds, with `D = d(material)` (bars in the
-/// group: `E A / L`).
-fn group_matrix<M: crate::fe::element::Voigt>(
+/// A group's stiffness `K_g` (only when there are several groups: one group's is
+/// the model's) and, for an identity viscosity, its `V_g = ∫ Bᵀ η B`, in the
+/// idealisation `K`.
+fn group_matrices<const D: usize, const V: usize, K: Kinematics<D, V>>(
     model: &Model,
     asm: &Assembler,
-    in_group: impl Fn(usize) -> bool + Sync,
-    d: impl Fn(&crate::material::Material) -> M,
-) -> Vec<f64> {
-    let mesh = &model.mesh;
-    let ds: Vec<M> = model.materials.iter().map(d).collect();
-    asm.assemble(mesh, |bi, _e, x, ke| {
-        let block = &mesh.blocks[bi];
-        let kind = block.elements.kind;
-        let nd = mesh.dim * kind.nodes();
-        if !in_group(bi) {
-            ke[..nd * nd].fill(0.0);
-            return;
-        }
-        let mat = &model.materials[block.material];
-        match kind {
-            ElementKind::Bar2 => element::bar_stiffness(x, mesh.dim, mat.e * block.section, ke),
-            kind => element::continuum_stiffness(kind, x, &ds[block.material], block.section, ke),
-        }
-    })
+    in_group: &(impl Fn(usize) -> bool + Sync),
+    law: GroupLaw,
+    single: bool,
+) -> (Option<Vec<f64>>, Vec<f64>) {
+    let (mesh, materials) = (&model.mesh, &model.materials[..]);
+    let k = (!single).then(|| {
+        asm.stiffness_of::<D, V, K>(mesh, materials, in_group, |m| m.elasticity::<V, K>())
+    });
+    let v = match law {
+        GroupLaw::MatrixVoigt => asm.stiffness_of::<D, V, K>(mesh, materials, in_group, |m| {
+            m.viscosity::<V, K>().unwrap_or([[0.0; V]; V])
+        }),
+        _ => Vec::new(),
+    };
+    (k, v)
 }
 
 /// One group's pass over the dofs.

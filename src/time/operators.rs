@@ -128,7 +128,7 @@ impl Operators {
     pub fn new(model: &Model, scheme: Scheme) -> Self {
         let a = &model.analysis;
         let asm = Assembler::new(&model.mesh);
-        let k = asm.stiffness(&model.mesh, &model.materials, model.plane);
+        let k = asm.stiffness(&model.mesh, &model.materials, model.idealisation);
         let mass = asm.mass(&model.mesh, &model.materials, a.time.lumped_mass);
         let gravity = gravity_force(model, &mass, &asm.pattern);
         let response = if model.materials.iter().all(|m| m.is_linear_elastic()) {
@@ -211,7 +211,7 @@ impl Operators {
             self.kt = self.asm.tangent(
                 &model.mesh,
                 &model.materials,
-                model.plane,
+                model.idealisation,
                 &u0,
                 self.h(),
                 &stores,
@@ -341,7 +341,7 @@ impl Operators {
         self.asm.internal_force(
             &model.mesh,
             &model.materials,
-            model.plane,
+            model.idealisation,
             pass,
             points,
             f,

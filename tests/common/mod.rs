@@ -1,19 +1,26 @@
 //! Shared builders for the integration tests.
 #![allow(dead_code)]
 
-use rothe::fe::Plane;
+use rothe::fe::Idealisation;
 use rothe::material::Material;
 use rothe::mesh::{Mesh, Part};
 use rothe::model::{Analysis, AnalysisKind, Body, Constraint, Load, Model, TimeFunction};
 
 /// A one-body model of `part` made of one elastic material, static by default.
-pub fn model_of(part: &Part, plane: Plane, e: f64, nu: f64, rho: f64, thickness: f64) -> Model {
+pub fn model_of(
+    part: &Part,
+    idealisation: Idealisation,
+    e: f64,
+    nu: f64,
+    rho: f64,
+    thickness: f64,
+) -> Model {
     let mut mesh = Mesh::default();
     mesh.add_part(part, 0, "b", 0, thickness);
     Model {
         mesh,
         materials: vec![Material::elastic("m", e, nu, rho)],
-        plane,
+        idealisation,
         bodies: vec![Body {
             name: "b".into(),
             velocity: [0.0; 3],
@@ -149,18 +156,16 @@ pub fn assert_tangent_is_the_derivative<const V: usize>(
 }
 
 /// One material-point update of `m` from `state_n` to the strain `eps` (step 1e-4 s,
-/// element size 0.1 m) in the idealisation `plane`: the response and the new
+/// element size 0.1 m) in the idealisation `K`: the response and the new
 /// state (as many values as `state_n`).
-pub fn point_update<const V: usize>(
+pub fn point_update<const V: usize, K: rothe::fe::StrainSpace<V>>(
     m: &Material,
-    plane: Plane,
     eps_n: [f64; V],
     eps: [f64; V],
     state_n: &[f64],
 ) -> (rothe::material::PointResponse<V>, Vec<f64>) {
     let mut st = vec![0.0; state_n.len()];
-    let r = m.update(
-        plane,
+    let r = m.update::<V, K>(
         &rothe::material::StrainStep {
             eps_n,
             eps,

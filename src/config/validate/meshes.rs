@@ -277,7 +277,7 @@ pub(super) fn check_generated_size(
             points = points.saturating_add(p);
             if let Some(&m) = mat_index.get(&b.material) {
                 let voigt = if dim == 3 { 6 } else { 3 };
-                history = history.max(materials[m].n_state_for(voigt) as u64);
+                history = history.max(materials[m].n_state(voigt) as u64);
             }
         }
     }
@@ -329,7 +329,7 @@ pub fn estimate(mesh: &Mesh, materials: &[Material], factor_nnz: Option<usize>) 
     let voigt = crate::assembly::internal::voigt_of(mesh);
     let history = materials
         .iter()
-        .map(|m| m.n_state_for(voigt))
+        .map(|m| m.n_state(voigt))
         .max()
         .unwrap_or(0) as u64;
     let tangent = materials.iter().any(|m| !m.has_constant_tangent());

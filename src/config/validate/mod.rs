@@ -23,7 +23,7 @@ pub use meshes::estimate;
 
 use super::{LoadOptions, Scenario};
 use crate::error::{Error, Result};
-use crate::fe::Plane;
+use crate::fe::{Idealisation, StrainSpace};
 use crate::mesh::Mesh;
 use crate::model::{
     Analysis, AnalysisKind, Body, ContactSettings, Damping, IterationSettings, Model,
@@ -191,8 +191,8 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     let mut model = Model {
         mesh,
         materials,
-        plane: if solid {
-            Plane::Solid
+        idealisation: if solid {
+            Idealisation::Solid
         } else {
             a.plane.unwrap_or_default()
         },
@@ -308,20 +308,18 @@ fn initial_overlap(model: &Model) -> Result<()> {
 /// (`plane = "stress"` or `"strain"` are refused there: they would be ignored), a
 /// plane mesh takes the given plane, never `solid` (a plane element has three strain
 /// components).
-fn body_plane(given: Option<Plane>, dim: usize, body: &str) -> Result<Plane> {
+fn body_plane(given: Option<Idealisation>, dim: usize, body: &str) -> Result<Idealisation> {
     match (dim, given) {
-        (3, None | Some(Plane::Solid)) => Ok(Plane::Solid),
-        (3, Some(p)) => {
-            Err(Error::config(
-                "analysis.plane",
-                format!(
+        (3, None | Some(Idealisation::Solid)) => Ok(Idealisation::Solid),
+        (3, Some(p)) => Err(Error::config(
+            "analysis.plane",
+            format!(
                 "body `{body}` is a solid (its mesh is three-dimensional), so `plane = \"{}\"` \
                  would be ignored: remove the key (or give \"solid\")",
-                if p == Plane::Strain { "strain" } else { "stress" }
+                p.name()
             ),
-            ))
-        }
-        (_, Some(Plane::Solid)) => Err(Error::config(
+        )),
+        (_, Some(Idealisation::Solid)) => Err(Error::config(
             "analysis.plane",
             format!(
                 "`solid` needs a three-dimensional mesh, but body `{body}` is plane; give \
@@ -362,21 +360,15 @@ fn products_are_finite(
     field: &str,
     thickness: f64,
     m: &crate::material::Material,
-    plane: crate::fe::Plane,
+    idealisation: Idealisation,
     part: &crate::mesh::Part,
     dt: Option<f64>,
 ) -> Result<(f64, f64)> {
-    let stiffness = if plane == Plane::Solid {
-        m.c_solid()
+    let stiffness = crate::dispatch_kinematics!(idealisation, <D, V, K> =>
+        K::elasticity(m.e, m.nu)
             .iter()
             .flatten()
-            .fold(0.0f64, |a, c| a.max(c.abs()))
-    } else {
-        m.c(plane)
-            .iter()
-            .flatten()
-            .fold(0.0f64, |a, c| a.max(c.abs()))
-    };
+            .fold(0.0f64, |a, c| a.max(c.abs())));
     let area: f64 = part
         .blocks
         .iter()
@@ -390,7 +382,7 @@ fn products_are_finite(
             }
         })
         .sum();
-    let solid = plane == Plane::Solid;
+    let solid = idealisation == Idealisation::Solid;
     let thick = (format!("{field}.thickness"), thickness, "m");
     let size = (
         format!("{field}.mesh"),
