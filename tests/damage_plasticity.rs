@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use rothe::config::MaterialSpec;
 use rothe::fe::Idealisation;
 use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
-use rothe::material::{Material, Model, StrainStep};
+use rothe::material::{Law as MaterialLaw, Material, StrainStep};
 use rothe::model::TimeFunction;
 
 const E: f64 = 33e9;
@@ -395,9 +395,9 @@ proptest! {
             let r = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n, eps: *eps, dt: 1e-4, length: 0.1 }, &st_n, &mut st);
             let d = r.dissipation;
             prop_assert!(d.damage >= 0.0 && d.plastic >= 0.0, "dissipation {:?}", d);
-            match m.model {
-                Model::Mazars(_) => prop_assert!(st[2] >= st_n[2] && st[2] < 1.0),
-                Model::RankineHill(_) => {
+            match m.law {
+                MaterialLaw::Mazars(_) => prop_assert!(st[2] >= st_n[2] && st[2] < 1.0),
+                MaterialLaw::RankineHill(_) => {
                     let (t, c) = if variant == 2 { (BILINEAR_T, BILINEAR_C) } else { (SOFTENING_T, EC2_C) };
                     let (ft, fc) = yield_functions(t, c, &r.sigma, st[3], st[4]);
                     prop_assert!(ft <= 1e-6 * 2.9e6 && fc <= 1e-6 * 30e6, "f_t = {}, f_c = {}", ft, fc);
@@ -452,7 +452,7 @@ fn mazars_damage_dissipation_is_the_integral_of_y_dd() {
     let classic = mat(&format!(
         "model = \"mazars\"\nvariant = \"classic\"\n{data}"
     ));
-    let (Model::Mazars(pp), Model::Mazars(pc)) = (&paper.model, &classic.model) else {
+    let (MaterialLaw::Mazars(pp), MaterialLaw::Mazars(pc)) = (&paper.law, &classic.law) else {
         panic!()
     };
     let (a_t, b_t, a_c, b_c, b_c_classic) = (pp.a_t, pp.b_t, pp.a_c, pp.b_c, pc.b_c);

@@ -9,7 +9,7 @@ use rothe::config::MaterialSpec;
 use rothe::fe::Idealisation;
 use rothe::material::identify::Ec2Class;
 use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
-use rothe::material::{Hardening, Material, Model};
+use rothe::material::{Hardening, Law, Material};
 use rothe::model::TimeFunction;
 
 fn material(text: &str) -> rothe::Result<Material> {
@@ -147,7 +147,7 @@ fn ec2_classes_give_table_3_1() {
         material("model = \"mazars\"\nnu = 0.2\nrho = 2400.0\nidentify = { class = \"C30/37\" }")
             .unwrap();
     assert!((m.e - Ec2Class::named("C30/37").unwrap().e_cm).abs() < 1.0);
-    let Model::Mazars(p) = m.model else { panic!() };
+    let Law::Mazars(p) = m.law else { panic!() };
     assert!((p.eps_t0 - 0.3 * 30f64.powf(2.0 / 3.0) * 1e6 / m.e).abs() < 1e-12);
     let m = material(
         "model = \"mazars\"\nE = 33e9\nnu = 0.2\nrho = 2400.0\nidentify = { class = \"C30/37\" }",
@@ -162,9 +162,7 @@ fn rankine_hill_takes_the_same_data() {
         "model = \"rankine_hill\"\nE = 33e9\nnu = 0.2\nrho = 2500.0\n{DATA}"
     ))
     .unwrap();
-    let Model::RankineHill(p) = m.model else {
-        panic!()
-    };
+    let Law::RankineHill(p) = m.law else { panic!() };
     // G_f of fib Model Code 2010, 73 f_cm^0.18 = 140.6 N/m (NOTES.md: 140).
     match p.tension {
         Hardening::LinearSoftening {

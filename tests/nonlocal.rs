@@ -8,7 +8,7 @@
 
 use rothe::assembly::nonlocal::{NonlocalTable, DRIVERS};
 use rothe::linsolve::Backend;
-use rothe::material::{Material, MazarsParams, MazarsVariant, Model, Regularisation};
+use rothe::material::{Law, Material, MazarsParams, MazarsVariant, Regularisation};
 use rothe::mesh::{structured, ElementKind, Elements, Mesh, Part};
 use rothe::time::backward_euler::BackwardEuler;
 use rothe::time::march::{march, Marched, StepControl};
@@ -237,7 +237,7 @@ fn nonlocal_mazars(radius: f64) -> Material {
         e: 30e9,
         nu: 0.2,
         rho: 2400.0,
-        model: Model::Mazars(MazarsParams {
+        law: Law::Mazars(MazarsParams {
             variant: MazarsVariant::Paper,
             eps_t0: 1e-4,
             eps_c0: 1e-4,
@@ -403,7 +403,7 @@ fn under_a_uniform_strain_nonlocal_is_local() {
         for eps in [[3e-4, -0.5e-4, 0.4e-4], [-2.5e-3, 0.4e-3, 0.6e-3]] {
             let evaluate = |radius: Option<f64>| {
                 let mut m = nonlocal_mazars(0.1);
-                if let Model::Mazars(p) = &mut m.model {
+                if let Law::Mazars(p) = &mut m.law {
                     p.variant = variant;
                     if radius.is_none() {
                         p.regularisation = Regularisation::Local;
@@ -571,7 +571,7 @@ fn under_a_uniform_strain_a_nonlocal_solid_is_local() {
                 .collect();
             let evaluate = |nonlocal: bool| {
                 let mut m = nonlocal_mazars(0.1);
-                if let Model::Mazars(p) = &mut m.model {
+                if let Law::Mazars(p) = &mut m.law {
                     p.variant = variant;
                     if !nonlocal {
                         p.regularisation = Regularisation::Local;

@@ -251,7 +251,9 @@ fn element_points<const D: usize, const V: usize, K: Kinematics<D, V>, F>(
             length,
         };
         let history_n = committed.history(g);
-        let averaged = cx.drivers.map(|d| [d[DRIVERS * g], d[DRIVERS * g + 1]]);
+        let averaged = cx
+            .drivers
+            .map(|d| std::array::from_fn(|k| d[DRIVERS * g + k]));
         let mut pred = [0.0; V];
         let resp = match trial {
             Some(t) => {

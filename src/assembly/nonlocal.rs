@@ -1,6 +1,7 @@
 //! Nonlocal integral averaging of the damage drivers (Pijaudier-Cabot and Bažant).
 //!
-//! A nonlocal material's equivalent strains ([`crate::material::mazars::drivers`])
+//! A nonlocal material's drivers ([`crate::material::Constitutive::drivers`]: Mazars'
+//! equivalent strains)
 //! are replaced, where they drive the damage, by their average over the Gauss points
 //! of the same body within the interaction radius `R`:
 //!
@@ -22,11 +23,13 @@ use rstar::RTree;
 
 use crate::fe::{kinematics, stiffness_rule, ElementKind, Kinematics};
 use crate::material::store::StateStore;
-use crate::material::{mazars, Material, MazarsVariant, Model};
+use crate::material::{Material, MAX_DRIVERS};
 use crate::mesh::Mesh;
 
-/// Drivers per point (`[ε_t, ε_c]` or `[ε̃, 0]`).
-pub const DRIVERS: usize = 2;
+/// Drivers per point in the buffers: every nonlocal model's
+/// ([`crate::material::Constitutive::drivers`]; Mazars: `[ε_t, ε_c]` or `[ε̃, 0]`),
+/// unused ones zero.
+pub const DRIVERS: usize = MAX_DRIVERS;
 
 /// An R-tree of member points (their member numbers as data).
 type PointTree = RTree<GeomWithData<[f64; 3], u32>>;
@@ -354,7 +357,7 @@ impl NonlocalTable {
     /// the thread pool (each row summed in its stored order: the same bits on any
     /// pool).
     pub fn average(&self, local: &[f64], out: &mut [f64]) {
-        let mut bounds = vec![[0.0; 2]; self.n_buckets()];
+        let mut bounds = vec![[0.0; DRIVERS]; self.n_buckets()];
         self.average_where(local, &mut bounds, |_, _| true, out);
     }
 
@@ -366,9 +369,14 @@ impl NonlocalTable {
     /// [`NonlocalTable::average`] for the members where `needed(i, bound)` holds,
     /// `bound` being an upper bound of their averages (the largest driver in the
     /// buckets their radius reaches); the others get `-∞`.
-    fn average_where<F>(&self, local: &[f64], bounds: &mut [[f64; 2]], needed: F, out: &mut [f64])
-    where
-        F: Fn(usize, [f64; 2]) -> bool + Sync,
+    fn average_where<F>(
+        &self,
+        local: &[f64],
+        bounds: &mut [[f64; DRIVERS]],
+        needed: F,
+        out: &mut [f64],
+    ) where
+        F: Fn(usize, [f64; DRIVERS]) -> bool + Sync,
     {
         self.bucket_maxima(local, bounds);
         let bounds = &*bounds;
@@ -382,40 +390,40 @@ impl NonlocalTable {
                     let b = self.bucket[i] as usize;
                     let (bx, by, bz) = (b % nx, (b / nx) % ny, b / (nx * ny));
                     let r = self.reach[i] as usize;
-                    let mut bound = [f64::NEG_INFINITY; 2];
+                    let mut bound = [f64::NEG_INFINITY; DRIVERS];
                     for z in bz.saturating_sub(r)..(bz + r + 1).min(nz) {
                         for y in by.saturating_sub(r)..(by + r + 1).min(ny) {
                             for x in bx.saturating_sub(r)..(bx + r + 1).min(nx) {
                                 let m = bounds[(z * ny + y) * nx + x];
-                                bound = [bound[0].max(m[0]), bound[1].max(m[1])];
+                                bound = std::array::from_fn(|d| bound[d].max(m[d]));
                             }
                         }
                     }
                     if !needed(i, bound) {
-                        o[0] = f64::NEG_INFINITY;
-                        o[1] = f64::NEG_INFINITY;
+                        o.fill(f64::NEG_INFINITY);
                         continue;
                     }
                     let (cols, w) = self.neighbours(i);
-                    let (mut a, mut b) = (0.0, 0.0);
+                    let mut sum = [0.0; DRIVERS];
                     for (&j, &wj) in cols.iter().zip(w) {
-                        let j = j as usize;
-                        a += wj * local[DRIVERS * j];
-                        b += wj * local[DRIVERS * j + 1];
+                        let lj = &local[DRIVERS * j as usize..][..DRIVERS];
+                        for d in 0..DRIVERS {
+                            sum[d] += wj * lj[d];
+                        }
                     }
-                    o[0] = a;
-                    o[1] = b;
+                    o.copy_from_slice(&sum);
                 }
             });
     }
 
     /// The largest of each driver per bucket, into `m`.
-    fn bucket_maxima(&self, local: &[f64], m: &mut [[f64; 2]]) {
-        m.fill([f64::NEG_INFINITY; 2]);
+    fn bucket_maxima(&self, local: &[f64], m: &mut [[f64; DRIVERS]]) {
+        m.fill([f64::NEG_INFINITY; DRIVERS]);
         for (i, &b) in self.bucket.iter().enumerate() {
             let e = &mut m[b as usize];
-            e[0] = e[0].max(local[DRIVERS * i]);
-            e[1] = e[1].max(local[DRIVERS * i + 1]);
+            for d in 0..DRIVERS {
+                e[d] = e[d].max(local[DRIVERS * i + d]);
+            }
         }
     }
 
@@ -431,9 +439,6 @@ impl NonlocalTable {
         for (bi, b) in mesh.blocks.iter().enumerate() {
             let Some(off) = self.offset(bi) else { continue };
             let mat = &materials[b.material];
-            let Model::Mazars(p) = &mat.model else {
-                continue;
-            };
             let kind = b.elements.kind;
             let ng = stiffness_rule(kind).len();
             let span = &mut local[DRIVERS * off..DRIVERS * (off + ng * b.elements.len())];
@@ -448,9 +453,8 @@ impl NonlocalTable {
                         for (q, &(xi, _)) in stiffness_rule(kind).iter().enumerate() {
                             let kin = kinematics(kind, &x[..nn], xi);
                             let eps = K::strain(&kin, nn, &ue);
-                            let d = mazars::drivers::<V, K>(p, mat.nu, &eps);
-                            el[DRIVERS * q] = d[0];
-                            el[DRIVERS * q + 1] = d[1];
+                            let d = mat.drivers::<V, K>(&eps);
+                            el[DRIVERS * q..][..DRIVERS].copy_from_slice(&d);
                         }
                     }
                 });
@@ -470,7 +474,7 @@ pub struct Nonlocal {
     /// Their averages (`-∞` where the bound shows that no history maximum can grow).
     pub averaged: Vec<f64>,
     /// The largest drivers per bucket of the last pass.
-    bounds: Vec<[f64; 2]>,
+    bounds: Vec<[f64; DRIVERS]>,
 }
 
 impl Nonlocal {
@@ -479,7 +483,7 @@ impl Nonlocal {
         NonlocalTable::build(mesh, materials).map(|table| {
             let n = DRIVERS * table.n_points();
             Nonlocal {
-                bounds: vec![[0.0; 2]; table.n_buckets()],
+                bounds: vec![[0.0; DRIVERS]; table.n_buckets()],
                 table,
                 local: crate::memory::zeroed(n),
                 averaged: crate::memory::zeroed(n),
@@ -501,23 +505,14 @@ impl Nonlocal {
     ) {
         let t = &self.table;
         t.local_drivers::<D, V, K>(mesh, materials, u, &mut self.local);
-        let needed = |i: usize, bound: [f64; 2]| {
+        let needed = |i: usize, bound: [f64; DRIVERS]| {
             let bi = t.block[i] as usize;
-            let Model::Mazars(p) = &materials[mesh.blocks[bi].material].model else {
-                return true;
-            };
             let Some(store) = stores.get(bi) else {
                 return true;
             };
             let g = i - t.offsets[bi].unwrap_or(0);
-            let committed = store.committed();
-            let h = committed.history(g);
-            match p.variant {
-                MazarsVariant::Paper => {
-                    bound[0] > h[0].max(p.eps_t0) || bound[1] > h[1].max(p.eps_c0)
-                }
-                MazarsVariant::Classic => bound[0] > h[0].max(p.eps_t0),
-            }
+            materials[mesh.blocks[bi].material]
+                .drivers_can_grow(bound, store.committed().history(g))
         };
         t.average_where(&self.local, &mut self.bounds, needed, &mut self.averaged);
     }

@@ -52,8 +52,8 @@ impl Hardening {
                 post_yield_modulus,
             } => format!(
                 "bilinear, strength = {}, post_yield_modulus = {}",
-                super::sig(strength),
-                super::sig(post_yield_modulus)
+                super::point::sig(strength),
+                super::point::sig(post_yield_modulus)
             ),
             Hardening::Ec2 {
                 f_cm,
@@ -61,17 +61,17 @@ impl Hardening {
                 eps_cu1,
             } => format!(
                 "ec2, f_cm = {}, eps_c1 = {}, eps_cu1 = {}",
-                super::sig(f_cm),
-                super::sig(eps_c1),
-                super::sig(eps_cu1)
+                super::point::sig(f_cm),
+                super::point::sig(eps_c1),
+                super::point::sig(eps_cu1)
             ),
             Hardening::LinearSoftening {
                 strength,
                 fracture_energy,
             } => format!(
                 "linear_softening, strength = {}, fracture_energy = {}",
-                super::sig(strength),
-                super::sig(fracture_energy)
+                super::point::sig(strength),
+                super::point::sig(fracture_energy)
             ),
         }
     }

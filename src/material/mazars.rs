@@ -23,7 +23,10 @@
 //! with the element size so that a band dissipates the fracture energy
 //! (`theory/damage.md`).
 
-use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
+use super::point::{
+    dot3, mul3, sig, Constitutive, Dissipation, Moduli, PointResponse, PointStatus, StrainStep,
+    TangentKind, MAX_DRIVERS,
+};
 use crate::fe::StrainSpace;
 
 /// Which Mazars law (`variant = "paper" | "classic"` in a scenario).
@@ -302,5 +305,146 @@ fn secant_response<const V: usize>(
             ..Default::default()
         },
         status: PointStatus::Ok,
+    }
+}
+
+impl Constitutive for MazarsParams {
+    fn name(&self) -> &'static str {
+        "mazars"
+    }
+
+    fn parameters(&self) -> Vec<(&'static str, String)> {
+        let p = self;
+        let mut v = vec![
+            ("variant", format!("{:?}", p.variant).to_lowercase()),
+            ("eps_t0", sig(p.eps_t0)),
+        ];
+        if p.variant == MazarsVariant::Paper {
+            v.push(("eps_c0", sig(p.eps_c0)));
+        }
+        match p.regularisation {
+            Regularisation::CrackBand { fracture_energy } => {
+                v.push(("A_t", "1 (crack band)".into()));
+                v.push(("B_t", "per element from G_f (crack band)".into()));
+                v.push(("fracture_energy", sig(fracture_energy)));
+            }
+            _ => {
+                v.push(("A_t", sig(p.a_t)));
+                v.push(("B_t", sig(p.b_t)));
+            }
+        }
+        v.push(("A_c", sig(p.a_c)));
+        v.push(("B_c", sig(p.b_c)));
+        if p.variant == MazarsVariant::Classic {
+            v.push(("beta", sig(p.beta)));
+        }
+        v.push(("d_max", format!("{}", p.d_max)));
+        v.push(("regularisation", p.regularisation.name().into()));
+        if let Regularisation::Nonlocal { radius } = p.regularisation {
+            v.push(("radius", sig(radius)));
+        }
+        v
+    }
+
+    fn regularisation(&self) -> Option<&'static str> {
+        Some(self.regularisation.name())
+    }
+
+    /// `[k1, k2, D]` (paper: `ε_t*, ε_c*`; classic: `κ, 0`).
+    fn n_state(&self, _voigt: usize) -> usize {
+        3
+    }
+
+    fn state_names(&self, _voigt: usize) -> &'static [&'static str] {
+        match self.variant {
+            MazarsVariant::Paper => &["eps_t_max", "eps_c_max", "damage"],
+            MazarsVariant::Classic => &["kappa", "unused", "damage"],
+        }
+    }
+
+    fn output_fields(&self, state: &[f64], _voigt: usize) -> (f64, f64) {
+        (state[2], 0.0)
+    }
+
+    fn tangent_kind(&self) -> TangentKind {
+        TangentKind::StateDependent
+    }
+
+    fn is_rate_independent(&self) -> bool {
+        true
+    }
+
+    fn has_frozen_form(&self) -> bool {
+        true
+    }
+
+    fn nonlocal_radius(&self) -> Option<f64> {
+        match self.regularisation {
+            Regularisation::Nonlocal { radius } => Some(radius),
+            _ => None,
+        }
+    }
+
+    fn n_drivers(&self) -> usize {
+        2
+    }
+
+    fn drivers<const V: usize, K: StrainSpace<V>>(
+        &self,
+        moduli: Moduli,
+        eps: &[f64; V],
+    ) -> [f64; MAX_DRIVERS] {
+        drivers::<V, K>(self, moduli.nu, eps)
+    }
+
+    /// A history maximum (or its threshold) below the bound.
+    fn drivers_can_grow(&self, bound: [f64; MAX_DRIVERS], h: &[f64]) -> bool {
+        match self.variant {
+            MazarsVariant::Paper => {
+                bound[0] > h[0].max(self.eps_t0) || bound[1] > h[1].max(self.eps_c0)
+            }
+            MazarsVariant::Classic => bound[0] > h[0].max(self.eps_t0),
+        }
+    }
+
+    fn update<const V: usize, K: StrainSpace<V>>(
+        &self,
+        moduli: Moduli,
+        c: &[[f64; V]; V],
+        step: &StrainStep<V>,
+        averaged: Option<[f64; MAX_DRIVERS]>,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse<V> {
+        update::<V, K>(self, c, moduli.nu, step, averaged, state_n, state)
+    }
+
+    /// `D = D⁰`: the secant of the last step.
+    fn update_frozen<const V: usize, K: StrainSpace<V>>(
+        &self,
+        _moduli: Moduli,
+        c: &[[f64; V]; V],
+        step: &StrainStep<V>,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse<V> {
+        frozen(c, step, state_n, state)
+    }
+
+    /// The stress at the trial damage: with the strain unchanged neither the
+    /// history maxima nor the damage grow (the local law at the committed strain
+    /// returns at most the committed `D`; a nonlocal average is not re-evaluated for
+    /// a prediction).
+    fn predicted_stress<const V: usize, K: StrainSpace<V>>(
+        &self,
+        _moduli: Moduli,
+        c: &[[f64; V]; V],
+        eps: &[f64; V],
+        state: &[f64],
+        _dt: f64,
+    ) -> [f64; V] {
+        let w = 1.0 - state[2];
+        let s = mul3(c, eps);
+        s.map(|x| w * x)
     }
 }

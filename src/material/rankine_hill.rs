@@ -16,7 +16,10 @@
 
 use super::hardening::{Hardening, PreparedLaw};
 use super::linalg::{inverse, solve_in_place, Small, MAX_DIM};
-use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep, MAX_STATE};
+use super::point::{
+    dot3, mul3, Constitutive, Dissipation, Moduli, PointResponse, PointStatus, StrainStep,
+    TangentKind, MAX_DRIVERS, MAX_STATE,
+};
 use crate::fe::frame::{Frame, SolidFrame};
 use crate::fe::{FrameUser, Idealisation, Solid, StrainSpace};
 
@@ -688,4 +691,82 @@ fn update_once<const V: usize, const P: usize, F: Frame<V, P>>(
 fn numerical_elastic<const V: usize>(c: &[[f64; V]; V], eps: &[f64; V], eps_n: &[f64; V]) -> f64 {
     let de: [f64; V] = std::array::from_fn(|i| eps[i] - eps_n[i]);
     0.5 * dot3(&de, &mul3(c, &de))
+}
+
+impl Constitutive for RankineHillParams {
+    fn name(&self) -> &'static str {
+        "rankine_hill"
+    }
+
+    fn parameters(&self) -> Vec<(&'static str, String)> {
+        vec![
+            ("tension", self.tension.describe()),
+            ("compression", self.compression.describe()),
+        ]
+    }
+
+    /// A softening tension law is regularised by the crack band.
+    fn regularisation(&self) -> Option<&'static str> {
+        matches!(self.tension, Hardening::LinearSoftening { .. }).then_some("crack_band")
+    }
+
+    /// The plastic strains and `κ_t, κ_c`; the plane keeps a sixth value, `εᵖ_zz`,
+    /// which plane strain's return through the solid's needs (zero in plane
+    /// stress).
+    fn n_state(&self, voigt: usize) -> usize {
+        if voigt == 3 {
+            n_state(voigt) + 1
+        } else {
+            n_state(voigt)
+        }
+    }
+
+    fn state_names(&self, voigt: usize) -> &'static [&'static str] {
+        if voigt == 3 {
+            &[
+                "eps_p_xx",
+                "eps_p_yy",
+                "gamma_p_xy",
+                "kappa_t",
+                "kappa_c",
+                "eps_p_zz",
+            ]
+        } else {
+            &[
+                "eps_p_xx",
+                "eps_p_yy",
+                "gamma_p_xy",
+                "eps_p_zz",
+                "gamma_p_yz",
+                "gamma_p_zx",
+                "kappa_t",
+                "kappa_c",
+            ]
+        }
+    }
+
+    /// The equivalent plastic strain `κ_t + κ_c`.
+    fn output_fields(&self, state: &[f64], voigt: usize) -> (f64, f64) {
+        (0.0, state[voigt] + state[voigt + 1])
+    }
+
+    fn tangent_kind(&self) -> TangentKind {
+        TangentKind::StateDependent
+    }
+
+    fn is_rate_independent(&self) -> bool {
+        true
+    }
+
+    fn update<const V: usize, K: StrainSpace<V>>(
+        &self,
+        moduli: Moduli,
+        c: &[[f64; V]; V],
+        step: &StrainStep<V>,
+        _averaged: Option<[f64; MAX_DRIVERS]>,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse<V> {
+        update_in::<V, K>(self, c, moduli.e, moduli.nu, step, state_n, state)
+    }
 }

@@ -2,7 +2,154 @@
 //! with the Maxwell and Kelvin limits. All updates are backward Euler, exact in the
 //! energy split `σ_{n+1}:Δε = Δψ + ΔD_viscous + ΔD_num` (see `theory/viscoelasticity.md`).
 
-use super::{dot3, mul3, Dissipation, PointResponse, PointStatus, StrainStep};
+use super::point::{
+    dot3, mul3, Constitutive, Dissipation, Moduli, PointResponse, PointStatus, StrainStep,
+    TangentKind, MAX_DRIVERS,
+};
+use crate::fe::StrainSpace;
+
+/// The viscosity of a Kelvin-Voigt material, which is the whole model:
+/// `σ = C ε + η ε̇`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Viscosity {
+    /// `η = α C` (stiffness-proportional, `α` in seconds): `σ = C ε + α C ε̇`.
+    Proportional(f64),
+    /// `η = β I` (identity viscosity, `β` in Pa·s), as in the paper's examples.
+    Identity(f64),
+}
+
+impl Constitutive for Viscosity {
+    fn name(&self) -> &'static str {
+        "kelvin_voigt"
+    }
+
+    fn tangent_kind(&self) -> TangentKind {
+        TangentKind::Constant
+    }
+
+    fn is_rate_independent(&self) -> bool {
+        false
+    }
+
+    fn viscosity<const V: usize, K: StrainSpace<V>>(
+        &self,
+        c: &[[f64; V]; V],
+    ) -> Option<[[f64; V]; V]> {
+        Some(match *self {
+            Viscosity::Proportional(alpha) => c.map(|row| row.map(|x| alpha * x)),
+            Viscosity::Identity(beta) => identity_viscosity(beta),
+        })
+    }
+
+    fn update<const V: usize, K: StrainSpace<V>>(
+        &self,
+        _moduli: Moduli,
+        c: &[[f64; V]; V],
+        step: &StrainStep<V>,
+        _averaged: Option<[f64; MAX_DRIVERS]>,
+        _state_n: &[f64],
+        _state: &mut [f64],
+    ) -> PointResponse<V> {
+        let eta = self
+            .viscosity::<V, K>(c)
+            .expect("a Kelvin-Voigt model has a viscosity");
+        kelvin_voigt(c, &eta, step)
+    }
+}
+
+/// The standard linear solid of eq. (10): `σ = p C ε + τ`, a Maxwell branch of
+/// spring `α C` and dashpot `β C`; without the parallel spring (`p = 0`) the Maxwell
+/// model `σ = τ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sls {
+    /// Branch stiffness ratio `α` (dimensionless).
+    pub alpha: f64,
+    /// Dashpot time `β` (s).
+    pub beta: f64,
+    /// Whether the parallel spring `C` is present.
+    pub parallel: bool,
+}
+
+impl Sls {
+    /// `p`: 1 with the parallel spring, 0 without.
+    fn p(&self) -> f64 {
+        if self.parallel {
+            1.0
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Constitutive for Sls {
+    fn name(&self) -> &'static str {
+        if self.parallel {
+            "sls"
+        } else {
+            "maxwell"
+        }
+    }
+
+    /// One dashpot strain per component.
+    fn n_state(&self, voigt: usize) -> usize {
+        voigt
+    }
+
+    fn state_names(&self, voigt: usize) -> &'static [&'static str] {
+        const NAMES: [&str; 6] = [
+            "eps_d_xx",
+            "eps_d_yy",
+            "gamma_d_xy",
+            "eps_d_zz",
+            "gamma_d_yz",
+            "gamma_d_zx",
+        ];
+        &NAMES[..voigt]
+    }
+
+    fn tangent_kind(&self) -> TangentKind {
+        TangentKind::Constant
+    }
+
+    fn is_rate_independent(&self) -> bool {
+        false
+    }
+
+    /// `(p + α) C`: the Maxwell branch answers at once.
+    fn instantaneous_factor(&self) -> f64 {
+        self.alpha + self.p()
+    }
+
+    fn update<const V: usize, K: StrainSpace<V>>(
+        &self,
+        _moduli: Moduli,
+        c: &[[f64; V]; V],
+        step: &StrainStep<V>,
+        _averaged: Option<[f64; MAX_DRIVERS]>,
+        state_n: &[f64],
+        state: &mut [f64],
+    ) -> PointResponse<V> {
+        standard_linear_solid(c, self.p(), self.alpha, self.beta, step, state_n, state)
+    }
+
+    /// `p C ε + α/(1 + k) C (ε − ε_d)`, `k = h α/β`, from the dashpot strain
+    /// `ε_d` of `state`.
+    fn predicted_stress<const V: usize, K: StrainSpace<V>>(
+        &self,
+        _moduli: Moduli,
+        c: &[[f64; V]; V],
+        eps: &[f64; V],
+        state: &[f64],
+        dt: f64,
+    ) -> [f64; V] {
+        let k = dt * self.alpha / self.beta;
+        let p = self.p();
+        let ee: [f64; V] = std::array::from_fn(|i| eps[i] - state[i]);
+        let (ce, cee) = (mul3(c, eps), mul3(c, &ee));
+        let a = self.alpha / (1.0 + k);
+        std::array::from_fn(|i| p * ce[i] + a * cee[i])
+    }
+}
 
 /// Whether Voigt component `i` is a shear (engineering `γ`): the plane's third, a
 /// solid's third, fifth and sixth (order of `fe`).

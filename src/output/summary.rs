@@ -201,13 +201,13 @@ pub struct MaterialSummary {
 impl MaterialSummary {
     /// The summary of `m`.
     pub fn of(m: &crate::material::Material) -> Self {
-        use crate::material::{Hardening, Model, Regularisation};
-        let fracture_energy = match &m.model {
-            Model::Mazars(p) => match p.regularisation {
+        use crate::material::{Hardening, Law, Regularisation};
+        let fracture_energy = match &m.law {
+            Law::Mazars(p) => match p.regularisation {
                 Regularisation::CrackBand { fracture_energy } => Some(fracture_energy),
                 _ => None,
             },
-            Model::RankineHill(p) => match p.tension {
+            Law::RankineHill(p) => match p.tension {
                 Hardening::LinearSoftening {
                     fracture_energy, ..
                 } => Some(fracture_energy),

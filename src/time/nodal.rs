@@ -26,7 +26,7 @@ use crate::energy::Dissipation;
 use crate::fe::{element, kinematics, stiffness_rule, ElementKind, Kinematics};
 use crate::halves::{add, in_halves, split_slices, Slices, VECTOR_LEAF};
 use crate::material::store::StateStore;
-use crate::material::{mul3, Model as Law, Viscosity};
+use crate::material::{mul3, Law, Sls, Viscosity};
 use crate::model::Model;
 
 /// Dofs per parallel chunk of the field passes.
@@ -125,22 +125,22 @@ impl NodalLaws {
             if b.elements.kind == ElementKind::Bar2 {
                 return Some((GroupLaw::Elastic, None));
             }
-            let law = match m.model {
+            let law = match m.law {
                 Law::Elastic => return Some((GroupLaw::Elastic, None)),
                 Law::KelvinVoigt(Viscosity::Proportional(alpha)) => {
                     GroupLaw::ProportionalVoigt { alpha }
                 }
                 Law::KelvinVoigt(Viscosity::Identity(_)) => GroupLaw::MatrixVoigt,
-                Law::Sls {
+                Law::Sls(Sls {
                     alpha,
                     beta,
                     parallel,
-                } => GroupLaw::Sls {
+                }) => GroupLaw::Sls {
                     alpha,
                     beta,
                     p: if parallel { 1.0 } else { 0.0 },
                 },
-                Law::Mazars(_) | Law::RankineHill(_) => return None,
+                Law::Mazars(_) | Law::RankineHill(_) | Law::Custom(_) => return None,
             };
             Some((law, Some(b.material)))
         };

@@ -91,12 +91,12 @@ fn hardening(
 /// the exponential crack band of Mazars needs the same (its `G_f/h` must exceed the
 /// elastic energy `f_t²/(2E)` at the peak).
 pub(super) fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()> {
-    use crate::material::{Hardening, Model};
+    use crate::material::{Hardening, Law};
     use crate::material::{MazarsParams, Regularisation};
     for (bi, b) in mesh.blocks.iter().enumerate() {
         let mat = &materials[b.material];
-        let (strength, fracture_energy, key) = match &mat.model {
-            Model::RankineHill(p) => match p.tension {
+        let (strength, fracture_energy, key) = match &mat.law {
+            Law::RankineHill(p) => match p.tension {
                 Hardening::LinearSoftening {
                     strength,
                     fracture_energy,
@@ -109,7 +109,7 @@ pub(super) fn check_crack_band(mesh: &Mesh, materials: &[Material]) -> Result<()
                 } => (strength, fracture_energy, "tension.fracture_energy"),
                 _ => continue,
             },
-            Model::Mazars(MazarsParams {
+            Law::Mazars(MazarsParams {
                 regularisation: Regularisation::CrackBand { fracture_energy },
                 eps_t0,
                 ..
@@ -269,21 +269,21 @@ fn hardening_spec(h: &crate::material::Hardening) -> crate::config::HardeningSpe
 
 /// Validates one material spec into a [`Material`]; `field` prefixes error paths.
 pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material> {
-    use crate::material::{Model, Viscosity};
-    let with = |e, nu, rho, model| -> Result<Material> {
+    use crate::material::{Law, Sls, Viscosity};
+    let with = |e, nu, rho, law| -> Result<Material> {
         check_elastic(field, e, nu, rho)?;
         Ok(Material {
             name: name.into(),
             e,
             nu,
             rho,
-            model,
+            law,
             identified_from: None,
         })
     };
     let viscosity = |key: &str, v: f64| positive(&format!("{field}.{key}"), v);
     match *spec {
-        MaterialSpec::Elastic { e, nu, rho } => with(e, nu, rho, Model::Elastic),
+        MaterialSpec::Elastic { e, nu, rho } => with(e, nu, rho, Law::Elastic),
         MaterialSpec::KelvinVoigt {
             e,
             nu,
@@ -307,7 +307,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                     ))
                 }
             };
-            with(e, nu, rho, Model::KelvinVoigt(v))
+            with(e, nu, rho, Law::KelvinVoigt(v))
         }
         MaterialSpec::Sls {
             e,
@@ -322,11 +322,11 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                 e,
                 nu,
                 rho,
-                Model::Sls {
+                Law::Sls(Sls {
                     alpha,
                     beta,
                     parallel: true,
-                },
+                }),
             )
         }
         MaterialSpec::Maxwell { e, nu, rho, beta } => {
@@ -335,11 +335,11 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                 e,
                 nu,
                 rho,
-                Model::Sls {
+                Law::Sls(Sls {
                     alpha: 1.0,
                     beta,
                     parallel: false,
-                },
+                }),
             )
         }
         MaterialSpec::Mazars {
@@ -474,7 +474,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                 e,
                 nu,
                 rho,
-                Model::Mazars(MazarsParams {
+                Law::Mazars(MazarsParams {
                     variant,
                     eps_t0: ident.eps_t0,
                     eps_c0: ident.eps_c0,
@@ -579,7 +579,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
                 e,
                 nu,
                 rho,
-                Model::RankineHill(crate::material::RankineHillParams::new(
+                Law::RankineHill(crate::material::RankineHillParams::new(
                     tension,
                     compression,
                     e,
@@ -590,12 +590,7 @@ pub fn material(name: &str, field: &str, spec: &MaterialSpec) -> Result<Material
         }
         MaterialSpec::Kelvin { e, nu, rho, beta } => {
             viscosity("beta", beta)?;
-            with(
-                e,
-                nu,
-                rho,
-                Model::KelvinVoigt(Viscosity::Proportional(beta)),
-            )
+            with(e, nu, rho, Law::KelvinVoigt(Viscosity::Proportional(beta)))
         }
     }
 }
