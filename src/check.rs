@@ -161,7 +161,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         &mesh.coords,
     )?;
     let nnz_l = system.factor_nnz().unwrap_or(0);
-    let memory = crate::config::memory_estimate(model, Some(nnz_l));
+    let memory = crate::memory::of_model(model, Some(nnz_l));
     memory.check(memory_limit, "the run")?;
     let a = &model.analysis;
     let steps = a.n_steps();

@@ -347,8 +347,7 @@ fn main() -> ExitCode {
         Command::Run { out, .. } => Some(out.clone()),
         _ => None,
     };
-    let result = std::panic::catch_unwind(|| {
-        match cli.command {
+    let result = std::panic::catch_unwind(|| match cli.command {
         Command::Run {
             scenario,
             out,
@@ -389,20 +388,22 @@ fn main() -> ExitCode {
             &sets,
             sweep,
         ),
-        Command::Material { file, out } => rothe::material::point_driver::run_file(&file, &out, |m| {
+        Command::Material { file, out } => rothe::point_driver::run_file(&file, &out, |m| {
             for l in rothe::check::material_lines(m) {
                 eprintln!("{l}");
             }
             if m.nonlocal_radius().is_some() {
-                eprintln!("(a single point is a uniform field: its nonlocal average is its own strain)");
+                eprintln!(
+                    "(a single point is a uniform field: its nonlocal average is its own strain)"
+                );
             }
         })
-            .map(|steps| {
-                eprintln!(
-                    "{steps} steps; wrote {}",
-                    out.join("material.csv").display()
-                );
-            }),
+        .map(|steps| {
+            eprintln!(
+                "{steps} steps; wrote {}",
+                out.join("material.csv").display()
+            );
+        }),
         Command::Check { scenario, matrices } => {
             let limit = scenario.options().memory_limit;
             scenario.load().and_then(|model| {
@@ -416,7 +417,6 @@ fn main() -> ExitCode {
                 Ok(())
             })
         }
-    }
     });
     let result = result.unwrap_or_else(|p| {
         let e = rothe::Error::Internal(format!(

@@ -88,7 +88,7 @@ impl TimeFunction {
 /// A displacement component held at `value * function(t)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Constraint {
-    /// Global dof index (`2 node + component`).
+    /// Global dof index (`d node + component`, `d` the mesh dimension).
     pub dof: usize,
     /// Amplitude.
     pub value: f64,
@@ -424,6 +424,16 @@ pub struct ContactSide {
     pub master_boundary: Vec<[usize; 2]>,
 }
 
+/// The corners of a face: three for a triangle (fourth node `usize::MAX`), else
+/// four.
+pub fn face_corners(face: &[usize; 4]) -> &[usize] {
+    if face[3] == usize::MAX {
+        &face[..3]
+    } else {
+        &face[..]
+    }
+}
+
 impl ContactSide {
     /// The nodes of a deformable master (segments' or faces' corners, with
     /// repeats); none for a rigid one.
@@ -432,7 +442,7 @@ impl ContactSide {
             Master::Segments(segs) => segs.iter().flatten().copied().collect(),
             Master::Faces(faces) => faces
                 .iter()
-                .flat_map(|f| crate::contact::faces::corners(f).iter().copied())
+                .flat_map(|f| face_corners(f).iter().copied())
                 .collect(),
             _ => Vec::new(),
         }

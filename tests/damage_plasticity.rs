@@ -9,9 +9,9 @@ mod common;
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
 use rothe::fe::Idealisation;
-use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
 use rothe::material::{Law as MaterialLaw, Material, StrainStep};
 use rothe::model::TimeFunction;
+use rothe::point_driver::{run_path, Control, PathKind, PathSpec};
 
 const E: f64 = 33e9;
 const NU: f64 = 0.2;
@@ -121,7 +121,7 @@ fn uniaxial(
     m: &Material,
     points: Vec<[f64; 2]>,
     n: usize,
-) -> Vec<rothe::material::point_driver::PointRecord> {
+) -> Vec<rothe::point_driver::PointRecord> {
     let t_end = points.last().unwrap()[0];
     let p = PathSpec {
         kind: PathKind::UniaxialStress,

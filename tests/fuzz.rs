@@ -249,14 +249,14 @@ fn exercise_scenario(text: &str, dir: &Path) -> Result<(), String> {
 
 /// Drives a material-point file for at most a few hundred steps.
 fn exercise_material(text: &str) -> Result<(), String> {
-    let Ok(spec) = toml::from_str::<rothe::material::point_driver::DriverFile>(text) else {
+    let Ok(spec) = toml::from_str::<rothe::point_driver::DriverFile>(text) else {
         return Ok(());
     };
     let Ok(mat) = rothe::config::material("point", "material", &spec.material) else {
         return Ok(());
     };
     let mut n = 0;
-    let r = rothe::material::point_driver::run_path_with(&mat, &spec.path, |rec| {
+    let r = rothe::point_driver::run_path_with(&mat, &spec.path, |rec| {
         if rec.response.sigma.iter().any(|x| !x.is_finite()) {
             return Err(rothe::Error::Internal("non-finite stress passed on".into()));
         }

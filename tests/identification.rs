@@ -8,9 +8,9 @@
 use rothe::config::MaterialSpec;
 use rothe::fe::Idealisation;
 use rothe::material::identify::Ec2Class;
-use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec};
 use rothe::material::{Hardening, Law, Material};
 use rothe::model::TimeFunction;
+use rothe::point_driver::{run_path, Control, PathKind, PathSpec};
 
 fn material(text: &str) -> rothe::Result<Material> {
     let spec: MaterialSpec = toml::from_str(text).expect("spec parses");

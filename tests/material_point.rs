@@ -8,9 +8,9 @@ mod common;
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;
 use rothe::fe::Idealisation;
-use rothe::material::point_driver::{run_path, Control, PathKind, PathSpec, PointRecord};
 use rothe::material::{Material, StrainStep};
 use rothe::model::TimeFunction;
+use rothe::point_driver::{run_path, Control, PathKind, PathSpec, PointRecord};
 
 const E: f64 = 30e9;
 const NU: f64 = 0.2;

@@ -640,7 +640,7 @@ fn the_material_driver_takes_a_solid_point() {
     // zero, the plastic work alike. The file form writes six strain and six stress
     // columns and the solid's history names; a table of three-component strains
     // for a solid's point is refused naming the row.
-    use rothe::material::point_driver::{run_file, run_path, run_solid_path, PathSpec};
+    use rothe::point_driver::{run_file, run_path, run_solid_path, PathSpec};
     let m = mat(BILINEAR);
     let path = |plane: &str| -> PathSpec {
         toml::from_str(&format!(

@@ -531,7 +531,7 @@ impl NativeRun {
 /// The material driver (`rothe material FILE --out DIR`): writes `material.csv`.
 #[pyfunction]
 fn material(py: Python<'_>, file: PathBuf, out: PathBuf) -> PyResult<usize> {
-    py.detach(move || rothe::material::point_driver::run_file(&file, &out, |_| {}))
+    py.detach(move || rothe::point_driver::run_file(&file, &out, |_| {}))
         .map_err(py_err)
 }
 

@@ -5,28 +5,19 @@
 //! nothing is allocated per pass (element buffers live on the stack, trial states in
 //! the stores).
 
-use super::nonlocal::DRIVERS;
 use super::{Assembler, SharedValues};
 use crate::energy::Dissipation;
 use crate::fe::{
     element, kinematics_from, rule_shapes, stiffness_rule, ElementKind, Idealisation, Kinematics,
-    PointKinematics, MAX_ELEMENT_DOFS, MAX_NODES,
+    PointKinematics, MAX_ELEMENT_DOFS,
 };
 use crate::halves::in_halves;
 use crate::material::store::{Committed, Layout, StateStore};
-use crate::material::{Material, PointResponse, PointStatus, StrainStep, MAX_STATE};
+use crate::material::{
+    Material, PointFailure, PointResponse, PointStatus, StrainStep, MAX_DRIVERS as DRIVERS,
+    MAX_STATE,
+};
 use crate::mesh::Mesh;
-
-/// A material point whose update failed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PointFailure {
-    /// Element block.
-    pub block: usize,
-    /// Element within the block.
-    pub element: usize,
-    /// Point within the block.
-    pub point: usize,
-}
 
 /// Integrated point quantities of one evaluation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -191,7 +182,7 @@ fn element_points<const D: usize, const V: usize, K: Kinematics<D, V>, F>(
 ) where
     F: FnMut(f64, &PointResponse<V>, Option<&PointKinematics>, &[[f64; 3]], [f64; V]),
 {
-    let (x, ue, nn) = gather::<D>(cx.mesh, nodes, u);
+    let (x, ue, nn) = super::gather::<D>(cx.mesh, nodes, u);
     if cx.kind == ElementKind::Bar2 {
         let g = e;
         let eps = element::bar_strain(&x[..2], D, &ue[..2 * D]);
@@ -288,67 +279,12 @@ fn element_points<const D: usize, const V: usize, K: Kinematics<D, V>, F>(
     }
 }
 
-/// The coordinates and displacements (`D` per node) of an element's nodes, and
-/// their number.
-#[inline(always)]
-pub(crate) fn gather<const D: usize>(
-    mesh: &Mesh,
-    nodes: &[usize],
-    u: &[f64],
-) -> ([[f64; 3]; MAX_NODES], [f64; MAX_ELEMENT_DOFS], usize) {
-    (
-        super::element_coords(mesh, nodes),
-        super::element_values(u, nodes, D),
-        nodes.len(),
-    )
-}
-
 /// Writes a Voigt vector (element by element: no call to `memcpy` on the hot path).
 #[inline(always)]
 #[allow(clippy::manual_memcpy)]
 fn write_v<const V: usize>(out: &mut [f64], v: &[f64; V]) {
     for i in 0..V {
         out[i] = v[i];
-    }
-}
-
-/// Adds one point's `w Bᵀ D B` (continuum) or sets the bar stiffness `E A / L`
-/// (bars have one point) in the element matrix `ke`.
-#[inline]
-fn add_point_tangent<const D: usize, const V: usize, K: Kinematics<D, V>>(
-    k: Option<&PointKinematics>,
-    x: &[[f64; 3]],
-    nn: usize,
-    w: f64,
-    d: &[[f64; V]; V],
-    ke: &mut [f64],
-) {
-    match k {
-        Some(k) => K::add_btdb(k, nn, d, w, ke),
-        None => element::bar_stiffness(x, D, d[0][0] * w / element::bar_axis(x).1, ke),
-    }
-}
-
-/// Adds `w Bᵀ σ` (continuum) or the axial force `σ w / L` along the bar to `fe`.
-#[inline]
-fn add_bt_sigma<const D: usize, const V: usize, K: Kinematics<D, V>>(
-    k: Option<&PointKinematics>,
-    x: &[[f64; 3]],
-    nn: usize,
-    w: f64,
-    sigma: &[f64; V],
-    fe: &mut [f64; MAX_ELEMENT_DOFS],
-) {
-    match k {
-        Some(k) => K::add_bt_sigma(k, nn, w, sigma, fe),
-        None => {
-            let (ax, l) = element::bar_axis(x);
-            let n = sigma[0] * w / l;
-            for i in 0..D {
-                fe[i] -= n * ax[i];
-                fe[D + i] += n * ax[i];
-            }
-        }
     }
 }
 
@@ -503,9 +439,16 @@ impl Assembler {
                                     });
                                 }
                                 q += 1;
-                                add_bt_sigma::<D, V, K>(k, x, nodes.len(), w, &r.sigma, &mut fe);
+                                element::add_point_force::<D, V, K>(
+                                    k,
+                                    x,
+                                    nodes.len(),
+                                    w,
+                                    &r.sigma,
+                                    &mut fe,
+                                );
                                 if predict {
-                                    add_bt_sigma::<D, V, K>(
+                                    element::add_point_force::<D, V, K>(
                                         k,
                                         x,
                                         nodes.len(),
@@ -516,7 +459,7 @@ impl Assembler {
                                 }
                                 if block_tangent {
                                     if !by_delta {
-                                        add_point_tangent::<D, V, K>(
+                                        element::add_point_tangent::<D, V, K>(
                                             k,
                                             x,
                                             nodes.len(),
@@ -531,7 +474,7 @@ impl Assembler {
                                                 *a -= b;
                                             }
                                         }
-                                        add_point_tangent::<D, V, K>(
+                                        element::add_point_tangent::<D, V, K>(
                                             k,
                                             x,
                                             nodes.len(),
@@ -619,7 +562,9 @@ impl Assembler {
                 u,
                 e,
                 None,
-                |w, r, k, x, _| add_point_tangent::<D, V, K>(k, x, nodes.len(), w, &r.tangent, ke),
+                |w, r, k, x, _| {
+                    element::add_point_tangent::<D, V, K>(k, x, nodes.len(), w, &r.tangent, ke)
+                },
             );
         })
     }

@@ -42,6 +42,21 @@ pub fn element_values(field: &[f64], nodes: &[usize], dim: usize) -> [f64; MAX_E
     out
 }
 
+/// The coordinates and displacements (`D` per node) of an element's nodes, and
+/// their number.
+#[inline(always)]
+pub(crate) fn gather<const D: usize>(
+    mesh: &Mesh,
+    nodes: &[usize],
+    u: &[f64],
+) -> ([[f64; 3]; MAX_NODES], [f64; MAX_ELEMENT_DOFS], usize) {
+    (
+        element_coords(mesh, nodes),
+        element_values(u, nodes, D),
+        nodes.len(),
+    )
+}
+
 /// Mass matrix: consistent (on the shared pattern) or lumped (a diagonal).
 #[derive(Clone, Debug)]
 pub enum Mass {
@@ -52,10 +67,11 @@ pub enum Mass {
 }
 
 /// A consistent mass matrix: its values on the shared pattern (it dereferences to
-/// them), and, when every 2×2 node block is a multiple of the identity (a scalar
-/// density on every element, as in all of rothe's elements), that multiple per
-/// node pair in adjacency order, which the products read instead: a quarter of
-/// the values, so `M x` streams a quarter of the matrix.
+/// them), and, when every `d × d` node block is a multiple of the identity (a
+/// scalar density on every element, as in all of rothe's elements), that multiple
+/// per node pair in adjacency order, which the products read instead: `1/d²` of the
+/// values (a quarter in the plane, a ninth in a solid), so `M x` streams that much
+/// of the matrix.
 #[derive(Clone, Debug)]
 pub struct ConsistentMass {
     values: Vec<f64>,
@@ -243,7 +259,7 @@ impl Assembler {
     where
         F: Fn(usize, usize, &[[f64; 3]], &mut [f64]) + Sync,
     {
-        let mut values = crate::memory::zeroed(self.pattern.nnz());
+        let mut values = crate::buffers::zeroed(self.pattern.nnz());
         let shared = SharedValues(values.as_mut_ptr());
         for (bi, block) in mesh.blocks.iter().enumerate() {
             let nn = block.elements.kind.nodes();

@@ -448,8 +448,7 @@ impl NonlocalTable {
                     let per = (POINT_LEAF / ng).max(1);
                     for (k, el) in chunk.chunks_exact_mut(DRIVERS * ng).enumerate() {
                         let e = c * per + k;
-                        let (x, ue, nn) =
-                            super::internal::gather::<D>(mesh, b.elements.element(e), u);
+                        let (x, ue, nn) = super::gather::<D>(mesh, b.elements.element(e), u);
                         for (q, &(xi, _)) in stiffness_rule(kind).iter().enumerate() {
                             let kin = kinematics(kind, &x[..nn], xi);
                             let eps = K::strain(&kin, nn, &ue);
@@ -485,8 +484,8 @@ impl Nonlocal {
             Nonlocal {
                 bounds: vec![[0.0; DRIVERS]; table.n_buckets()],
                 table,
-                local: crate::memory::zeroed(n),
-                averaged: crate::memory::zeroed(n),
+                local: crate::buffers::zeroed(n),
+                averaged: crate::buffers::zeroed(n),
             }
         })
     }

@@ -13,22 +13,7 @@ mod validate;
 pub use bodies::{
     BarSpec, BodySpec, Component, LoadSpec, MeshSpec, PrescribedSpec, ProbeSpec, SupportSpec,
 };
-pub use validate::{material, HUGE_STEPS};
-
-/// Checks that `v` is positive and finite; the error names `field`.
-pub fn positive_pub(field: &str, v: f64) -> Result<()> {
-    validate::positive(field, v)
-}
-
-/// Checks that every entry of `v` is finite; the error names `field`.
-pub fn finite_pub(field: &str, v: &[f64]) -> Result<()> {
-    validate::finite(field, v)
-}
-
-/// Checks a time function's numbers and shape; the error names `field`.
-pub fn check_function_pub(field: &str, f: &TimeFunction) -> Result<()> {
-    validate::check_function(field, f)
-}
+pub use validate::{check_function, finite, material, positive, HUGE_STEPS};
 
 /// How a scenario is loaded.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,7 +54,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result};
 use crate::fe::Idealisation;
-use crate::model::{AnalysisKind, Model, TimeFunction};
+use crate::model::{AnalysisKind, Model};
 use location::{field_path, line_column, toml_error, within_material};
 
 /// A whole scenario file.
@@ -644,14 +629,4 @@ pub fn from_str(text: &str, dir: &Path) -> Result<Model> {
 /// [`from_str`] with options.
 pub fn from_str_with(text: &str, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     validate::build(&parse_with(text, &Overrides::none())?, dir, opts)
-}
-
-/// The memory estimate of a model (the factor's exact nonzeros when known).
-pub fn memory_estimate(model: &Model, factor_nnz: Option<usize>) -> crate::memory::Estimate {
-    let mut est = validate::estimate(&model.mesh, &model.materials, factor_nnz);
-    if model.analysis.time.contact_predictor == crate::model::ContactPredictor::Stabilised {
-        // The predictor's factor of the mass, on the same pattern and ordering.
-        est.factor *= 2;
-    }
-    est
 }

@@ -21,6 +21,7 @@
 //! common boundary, both faces hold it, each as the half-space of its own plane, as
 //! the plane's notches are (`theory/contact3d.md`).
 
+use crate::model::face_corners;
 use std::collections::HashMap;
 
 use rstar::primitives::{GeomWithData, Rectangle};
@@ -67,16 +68,6 @@ fn unit(a: V3) -> Option<V3> {
     (l > 0.0 && l.is_finite()).then(|| [a[0] / l, a[1] / l, a[2] / l])
 }
 
-/// The corners of a face: three for a triangle (fourth node `usize::MAX`), else
-/// four.
-pub fn corners(face: &[usize; 4]) -> &[usize] {
-    if face[3] == usize::MAX {
-        &face[..3]
-    } else {
-        &face[..]
-    }
-}
-
 /// The box of `points` grown by `pad` on every side.
 pub(super) fn bounding_box(points: impl Iterator<Item = V3>, pad: f64) -> AABB<V3> {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
@@ -104,7 +95,7 @@ pub(super) fn face_tree<I: Iterator<Item = V3>>(
             .iter()
             .enumerate()
             .map(|(k, f)| {
-                let b = bounding_box(corners(f).iter().flat_map(|&n| at(n)), pad);
+                let b = bounding_box(face_corners(f).iter().flat_map(|&n| at(n)), pad);
                 GeomWithData::new(Rectangle::from_aabb(b), k)
             })
             .collect(),
@@ -327,7 +318,7 @@ impl Surface {
         let mut normal = Vec::with_capacity(faces.len());
         let mut at_node: HashMap<usize, V3> = HashMap::with_capacity(faces.len());
         for f in faces {
-            let c = corners(f);
+            let c = face_corners(f);
             let n = if c.len() == 3 {
                 cross(sub(x(c[1]), x(c[0])), sub(x(c[2]), x(c[0])))
             } else {
@@ -358,7 +349,7 @@ impl Surface {
     /// mean normal.
     pub(super) fn normal(&self, face: &[usize; 4], pr: &Projection) -> V3 {
         let mut n = [0.0; 3];
-        for (k, &v) in corners(face).iter().enumerate() {
+        for (k, &v) in face_corners(face).iter().enumerate() {
             if let Some(m) = self.at_node.get(&v) {
                 for i in 0..3 {
                     n[i] += pr.weights[k] * m[i];
@@ -375,7 +366,7 @@ pub fn boundary_edges(faces: &[[usize; 4]]) -> Vec<[usize; 2]> {
     let mut edges: Vec<[usize; 2]> = faces
         .iter()
         .flat_map(|f| {
-            let c = corners(f);
+            let c = face_corners(f);
             (0..c.len()).map(move |i| {
                 let (a, b) = (c[i], c[(i + 1) % c.len()]);
                 [a.min(b), a.max(b)]
@@ -403,7 +394,7 @@ fn beyond_boundary<X: Fn(usize) -> V3>(
     pr: &Projection,
     x: &X,
 ) -> bool {
-    let c = corners(face);
+    let c = face_corners(face);
     let on_edge = match pr.region {
         Region::Edge(i) => {
             let (a, b) = (c[i], c[(i + 1) % c.len()]);
@@ -457,7 +448,7 @@ pub(super) fn face_candidate<X: Fn(usize) -> V3>(
 ) -> Candidate {
     let mut weights = Weights::EMPTY;
     weights.add(key.2, 1.0);
-    for (k, &v) in corners(face).iter().enumerate() {
+    for (k, &v) in face_corners(face).iter().enumerate() {
         weights.add(v, -pr.weights[k]);
     }
     let tangents = plane_tangents(normal);
@@ -548,7 +539,7 @@ fn faces_side<X: Fn(usize) -> V3>(
         near.clear();
         for hit in tree.locate_in_envelope_intersecting(reach) {
             let f = &faces[hit.data];
-            if corners(f).contains(&s) {
+            if face_corners(f).contains(&s) {
                 continue;
             }
             if let Some(pr) = project(p, f, x) {
@@ -593,9 +584,9 @@ fn faces_side<X: Fn(usize) -> V3>(
         if on_boundary {
             let nk = surface.normal[k];
             let shared = |f: usize| {
-                corners(&faces[f])
+                face_corners(&faces[f])
                     .iter()
-                    .any(|v| corners(&faces[k]).contains(v))
+                    .any(|v| face_corners(&faces[k]).contains(v))
             };
             for (f, prf) in &near {
                 if *f == k || !shared(*f) {
@@ -608,8 +599,8 @@ fn faces_side<X: Fn(usize) -> V3>(
                 // The corners of the neighbour it does not share with the nearest
                 // face (a shared one lies on the boundary, where round-off decides
                 // the sign).
-                let own = corners(&faces[k]);
-                let rises = corners(&faces[*f])
+                let own = face_corners(&faces[k]);
+                let rises = face_corners(&faces[*f])
                     .iter()
                     .filter(|v| !own.contains(v))
                     .any(|&v| {

@@ -66,7 +66,7 @@ pub fn tributary_areas(model: &crate::model::Model) -> Vec<f64> {
     if mesh.dim == 3 {
         for side in model.contacts.iter().flat_map(|p| &p.sides) {
             for f in &side.faces {
-                let c = faces::corners(f);
+                let c = crate::model::face_corners(f);
                 let x = |k: usize| mesh.coords[c[k % c.len()]];
                 let d = |a: [f64; 3], b: [f64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
                 // Half the cross product of the diagonals (of two edges for a

@@ -256,7 +256,7 @@ fn exterior(mesh: &Mesh, body: usize) -> Vec<Facet> {
             for f in facets {
                 let mut key: Vec<usize> = match &f {
                     Facet::Edge(e) => e.to_vec(),
-                    Facet::Face(f) => super::faces::corners(f).to_vec(),
+                    Facet::Face(f) => crate::model::face_corners(f).to_vec(),
                 };
                 key.sort_unstable();
                 uses.entry(key).or_insert((0, f)).0 += 1;

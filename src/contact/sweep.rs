@@ -3,13 +3,12 @@
 //! [`super::detect`] (or [`super::faces`] in a solid) reaches (theory/contact.md,
 //! "Nothing crosses unseen"; theory/contact3d.md).
 
+use crate::model::face_corners;
 use rstar::primitives::GeomWithData;
 use rstar::{RTree, RTreeObject};
 
 use super::detect::{closest, segment_candidate, within_ends, Chain, RigidHistory};
-use super::faces::{
-    bounding_box, corners, dot, face_candidate, face_tree, project, sub, Surface, V3,
-};
+use super::faces::{bounding_box, dot, face_candidate, face_tree, project, sub, Surface, V3};
 use super::rows::{Candidate, Contactee, Weights};
 use crate::model::{ContactPair, Master};
 
@@ -196,7 +195,7 @@ where
                 Master::Faces(faces) => {
                     let movers = movers(
                         &side.slaves,
-                        faces.iter().flat_map(|f| corners(f).iter().copied()),
+                        faces.iter().flat_map(|f| face_corners(f).iter().copied()),
                         pair.radius,
                         |n| dist(x0(n), x1(n)),
                         |s| known(&out[..before], (pi, si, s)),
@@ -212,7 +211,7 @@ where
                         let mut first: Option<(f64, usize)> = None;
                         for hit in tree.locate_in_envelope_intersecting(reach) {
                             let f = &faces[hit.data];
-                            let c = corners(f);
+                            let c = face_corners(f);
                             if c.contains(&s) {
                                 continue;
                             }

@@ -3,7 +3,10 @@
 //! caller-owned slices (row-major `n_dof x n_dof`, `n_dof = dim x nodes`), so the
 //! assembly loop allocates nothing.
 
-use super::{kinematics, mass_rule, stiffness_rule, ElementKind, Kinematics};
+use super::{
+    kinematics, mass_rule, stiffness_rule, ElementKind, Kinematics, PointKinematics,
+    MAX_ELEMENT_DOFS,
+};
 
 /// The measure of a continuum element: its area (plane kinds, from the Jacobian) or
 /// volume (solids), signed by the Jacobian.
@@ -96,4 +99,46 @@ pub fn bar_mass(x: &[[f64; 3]], dim: usize, rho_a: f64, me: &mut [f64]) {
 pub fn bar_strain(x: &[[f64; 3]], dim: usize, ue: &[f64]) -> f64 {
     let (e, l) = bar_axis(x);
     (0..dim).fold(0.0, |s, i| s + (ue[dim + i] - ue[i]) * e[i]) / l
+}
+
+/// Adds one material point's `w Bᵀ σ` to the element force `fe` in the
+/// idealisation `K` (`k` its kinematics), or, for a bar (`k = None`, nodes `x`),
+/// the axial force `σ w / L` along it.
+#[inline]
+pub fn add_point_force<const D: usize, const V: usize, K: Kinematics<D, V>>(
+    k: Option<&PointKinematics>,
+    x: &[[f64; 3]],
+    nn: usize,
+    w: f64,
+    sigma: &[f64; V],
+    fe: &mut [f64; MAX_ELEMENT_DOFS],
+) {
+    match k {
+        Some(k) => K::add_bt_sigma(k, nn, w, sigma, fe),
+        None => {
+            let (ax, l) = bar_axis(x);
+            let n = sigma[0] * w / l;
+            for i in 0..D {
+                fe[i] -= n * ax[i];
+                fe[D + i] += n * ax[i];
+            }
+        }
+    }
+}
+
+/// Adds one material point's `w Bᵀ D B` to the element matrix `ke` in the
+/// idealisation `K`, or sets a bar's stiffness `D₀₀ w / L` along its axis.
+#[inline]
+pub fn add_point_tangent<const D: usize, const V: usize, K: Kinematics<D, V>>(
+    k: Option<&PointKinematics>,
+    x: &[[f64; 3]],
+    nn: usize,
+    w: f64,
+    d: &[[f64; V]; V],
+    ke: &mut [f64],
+) {
+    match k {
+        Some(k) => K::add_btdb(k, nn, d, w, ke),
+        None => bar_stiffness(x, D, d[0][0] * w / bar_axis(x).1, ke),
+    }
 }

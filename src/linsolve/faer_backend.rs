@@ -167,10 +167,10 @@ impl SymmetricSolver for FaerCholesky {
                 message: format!("out of memory allocating the {what}"),
             };
             let len = sym.len_val();
-            self.l_values = crate::memory::try_zeroed(len).ok_or_else(|| oom("factor values"))?;
+            self.l_values = crate::buffers::try_zeroed(len).ok_or_else(|| oom("factor values"))?;
             let freq = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
             let mut scratch = MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?;
-            crate::memory::touch(&mut scratch);
+            crate::buffers::touch(&mut scratch);
             self.factor_scratch = Some(scratch);
         }
         let mat = SparseColMatRef::new(Self::pattern(a), &a.values);

@@ -23,7 +23,6 @@ pub mod identify;
 pub mod linalg;
 pub mod mazars;
 pub mod point;
-pub mod point_driver;
 pub mod rankine_hill;
 pub mod store;
 pub mod viscoelastic;
@@ -33,8 +32,8 @@ pub use elastic::Elastic;
 pub use hardening::Hardening;
 pub use mazars::{MazarsParams, MazarsVariant, Regularisation};
 pub use point::{
-    dot3, mul3, sig, Constitutive, Dissipation, Moduli, PointResponse, PointStatus, StrainStep,
-    TangentKind, MAX_DRIVERS, MAX_STATE,
+    dot3, mul3, sig, Constitutive, Dissipation, Moduli, PointFailure, PointResponse, PointStatus,
+    StrainStep, TangentKind, MAX_DRIVERS, MAX_STATE,
 };
 pub use rankine_hill::RankineHillParams;
 pub use viscoelastic::{Sls, Viscosity};

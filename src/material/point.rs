@@ -17,6 +17,17 @@ pub const MAX_STATE: usize = 8;
 /// stride of the nonlocal averaging's buffers.
 pub const MAX_DRIVERS: usize = 2;
 
+/// A material point whose update failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointFailure {
+    /// Element block.
+    pub block: usize,
+    /// Element within the block.
+    pub element: usize,
+    /// Point within the block.
+    pub point: usize,
+}
+
 /// Whether a material update found its state.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PointStatus {

@@ -70,8 +70,8 @@ impl StateStore {
             n_points,
             n_state,
             voigt,
-            committed: crate::memory::zeroed(len),
-            trial: crate::memory::zeroed(len),
+            committed: crate::buffers::zeroed(len),
+            trial: crate::buffers::zeroed(len),
         }
     }
 

@@ -30,8 +30,8 @@ pub use correction::{Corrected, Correction, LinearCorrection};
 
 pub(crate) use free_dofs::{add_on_free, fill_free};
 
-use crate::assembly::internal::PointFailure;
 use crate::error::Result;
+use crate::material::PointFailure;
 use crate::system::{EffectiveSystem, Factored};
 
 /// What an evaluation of the residual reports besides the residual itself.

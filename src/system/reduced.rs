@@ -58,7 +58,7 @@ impl ReducedMatrix {
                 n: nf,
                 col_ptr,
                 row_idx,
-                values: crate::memory::zeroed(nnz),
+                values: crate::buffers::zeroed(nnz),
             },
             src,
             diag_pos,

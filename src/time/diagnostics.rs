@@ -94,7 +94,7 @@ fn unheld_load(model: &Model, dof: usize) -> Option<String> {
     }
     let mesh = &model.mesh;
     let body = mesh.node_body[dof / mesh.dim];
-    if !super::statics::bodies_held_by_contact_only(model).contains(&body) {
+    if !super::seat::bodies_held_by_contact_only(model).contains(&body) {
         return None;
     }
     let pairs: Vec<String> = model

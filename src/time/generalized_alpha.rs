@@ -1,13 +1,7 @@
 //! Chung and Hulbert's generalized-α (`analysis.scheme = "generalized_alpha"`): its
-//! parameters from `ρ∞`, the step's coefficients, the vectors of the step's start the
-//! residual pass reads, and the initial acceleration. The step itself is the implicit
-//! one (`time::implicit`, `time::residual`); theory: `theory/trapezoidal.md`.
-
-use super::operators::Operators;
-use super::State;
-use crate::error::{Error, Result};
-use crate::model::Model;
-use crate::system::{EffectiveSystem, Factored};
+//! parameters from `ρ∞` and the step's coefficients. The vectors of the step's start
+//! and the initial acceleration are `time::step_start`'s; the step itself is the
+//! implicit one (`time::implicit`, `time::residual`); theory: `theory/trapezoidal.md`.
 
 /// Generalized-α's parameters from `ρ∞` (Chung and Hulbert 1993):
 /// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ − α_m + α_f`,
@@ -70,91 +64,4 @@ pub(crate) struct AlphaStep {
     pub q_a: f64,
     pub h: f64,
     pub gamma: f64,
-}
-
-/// Generalized-α's vectors of the step's start, fixed through its iterations (what
-/// `residual::History` reads), and `M a_n`.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct StartVectors {
-    pub p: Vec<f64>,
-    pub q: Vec<f64>,
-    pub mq: Vec<f64>,
-    pub d: Vec<f64>,
-    ma_n: Vec<f64>,
-}
-
-impl StartVectors {
-    /// The vectors as the residual pass reads them.
-    pub fn history(&self) -> super::residual::History<'_> {
-        super::residual::History {
-            p: &self.p,
-            q: &self.q,
-            mq: &self.mq,
-            d: &self.d,
-        }
-    }
-}
-
-/// Fills `out` for the step from `s`: `p`, `q`, `mq` and `d` from `v_n`, `M v_n`, `a_n`
-/// and `M a_n`.
-pub(crate) fn history(ops: &Operators, a: &Alpha, s: &State, out: &mut StartVectors) {
-    let StartVectors { p, q, mq, d, ma_n } = out;
-    let st = a.at(ops.h());
-    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
-    let n = s.v.len();
-    ma_n.resize(n, 0.0);
-    ops.mass.matvec(&ops.asm.pattern, &s.a, ma_n);
-    let (v, mv, acc, ma) = (&s.v, &s.mv, &s.a, &*ma_n);
-    p.clear();
-    p.extend((0..n).map(|i| st.p_v * mv[i] + st.p_a * ma[i]));
-    q.clear();
-    q.extend((0..n).map(|i| st.q_v * v[i] + st.q_a * acc[i]));
-    mq.clear();
-    mq.extend((0..n).map(|i| st.q_v * mv[i] + st.q_a * ma[i]));
-    // C v_{n+1−α_f} less its Δu part: damp_m M(w q + (1 − w) v_n) + damp_k K(…).
-    let wq = st.w;
-    d.clear();
-    d.extend((0..n).map(|i| damp_m * (wq * mq[i] + (1.0 - wq) * mv[i])));
-    if damp_k != 0.0 {
-        let x: Vec<f64> = (0..n).map(|i| wq * q[i] + (1.0 - wq) * v[i]).collect();
-        let mut kx = vec![0.0; n];
-        ops.asm.pattern.matvec(&ops.k, &x, &mut kx);
-        for (di, k) in d.iter_mut().zip(&kx) {
-            *di += damp_k * k;
-        }
-    }
-}
-
-/// Generalized-α's `a_0`: `M a_0 = f_ext(0) − f_int(u_0) − C v_0` on the free dofs
-/// (zero on the constrained ones), one factorisation of `M` on the system's pattern.
-pub(crate) fn initial_acceleration(
-    model: &Model,
-    ops: &Operators,
-    sys: &mut EffectiveSystem,
-) -> Result<Vec<f64>> {
-    let s = ops.initial_state(model);
-    let n = s.v.len();
-    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
-    let mut kv = vec![0.0; n];
-    if damp_k != 0.0 {
-        ops.asm.pattern.matvec(&ops.k, &s.v, &mut kv);
-    }
-    let free = sys.dofs().free.clone();
-    let mut rhs: Vec<f64> = free
-        .iter()
-        .map(|&d| s.f_ext[d] - s.f_int[d] - damp_m * s.mv[d] - damp_k * kv[d])
-        .collect();
-    sys.refill(1.0, &ops.mass, &[]);
-    if let Factored::NotPositiveDefinite { message, .. } = sys.factorize()? {
-        return Err(Error::Solver {
-            backend: sys.backend(),
-            message: format!("the mass matrix for generalized-α's initial acceleration: {message}"),
-        });
-    }
-    sys.solve(&mut rhs)?;
-    let mut a0 = vec![0.0; n];
-    for (&d, x) in free.iter().zip(rhs) {
-        a0[d] = x;
-    }
-    Ok(a0)
 }

@@ -1,435 +1,26 @@
-//! What backward Euler and statics share: the operators (stiffness, mass, the
-//! constant tangent), the step problem they hand to the equilibrium loop, the step's
-//! scratch vectors, and the bookkeeping that turns a converged iterate into the new
-//! state and its ledger line.
-//!
-//! The step residual, with `Δu = u − u_n`, `v = Δu/h`:
-//! - backward Euler: `r(u) = M(v − v_n)/h + (zeta + a_m) M v + a_k K v + f_int(u) − f_ext`,
-//! - statics: `r(u) = f_int(u) − f_ext`,
-//!
-//! with `f_int(u) = f_int,n + K Δu` for linear elasticity and the Gauss-point loop
-//! otherwise. Its derivative is the effective matrix
-//! `K_eff = c_m M + c_k K + K_t` (`c_m = 1/h² + (zeta+a_m)/h` or 0, see
-//! [`Operators::coefficients`]). See `theory/scheme.md`.
+//! The implicit integrator, written once for backward Euler, the trapezoidal rule,
+//! generalized-α and statics ([`Implicit`]): the parts every implicit scheme holds
+//! ([`Core`]: operators, effective system, scratch, the correction, the predictor)
+//! and one step through the equilibrium loop ([`step`]). The step problem is
+//! `time::step_problem`'s, the kept factor `time::kept_factor`'s, the booking
+//! `time::booking`'s. `theory/scheme.md`.
 
+use std::marker::PhantomData;
 use std::time::Instant;
 
 use super::diagnostics::{describe, likely_cause};
 use super::forces::external_force;
-use super::nodal::{MassProduct, NodalState};
 use super::operators::{Operators, Response, Rule, Scheme};
 use super::predictor::Predictor;
-use super::residual::{residual_chunk, PassCoefficients, PassInputs, PassOutputs, PassSums};
-use super::{Rejection, State, StepOutcome, StepReport};
-use crate::assembly::internal::{new_stores, PointPass, PointTotals};
+use super::step_problem::{ImplicitStep, Scratch};
+use super::{Integrator, Rejection, SolverFacts, State, StepOutcome, StepReport, Timing};
 use crate::assembly::{Assembler, Mass};
 use crate::contact::ContactCorrection;
-use crate::energy::{Dissipation, StepIncrements, StepWork};
 use crate::error::{Error, Result};
-use crate::halves;
 use crate::linsolve::Backend;
-use crate::model::{ContactPredictor, IterationMethod, Model};
-use crate::nonlinear::{
-    self, Convergence, Correction, Evaluation, LinearCorrection, Outcome, StepProblem,
-};
+use crate::model::{ContactPredictor, Model};
+use crate::nonlinear::{self, Convergence, Correction, LinearCorrection, Outcome};
 use crate::system::{DofMap, EffectiveSystem, Factored};
-
-/// The vectors of the step being solved (reused from step to step).
-#[derive(Default)]
-pub(crate) struct Scratch {
-    /// The iterate `u_{n+1}`.
-    u_np1: Vec<f64>,
-    /// `u − u_n`.
-    du: Vec<f64>,
-    /// `v_{n+1} = Δu/h`.
-    v_np1: Vec<f64>,
-    /// `M v_{n+1}`.
-    mv_np1: Vec<f64>,
-    /// `f_int(u)`.
-    f_int_np1: Vec<f64>,
-    /// Applied external forces at `t_{n+1}`; the reactions are added once converged.
-    f_ext_np1: Vec<f64>,
-    /// Predicted internal force of the following step (nodal fields: of this step).
-    f_pred_np1: Vec<f64>,
-    /// Trial nodal fields.
-    nodal: NodalState,
-    /// `K Δu` (elastic) or `K v` (stiffness damping of history materials).
-    kdu: Vec<f64>,
-    /// `M Δu_c` in a prediction.
-    m_du: Vec<f64>,
-    /// `K_t Δu_c` in a prediction.
-    kt_du: Vec<f64>,
-    /// The residual (all dofs).
-    r: Vec<f64>,
-    /// Generalized-α: the step's start vectors, and the new acceleration.
-    alpha: super::generalized_alpha::StartVectors,
-    a_np1: Vec<f64>,
-    /// Tangent of the last evaluation (state-dependent materials).
-    kt: Vec<f64>,
-    /// The tangent the factor holds, and the factorisation count and coefficients
-    /// `(c_m, c_k, c_t)` it was made at: while a new tangent equals it bit for bit
-    /// (every Gauss point kept its tangent: elastic, or on an unchanged damage
-    /// state) the factor is kept instead of remade ([`ImplicitStep::update_matrix`]).
-    factored_kt: Vec<f64>,
-    kept: Option<(usize, (f64, f64, f64))>,
-    /// Factorisations spared so.
-    reused: usize,
-    /// With a kept factor: the last step took too many iterations on it (Newton) or
-    /// contracted too slowly (the fixed point), so the next step's first evaluation
-    /// refactorises.
-    refresh_pending: bool,
-    /// Steps whose iterations on a kept factor failed and were redone refactorising
-    /// at every changed tangent.
-    fallbacks: usize,
-    /// The factor can be solved with (its last factorisation succeeded).
-    factor_valid: bool,
-    /// Corrections taken over the run (a step's count includes a failed attempt on
-    /// a kept factor).
-    corrections: usize,
-    /// Material totals of the last evaluation.
-    totals: PointTotals,
-    /// The ledger sums of the last evaluation: the four work integrands (applied
-    /// loads), kinetic energy, the scheme's loss, and for elastic models the stored
-    /// energy and `½ Δu·K Δu`.
-    ledger_sums: PassSums,
-    nl: nonlinear::Scratch,
-}
-
-impl Scratch {
-    /// Relative residuals of the last step, one per evaluation.
-    pub fn history(&self) -> &[f64] {
-        self.nl.history()
-    }
-
-    pub fn new(n: usize, ops: &Operators, n_free: usize) -> Self {
-        let z = || vec![0.0; n];
-        Scratch {
-            u_np1: z(),
-            du: z(),
-            v_np1: z(),
-            mv_np1: z(),
-            f_int_np1: z(),
-            f_ext_np1: z(),
-            f_pred_np1: if matches!(ops.response, Response::Constant | Response::Nodal) {
-                z()
-            } else {
-                Vec::new()
-            },
-            nodal: NodalState::default(),
-            kdu: z(),
-            m_du: z(),
-            kt_du: z(),
-            r: z(),
-            alpha: Default::default(),
-            a_np1: Vec::new(),
-            kt: if matches!(ops.response, Response::StateDependent(_)) {
-                vec![0.0; ops.asm.pattern.nnz()]
-            } else {
-                Vec::new()
-            },
-            factored_kt: Vec::new(),
-            kept: None,
-            reused: 0,
-            refresh_pending: false,
-            fallbacks: 0,
-            factor_valid: true,
-            corrections: 0,
-            totals: PointTotals::default(),
-            ledger_sums: PassSums::default(),
-            nl: nonlinear::Scratch::new(n_free, ops.test.max_iterations),
-        }
-    }
-}
-
-/// The step problem handed to the equilibrium loop.
-struct ImplicitStep<'a> {
-    model: &'a Model,
-    ops: &'a Operators,
-    /// The committed state (its Gauss-point stores take the trial states).
-    s: &'a mut State,
-    w: &'a mut Scratch,
-    /// Prescribed displacements move in this step (`Δu_c ≠ 0`).
-    moving: bool,
-    /// The next evaluation keeps the histories committed (the first of a step with
-    /// moving prescribed displacements and a material with a frozen form).
-    frozen_first: bool,
-    /// The factor is kept while the iterations converge on it
-    /// ([`Convergence::refactor_rate`]); otherwise every tangent the iteration
-    /// method asks for is refactorised.
-    kept: bool,
-    /// No evaluation of this step has run yet.
-    first: bool,
-}
-
-impl StepProblem for ImplicitStep<'_> {
-    fn is_affine(&self) -> bool {
-        !matches!(self.ops.response, Response::StateDependent(_))
-    }
-
-    fn predict(&mut self, u: &[f64], free: &[usize], rhs: &mut Vec<f64>) -> bool {
-        let (ops, s, w) = (self.ops, &*self.s, &mut *self.w);
-        if let Some(laws) = &ops.nodal {
-            laws.predicted_force(ops.h(), &s.nodal, &mut w.f_pred_np1);
-        }
-        let base: &[f64] = match ops.response {
-            Response::Elastic => &s.f_int,
-            Response::Nodal => &w.f_pred_np1,
-            Response::Constant if s.f_pred_h == ops.h() && !s.f_pred.is_empty() => &s.f_pred,
-            // Damage and plasticity at the unchanged start of the step: the committed
-            // force (with a kept factor; full Newton starts from an evaluation).
-            Response::StateDependent(_)
-                if self.kept && !self.moving && ops.rate_independent && w.factor_valid =>
-            {
-                &s.f_int
-            }
-            _ => return false,
-        };
-        let _ = u; // The start of the step: its increment Δu_c is in `w.du`.
-        let (c_m, c_k, c_t) = ops.coefficients();
-        if self.moving {
-            // Δu_c is nonzero on prescribed dofs only.
-            let p = &ops.asm.pattern;
-            ops.mass.matvec(p, &w.du, &mut w.m_du);
-            p.matvec(&ops.k, &w.du, &mut w.kdu);
-            if c_t != 0.0 {
-                p.matvec(&ops.kt, &w.du, &mut w.kt_du);
-            }
-        }
-        let inv_h = ops.dynamic().map(|(h, _, _)| 1.0 / h);
-        let moving = self.moving;
-        let (mv_n, f_ext, m_du, kdu, kt_du) = (&s.mv, &w.f_ext_np1, &w.m_du, &w.kdu, &w.kt_du);
-        let (f_int_n, f_ext_n) = (&s.f_int, &s.f_ext);
-        let rule = ops.rule();
-        let (hist_p, hist_d) = (&w.alpha.p, &w.alpha.d);
-        let value = |i: usize| {
-            // The residual at Δu = Δu_c: the forces at the step's end (averaged with
-            // the start's by the trapezoidal rule and generalized-α), the momentum of
-            // the start.
-            let mut r = match rule {
-                Rule::BackwardEuler => base[i] - f_ext[i],
-                Rule::Trapezoidal => 0.5 * (base[i] + f_int_n[i]) - 0.5 * (f_ext[i] + f_ext_n[i]),
-                Rule::GeneralizedAlpha(a) => {
-                    let w = 1.0 - a.alpha_f;
-                    w * base[i] + (1.0 - w) * f_int_n[i] - w * f_ext[i] - (1.0 - w) * f_ext_n[i]
-                }
-            };
-            if let Some(inv_h) = inv_h {
-                r -= match rule {
-                    Rule::BackwardEuler => mv_n[i] * inv_h,
-                    Rule::Trapezoidal => 2.0 * mv_n[i] * inv_h,
-                    Rule::GeneralizedAlpha(_) => hist_p[i] - hist_d[i],
-                };
-            }
-            if moving {
-                r += c_m * m_du[i] + c_k * kdu[i];
-                if c_t != 0.0 {
-                    r += c_t * kt_du[i];
-                }
-            }
-            -r
-        };
-        nonlinear::fill_free(free, rhs, value, (), |_, _, _| (), |_, _| ());
-        true
-    }
-
-    fn wants_tangent(&mut self, iteration: usize, slow: bool) -> bool {
-        let first = std::mem::take(&mut self.first);
-        match (self.ops.response, self.kept) {
-            (Response::StateDependent(IterationMethod::Newton), false) => true,
-            (Response::StateDependent(IterationMethod::Fixed), false) => iteration == 0,
-            // A kept factor is remade with the tangent of the iterate after a slow
-            // iteration (Newton), or at the start of the step after a slow one (the
-            // fixed point keeps one factor through a step).
-            // The paper's first estimate (the committed damage at the jump of the
-            // prescribed values) is a secant solve: it gets its own factor.
-            (Response::StateDependent(IterationMethod::Newton), true) => {
-                let w = &mut *self.w;
-                slow || self.frozen_first
-                    || !w.factor_valid
-                    || (first && std::mem::take(&mut w.refresh_pending))
-            }
-            (Response::StateDependent(IterationMethod::Fixed), true) => {
-                let w = &mut *self.w;
-                w.refresh_pending |= slow;
-                !w.factor_valid || (first && std::mem::take(&mut w.refresh_pending))
-            }
-            _ => false,
-        }
-    }
-
-    fn evaluate(&mut self, u: &[f64], tangent: bool) -> Evaluation {
-        let (ops, model) = (self.ops, self.model);
-        let (s, w) = (&mut *self.s, &mut *self.w);
-        let h = ops.h();
-        let dynamic = ops.dynamic();
-        // `w.du` is `u − u_n`: set at the start of the step and kept by
-        // `apply_correction`. `mv_np1` holds M Δu until the residual pass scales it to M v = M Δu/h, and
-        // `kdu` holds K Δu (the elastic force increment, and h K v for damping).
-        let p = &ops.asm.pattern;
-        let mut failure = None;
-        let mut provisional = false;
-        let elastic = ops.response == Response::Elastic;
-        if elastic {
-            // K Δu (and M Δu with a consistent mass) in one pass over the pattern.
-            if dynamic.is_some() {
-                ops.mass
-                    .with_product(p, &ops.k, &w.du, &mut w.kdu, &w.du, &mut w.mv_np1);
-            } else {
-                p.matvec(&ops.k, &w.du, &mut w.kdu);
-            }
-        } else if let Some(laws) = &ops.nodal {
-            if w.nodal.is_empty() {
-                w.nodal = s.nodal.clone();
-            }
-            let t = laws.evaluate(
-                p,
-                &ops.k,
-                h,
-                u,
-                &w.du,
-                &s.nodal,
-                &mut w.nodal,
-                &mut w.f_int_np1,
-                &mut w.kdu,
-                dynamic.is_some().then_some(MassProduct {
-                    m: &ops.mass,
-                    out: &mut w.mv_np1,
-                }),
-            );
-            w.totals = PointTotals {
-                psi: t.psi,
-                dissipation: t.dissipation,
-                failure: None,
-            };
-        } else {
-            let pred = (!w.f_pred_np1.is_empty()).then_some(&mut w.f_pred_np1[..]);
-            let kt = tangent.then_some(&mut w.kt[..]);
-            // The first evaluation of a step whose prescribed displacements jump keeps
-            // the damage of the last step (the paper's first estimate): evaluated at
-            // the jump, the whole increment sits in the elements next to the moved
-            // dofs and could damage them in an iterate the solution never visits.
-            let frozen = std::mem::take(&mut self.frozen_first);
-            provisional = frozen;
-            let pass = PointPass {
-                u,
-                dt: h,
-                at_rest: false,
-                frozen,
-            };
-            w.totals = ops.internal(model, pass, &mut s.points, &mut w.f_int_np1, pred, kt);
-            failure = w.totals.failure;
-            if let Some((_, _, damp_k)) = dynamic {
-                if damp_k != 0.0 {
-                    ops.mass
-                        .with_product(p, &ops.k, &w.du, &mut w.kdu, &w.du, &mut w.mv_np1);
-                } else {
-                    ops.mass.matvec(p, &w.du, &mut w.mv_np1);
-                }
-            }
-        }
-        // The residual and its scales in one pass; it also finishes M v, v and, for
-        // elastic models, f_int = f_int,n + K Δu, and sums the step's ledger terms
-        // (with the applied loads: `finish` adds what the reactions do).
-        let (damp_m, damp_k) = dynamic.map_or((0.0, 0.0), |(_, m, k)| (m, k));
-        let trapezoidal = ops.rule() == Rule::Trapezoidal;
-        let alpha = match ops.rule() {
-            Rule::GeneralizedAlpha(a) => Some(a.at(h)),
-            _ => None,
-        };
-        let c = PassCoefficients {
-            inv_h: 1.0 / h,
-            damp_m,
-            damp_k,
-            alpha,
-        };
-        let inputs = PassInputs {
-            du: &w.du,
-            kdu: &w.kdu,
-            f_ext: &w.f_ext_np1,
-            mv_n: &s.mv,
-            v_n: &s.v,
-            f_int_n: &s.f_int,
-            f_ext_n: &s.f_ext,
-            free: &ops.free_mask,
-            history: alpha.map(|_| w.alpha.history()),
-        };
-        // In halves of a fixed tree (`crate::halves`): the same sums in every run, on
-        // any number of threads.
-        let n = w.r.len();
-        let outputs = [
-            &mut w.r[..],
-            &mut w.f_int_np1[..],
-            &mut w.mv_np1[..],
-            &mut w.v_np1[..],
-        ];
-        let leaf = |(lo, [r, f_int, mv, v]): halves::Slices<4>| {
-            let inp = inputs.range(lo, lo + r.len());
-            let out = PassOutputs { r, f_int, mv, v };
-            match (dynamic.is_some(), elastic, trapezoidal, alpha.is_some()) {
-                (true, true, _, true) => residual_chunk::<true, true, false, true>(&inp, out, &c),
-                (true, false, _, true) => residual_chunk::<true, false, false, true>(&inp, out, &c),
-                (true, true, true, _) => residual_chunk::<true, true, true, false>(&inp, out, &c),
-                (true, false, true, _) => residual_chunk::<true, false, true, false>(&inp, out, &c),
-                (true, true, false, _) => residual_chunk::<true, true, false, false>(&inp, out, &c),
-                (true, false, false, _) => {
-                    residual_chunk::<true, false, false, false>(&inp, out, &c)
-                }
-                (false, true, ..) => residual_chunk::<false, true, false, false>(&inp, out, &c),
-                (false, false, ..) => residual_chunk::<false, false, false, false>(&inp, out, &c),
-            }
-        };
-        let sums = halves::in_halves(
-            (0, outputs),
-            n,
-            halves::VECTOR_LEAF,
-            &halves::split_slices,
-            &leaf,
-            &PassSums::merge,
-        );
-        w.ledger_sums = sums;
-        Evaluation {
-            force_scale2: sums.force_scale2,
-            magnitude2: sums.magnitude2,
-            increment2: sums.increment2,
-            tangent,
-            failure,
-            provisional,
-        }
-    }
-
-    fn residual(&self) -> &[f64] {
-        &self.w.r
-    }
-
-    fn residual_mut(&mut self) -> &mut [f64] {
-        &mut self.w.r
-    }
-
-    /// Keeps the factor when the new tangent is the one it holds (same factor, same
-    /// coefficients, the same values bit for bit: the solve is then the one a
-    /// refactorisation would give), and refactorises otherwise.
-    fn update_matrix(&mut self, sys: &mut EffectiveSystem) -> Result<Factored> {
-        let w = &mut *self.w;
-        let key = (sys.factorizations(), self.ops.coefficients());
-        if w.kept == Some(key) && w.factored_kt == w.kt {
-            w.reused += 1;
-            return Ok(Factored::Ok);
-        }
-        let f = self.ops.refactor(sys, &w.kt)?;
-        w.factor_valid = f == Factored::Ok;
-        w.kept = None;
-        if f == Factored::Ok {
-            w.factored_kt.clone_from(&w.kt);
-            w.kept = Some((sys.factorizations(), self.ops.coefficients()));
-        }
-        Ok(f)
-    }
-
-    fn apply_correction(&mut self, u: &mut [f64], free: &[usize], delta: &[f64]) -> f64 {
-        self.w.corrections += 1;
-        nonlinear::add_on_free(free, delta, u, Some(&mut self.w.du))
-    }
-}
 
 /// How an implicit step corrects its iterates: one solve, or the contact QP.
 pub(crate) enum Corrector<'m> {
@@ -510,7 +101,7 @@ pub(crate) fn step(
         }
     }
     if let Rule::GeneralizedAlpha(a) = ops.rule() {
-        super::generalized_alpha::history(ops, &a, s, &mut w.alpha);
+        super::step_start::history(ops, &a, s, &mut w.alpha);
     }
     let mut u = std::mem::take(&mut w.u_np1);
     let corrections_before = w.corrections;
@@ -552,7 +143,7 @@ pub(crate) fn step(
         // The iterations on a kept factor failed where refactorising at every
         // changed tangent may not: the step again from its start, as full Newton
         // (or the fixed point with a factor per step) would take it.
-        w.fallbacks += 1;
+        w.factor.fallbacks += 1;
         start_iterate(model, s, t1, &mut u, &mut w.du);
         outcome = attempt(false, &mut u, w, s)?;
     }
@@ -563,11 +154,8 @@ pub(crate) fn step(
             residual,
             iterations,
         } => {
-            // A step that needed more iterations on the kept factor than a refreshed
-            // one would: the factor no longer fits the state (points that yielded and
-            // now unload, a zone that stopped growing), so the next step remakes it.
-            if kept && iterations > nonlinear::KEPT_ITERATIONS as usize + 1 {
-                w.refresh_pending = true;
+            if kept {
+                w.factor.converged_in(iterations);
             }
             StepReport {
                 iterations: w.corrections - corrections_before,
@@ -620,7 +208,7 @@ pub(crate) fn step(
         }
     };
     let contact = correction.finish(&w.du, s);
-    finish(ops, sys.dofs(), w, s, t1, contact, predicted);
+    super::booking::finish(ops, sys.dofs(), w, s, t1, contact, predicted);
     if let Some((quantity, value)) = s.ledger.first_non_finite() {
         return Err(Error::NonFinite {
             quantity: format!("the ledger line {quantity}"),
@@ -661,147 +249,6 @@ fn first_non_finite(
     })
 }
 
-/// Books the converged step and makes it the state. The last evaluation summed the
-/// step's ledger terms with the applied loads; the reactions (the residual on the
-/// constrained dofs) are added here, with their part of the work terms.
-fn finish(
-    ops: &Operators,
-    dofs: &DofMap,
-    w: &mut Scratch,
-    s: &mut State,
-    t1: f64,
-    (contact, friction): (f64, f64),
-    predictor: f64,
-) {
-    let mut sums = w.ledger_sums;
-    let trapezoidal = ops.rule() == Rule::Trapezoidal;
-    // The residual on a constrained dof is the reaction the step's equation needs:
-    // at the end (backward Euler), or in the average ½(R_n + R_{n+1}) (trapezoidal).
-    let end_weight = 1.0 / ops.rule().theta();
-    for &d in &dofs.constrained {
-        let reaction = end_weight * w.r[d];
-        w.f_ext_np1[d] += reaction;
-        // External work and load jump are linear in f_ext,n+1.
-        sums.work[1] += w.du[d] * reaction;
-        sums.work[2] += w.du[d] * reaction;
-    }
-    let work = StepWork::from_sums(sums.work);
-    let alpha_f = match ops.rule() {
-        Rule::GeneralizedAlpha(a) => Some(a.alpha_f),
-        _ => None,
-    };
-    let (elastic_energy, mut material) = if ops.response == Response::Elastic {
-        (
-            ops.stored.of(&w.u_np1, &w.f_int_np1),
-            Dissipation {
-                numerical: match (trapezoidal, alpha_f) {
-                    (true, _) => 0.0,
-                    // Δu·f_int,n+1−α_f = ΔE_el + (1 − 2α_f) ½Δu·KΔu.
-                    (_, Some(af)) => (1.0 - 2.0 * af) * sums.elastic_loss,
-                    _ => sums.elastic_loss,
-                },
-                ..Default::default()
-            },
-        )
-    } else {
-        (w.totals.psi, w.totals.dissipation)
-    };
-    // The trapezoidal rule works with ½Δu·(f_int,n + f_int,n+1) where the points book
-    // σ_{n+1}:Δε (their algorithmic loss is backward Euler's), and with the averaged
-    // loads, so the load jump is no loss of it (theory/trapezoidal.md). Generalized-α
-    // weighs the start by α_f: 2α_f of the jumps, and its inertia's own loss.
-    let scheme_loss = if trapezoidal {
-        if ops.response != Response::Elastic {
-            material.numerical -= sums.internal_jump;
-        }
-        work.load_jump
-    } else if let Some(af) = alpha_f {
-        if ops.response != Response::Elastic {
-            material.numerical -= 2.0 * af * sums.internal_jump;
-        }
-        sums.scheme_loss + 2.0 * af * work.load_jump
-    } else {
-        sums.scheme_loss
-    };
-    if let Rule::GeneralizedAlpha(a) = ops.rule() {
-        // a_{n+1} from v_{n+1} = v_n + h((1 − γ) a_n + γ a_{n+1}).
-        let h = ops.h();
-        let g = a.gamma;
-        w.a_np1.clear();
-        w.a_np1.extend(
-            w.v_np1
-                .iter()
-                .zip(&s.v)
-                .zip(&s.a)
-                .map(|((v1, v0), a0)| (v1 - v0 - h * (1.0 - g) * a0) / (h * g)),
-        );
-        std::mem::swap(&mut s.a, &mut w.a_np1);
-    }
-    s.ledger.record(&StepIncrements {
-        kinetic: sums.kinetic,
-        elastic: elastic_energy,
-        work,
-        material,
-        scheme_loss,
-        contact,
-        friction,
-        predictor,
-    });
-    std::mem::swap(&mut s.u, &mut w.u_np1);
-    std::mem::swap(&mut s.f_int, &mut w.f_int_np1);
-    std::mem::swap(&mut s.f_ext, &mut w.f_ext_np1);
-    if ops.dynamic().is_some() {
-        std::mem::swap(&mut s.v, &mut w.v_np1);
-        std::mem::swap(&mut s.mv, &mut w.mv_np1);
-    }
-    if ops.response == Response::Nodal {
-        std::mem::swap(&mut s.nodal, &mut w.nodal);
-    } else {
-        if !w.f_pred_np1.is_empty() {
-            std::mem::swap(&mut s.f_pred, &mut w.f_pred_np1);
-            s.f_pred_h = ops.h();
-        }
-        s.points.iter_mut().for_each(|p| p.commit());
-    }
-    s.t = t1;
-    s.step += 1;
-}
-
-/// The matrices of a model's first step, for export: `K` and `M` on the shared
-/// pattern (with the assembler), and the effective matrix on the free dofs, analysed
-/// but not factorised (the tangent at rest for materials with history).
-pub fn first_matrices(model: &Model) -> Result<(Assembler, Vec<f64>, Mass, EffectiveSystem)> {
-    let a = &model.analysis;
-    let scheme = match a.time.kind {
-        crate::model::AnalysisKind::Dynamic => Scheme::Dynamic {
-            h: a.time.dt,
-            damp_m: a.damping.zeta + a.damping.rayleigh[0],
-            damp_k: a.damping.rayleigh[1],
-            rule: super::operators::Rule::of(&a.time),
-        },
-        crate::model::AnalysisKind::Static => Scheme::Static { dt: a.time.dt },
-    };
-    let ops = Operators::new(model, scheme);
-    let mut sys = ops.analysed_system(model, Backend::Faer)?;
-    let kt = match ops.response {
-        Response::StateDependent(_) => {
-            let stores = new_stores(&model.mesh, &model.materials);
-            let u0 = vec![0.0; model.mesh.n_dofs()];
-            ops.asm.tangent(
-                &model.mesh,
-                &model.materials,
-                model.idealisation,
-                &u0,
-                ops.h(),
-                &stores,
-            )
-        }
-        _ => ops.kt.clone(),
-    };
-    ops.refill(&mut sys, &kt);
-    Ok((ops.asm, ops.k, ops.mass, sys))
-}
-
 /// The integrator parts every implicit scheme holds.
 pub(crate) struct Core<'m> {
     pub model: &'m Model,
@@ -834,7 +281,7 @@ impl<'m> Core<'m> {
         if matches!(ops.rule(), super::operators::Rule::GeneralizedAlpha(_))
             && factored == Factored::Ok
         {
-            ops.a0 = super::generalized_alpha::initial_acceleration(model, &ops, &mut sys)?;
+            ops.a0 = super::step_start::initial_acceleration(model, &ops, &mut sys)?;
             factored = ops.refactor(&mut sys, &ops.kt)?;
         }
         if let Factored::NotPositiveDefinite { dof, message } = factored {
@@ -855,8 +302,7 @@ impl<'m> Core<'m> {
         let mut scratch = Scratch::new(model.mesh.n_dofs(), &ops, sys.dofs().n_free());
         if let Some(kt) = kt_at_rest {
             // The factor holds the tangent at rest: kept while the points stay there.
-            scratch.factored_kt = kt;
-            scratch.kept = Some((sys.factorizations(), ops.coefficients()));
+            scratch.factor.hold(kt, &sys, ops.coefficients());
         }
         Ok(Core {
             model,
@@ -914,7 +360,7 @@ impl<'m> Core<'m> {
             // tangent at rest of the new size replaces it, and the iterations remake
             // it from there when they need to.
             let f = self.ops.refactor(&mut self.sys, &self.ops.kt)?;
-            self.scratch.factor_valid = f == Factored::Ok;
+            self.scratch.factor.valid = f == Factored::Ok;
             return Ok(());
         }
         match self.ops.refactor(&mut self.sys, &self.ops.kt)? {
@@ -926,9 +372,9 @@ impl<'m> Core<'m> {
     }
 
     /// Time per phase.
-    pub fn timing(&self) -> super::Timing {
+    pub fn timing(&self) -> Timing {
         let t = self.sys.timing();
-        super::Timing {
+        Timing {
             assembly_s: self.assembly_s,
             factorization_s: t.analysis_s + t.factorization_s,
             solve_s: t.solve_s,
@@ -937,13 +383,176 @@ impl<'m> Core<'m> {
     }
 
     /// Solver facts.
-    pub fn solver(&self) -> super::SolverFacts {
-        super::SolverFacts {
+    pub fn solver(&self) -> SolverFacts {
+        SolverFacts {
             backend: self.sys.backend(),
             factorizations: self.sys.factorizations(),
-            reused_factors: self.scratch.reused,
-            fallbacks: self.scratch.fallbacks,
+            reused_factors: self.scratch.factor.reused,
+            fallbacks: self.scratch.factor.fallbacks,
             factor_nnz: self.sys.factor_nnz(),
         }
+    }
+}
+
+/// Which implicit problem an [`Implicit`] integrator solves: the dynamics of the
+/// model's scheme ([`Dynamic`]) or static equilibrium ([`Quasistatic`]).
+pub trait ImplicitKind {
+    /// Static equilibrium (no inertia) rather than dynamics.
+    const STATIC: bool;
+}
+
+/// Dynamics by the implicit scheme the model's `analysis.scheme` names (backward
+/// Euler, the trapezoidal rule, generalized-α).
+#[derive(Clone, Copy, Debug)]
+pub struct Dynamic;
+
+impl ImplicitKind for Dynamic {
+    const STATIC: bool = false;
+}
+
+/// Static equilibrium at load steps.
+#[derive(Clone, Copy, Debug)]
+pub struct Quasistatic;
+
+impl ImplicitKind for Quasistatic {
+    const STATIC: bool = true;
+}
+
+/// An implicit integrator: matrices, solver and scratch of one model
+/// ([`super::backward_euler::BackwardEuler`] and [`super::statics::Statics`] are its
+/// two kinds).
+pub struct Implicit<'m, S: ImplicitKind> {
+    core: Core<'m>,
+    kind: PhantomData<S>,
+}
+
+impl<'m, S: ImplicitKind> Implicit<'m, S> {
+    /// Assembles `K` (and `M`), the effective matrix, analyses and factorises it
+    /// (a body nothing holds is an error that says so).
+    pub fn new(model: &'m Model, backend: Backend) -> Result<Self> {
+        Self::with_memory_limit(model, backend, None)
+    }
+
+    /// [`Implicit::new`], refusing a factor whose memory estimate exceeds
+    /// `memory_limit` bytes before it is allocated.
+    pub fn with_memory_limit(
+        model: &'m Model,
+        backend: Backend,
+        memory_limit: Option<u64>,
+    ) -> Result<Self> {
+        let a = &model.analysis;
+        let scheme = if S::STATIC {
+            Scheme::Static { dt: a.time.dt }
+        } else {
+            Scheme::Dynamic {
+                h: a.time.dt,
+                damp_m: a.damping.zeta + a.damping.rayleigh[0],
+                damp_k: a.damping.rayleigh[1],
+                rule: Rule::of(&a.time),
+            }
+        };
+        Ok(Implicit {
+            core: Core::new(model, backend, scheme, memory_limit)?,
+            kind: PhantomData,
+        })
+    }
+
+    /// Solver backend name.
+    pub fn backend(&self) -> &'static str {
+        self.core.sys.backend()
+    }
+
+    /// Number of nonzeros of the Cholesky factor.
+    pub fn factor_nnz(&self) -> Option<usize> {
+        self.core.sys.factor_nnz()
+    }
+
+    /// Entries of the Cholesky factor on and below the diagonal.
+    pub fn factor_lower_entries(&self) -> Option<usize> {
+        self.core.sys.factor_lower_entries()
+    }
+
+    /// Numeric factorisations so far.
+    pub fn factorizations(&self) -> usize {
+        self.core.sys.factorizations()
+    }
+
+    /// The state at `t = 0`: prescribed displacements, bodies' initial velocities,
+    /// history materials at rest.
+    pub fn initial_state(&self) -> State {
+        self.core.ops.initial_state(self.core.model)
+    }
+
+    /// The elastic stiffness on the shared pattern.
+    pub fn stiffness(&self) -> &[f64] {
+        &self.core.ops.k
+    }
+
+    /// The mass matrix.
+    pub fn mass(&self) -> &Mass {
+        &self.core.ops.mass
+    }
+
+    /// The assembler (pattern and colours).
+    pub fn assembler(&self) -> &Assembler {
+        &self.core.ops.asm
+    }
+
+    /// The free-dof numbering.
+    pub fn dofs(&self) -> &DofMap {
+        self.core.sys.dofs()
+    }
+
+    /// Relative residuals of the last step's equilibrium iterations, one per
+    /// evaluation of the residual.
+    pub fn residual_history(&self) -> &[f64] {
+        self.core.scratch.history()
+    }
+
+    /// Time and counts of the contact correction, when the model has contact.
+    pub fn contact_stats(&self) -> Option<crate::contact::implicit::ContactStats> {
+        match &self.core.correction {
+            Corrector::Contact(c) => Some(c.stats()),
+            Corrector::Linear(_) => None,
+        }
+    }
+
+    /// The effective system (matrix, factor, solves).
+    pub fn system(&mut self) -> &mut EffectiveSystem {
+        &mut self.core.sys
+    }
+}
+
+impl<S: ImplicitKind> Integrator for Implicit<'_, S> {
+    fn model(&self) -> &Model {
+        self.core.model
+    }
+
+    fn h(&self) -> f64 {
+        self.core.ops.h()
+    }
+
+    fn set_step(&mut self, h: f64) -> Result<()> {
+        self.core.set_step(h)
+    }
+
+    fn initial_state(&mut self) -> Result<State> {
+        Ok(Implicit::initial_state(self))
+    }
+
+    fn step(&mut self, s: &mut State) -> Result<StepOutcome> {
+        self.core.step(s)
+    }
+
+    fn timing(&self) -> Timing {
+        self.core.timing()
+    }
+
+    fn output_points(&self, s: &State) -> Option<Vec<crate::material::store::StateStore>> {
+        self.core.ops.output_points(self.core.model, s)
+    }
+
+    fn solver(&self) -> SolverFacts {
+        self.core.solver()
     }
 }

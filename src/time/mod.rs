@@ -5,22 +5,29 @@
 //! An [`Integrator`] owns its matrices, solver and scratch; the [`State`] lives
 //! outside it, so a step can be repeated or cut back by copying the state, and
 //! [`march::march`] drives any integrator to the end time with step cuts. Start with
-//! [`backward_euler::BackwardEuler`]; its step equation goes through the one
+//! [`backward_euler::BackwardEuler`] ([`Implicit`]); its step equation goes through the one
 //! equilibrium loop of [`crate::nonlinear`].
 
 pub mod backward_euler;
+mod booking;
 pub mod central_difference;
 pub mod cfl;
 mod diagnostics;
+mod export;
 pub mod forces;
 mod generalized_alpha;
 mod implicit;
+mod kept_factor;
 pub mod march;
 pub mod nodal;
 mod operators;
 mod predictor;
 mod residual;
-pub use implicit::first_matrices;
+mod seat;
+mod step_problem;
+mod step_start;
+pub use export::first_matrices;
+pub use implicit::{Dynamic, Implicit, ImplicitKind, Quasistatic};
 pub mod statics;
 
 use crate::energy::Ledger;

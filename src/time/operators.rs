@@ -113,7 +113,7 @@ pub(crate) struct Operators {
     pub rate_independent: bool,
     /// Statics: the multiple of `M` added to the matrix (never to the residual) while
     /// a body in contact has rigid motions no support holds
-    /// ([`super::statics::STATIC_SEAT`]).
+    /// ([`super::seat::STATIC_SEAT`]).
     pub seat: f64,
     /// The stored energy of elastic models, translation removed.
     pub stored: crate::energy::StoredEnergy,
@@ -178,7 +178,7 @@ impl Operators {
         }
         ops.update_constant_tangent(model);
         if matches!(scheme, Scheme::Static { .. }) {
-            ops.seat = super::statics::seat(model, &ops.asm.pattern, &ops.k, &ops.mass);
+            ops.seat = super::seat::seat(model, &ops.asm.pattern, &ops.k, &ops.mass);
         }
         ops
     }
@@ -286,7 +286,7 @@ impl Operators {
     ) -> Result<(EffectiveSystem, Factored, Option<Vec<f64>>)> {
         let mut sys = self.analysed_system(model, backend)?;
         // The analysis knows the factor's size: refuse before it is allocated.
-        crate::config::memory_estimate(model, sys.factor_nnz())
+        crate::memory::of_model(model, sys.factor_nnz())
             .check(memory_limit, "the factorisation")?;
         let factored = match self.response {
             Response::StateDependent(_) => {

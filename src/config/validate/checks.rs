@@ -4,7 +4,7 @@ use crate::error::{Error, Result};
 use crate::model::TimeFunction;
 
 /// `v` is positive and finite.
-pub(crate) fn positive(field: &str, v: f64) -> Result<()> {
+pub fn positive(field: &str, v: f64) -> Result<()> {
     if v > 0.0 && v.is_finite() {
         Ok(())
     } else {
@@ -16,7 +16,7 @@ pub(crate) fn positive(field: &str, v: f64) -> Result<()> {
 }
 
 /// Every entry of `v` is finite; the error names the first one that is not.
-pub(crate) fn finite(field: &str, v: &[f64]) -> Result<()> {
+pub fn finite(field: &str, v: &[f64]) -> Result<()> {
     match v.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(i) if v.len() == 1 => Err(Error::config(
@@ -68,7 +68,7 @@ pub(crate) fn check_elastic(field: &str, e: f64, nu: f64, rho: f64) -> Result<()
 }
 
 /// Every number of a time function is finite and its shape is valid.
-pub(crate) fn check_function(field: &str, f: &TimeFunction) -> Result<()> {
+pub fn check_function(field: &str, f: &TimeFunction) -> Result<()> {
     match f {
         TimeFunction::Constant => Ok(()),
         TimeFunction::Step { at } => finite(&format!("{field}.at"), &[*at]),

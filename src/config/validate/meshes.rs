@@ -1,5 +1,6 @@
 //! Body meshes and bars: generated rectangles (sized before they are built), Gmsh
-//! files, bars along lines of nodes, and the memory estimate of the whole model.
+//! files, bars along lines of nodes, and the memory check of the whole model
+//! (the estimate itself is [`crate::memory`]'s).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -305,7 +306,7 @@ pub(super) fn check_generated_size(
 /// The memory estimate of the built mesh (the factor from its size: the exact
 /// figure is checked again after the symbolic analysis, before the factorisation).
 pub(super) fn check_memory(mesh: &Mesh, materials: &[Material], opts: &LoadOptions) -> Result<()> {
-    let est = estimate(mesh, materials, None);
+    let est = crate::memory::of_mesh(mesh, materials, None);
     est.check(
         opts.memory_limit,
         &format!(
@@ -314,41 +315,6 @@ pub(super) fn check_memory(mesh: &Mesh, materials: &[Material], opts: &LoadOptio
             mesh.n_elements()
         ),
     )
-}
-
-/// The memory estimate of a model, with the factor's exact nonzeros when known.
-pub fn estimate(mesh: &Mesh, materials: &[Material], factor_nnz: Option<usize>) -> Estimate {
-    let points: u64 = mesh
-        .blocks
-        .iter()
-        .map(|b| {
-            (b.elements.len() * crate::assembly::internal::points_per_element(b.elements.kind))
-                as u64
-        })
-        .sum();
-    let voigt = crate::assembly::internal::voigt_of(mesh);
-    let history = materials
-        .iter()
-        .map(|m| m.n_state(voigt))
-        .max()
-        .unwrap_or(0) as u64;
-    let tangent = materials.iter().any(|m| !m.has_constant_tangent());
-    let mut est = Estimate::of(
-        mesh.dim,
-        mesh.n_nodes() as u64,
-        mesh.n_elements() as u64,
-        points,
-        history,
-        factor_nnz.map_or_else(
-            || factor_nnz_estimate(mesh.n_dofs(), mesh.dim),
-            |n| n as u64,
-        ),
-        tangent,
-    );
-    // The nonlocal table (index and weight per entry) and its per-point buffers.
-    let (nl_points, nl_entries) = crate::assembly::nonlocal::estimated_entries(mesh, materials);
-    est.state += 12 * nl_entries + 64 * nl_points;
-    est
 }
 
 /// A body's part from its mesh spec.

@@ -17,9 +17,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 pub use checks::HUGE_STEPS;
-pub(crate) use checks::{check_function, finite, positive};
+pub use checks::{check_function, finite, positive};
 pub use materials::material;
-pub use meshes::estimate;
 
 use super::{LoadOptions, Scenario};
 use crate::error::{Error, Result};
@@ -283,7 +282,7 @@ fn initial_overlap(model: &Model) -> Result<()> {
         crate::contact::rows::Contactee::Mortar => "the master surface (mortar)".to_string(),
         crate::contact::rows::Contactee::Face { nodes, .. } => format!(
             "the master face of nodes {}",
-            crate::contact::faces::corners(&nodes)
+            crate::model::face_corners(&nodes)
                 .iter()
                 .map(|n| n.to_string())
                 .collect::<Vec<_>>()

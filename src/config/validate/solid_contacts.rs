@@ -47,7 +47,7 @@ pub(super) fn sides(
             let faces = master_faces(mesh, &format!("{field}.master"), m)?;
             let mut master_nodes: Vec<usize> = faces
                 .iter()
-                .flat_map(|f| crate::contact::faces::corners(f).iter().copied())
+                .flat_map(|f| crate::model::face_corners(f).iter().copied())
                 .collect();
             master_nodes.sort_unstable();
             master_nodes.dedup();
@@ -131,7 +131,7 @@ fn slave_set(mesh: &Mesh, field: &str, name: &str) -> Result<(Vec<usize>, Vec<[u
         }
         let mut nodes: Vec<usize> = faces
             .iter()
-            .flat_map(|f| crate::contact::faces::corners(f).iter().copied())
+            .flat_map(|f| crate::model::face_corners(f).iter().copied())
             .collect();
         nodes.sort_unstable();
         nodes.dedup();
@@ -183,7 +183,7 @@ fn master_faces(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<[usize; 4]>>
 fn edge_lengths(mesh: &Mesh, faces: &[[usize; 4]]) -> (f64, f64) {
     let (mut long, mut short) = (0.0f64, f64::INFINITY);
     for f in faces {
-        let c = crate::contact::faces::corners(f);
+        let c = crate::model::face_corners(f);
         for i in 0..c.len() {
             let (p, q) = (mesh.coords[c[i]], mesh.coords[c[(i + 1) % c.len()]]);
             let l = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();

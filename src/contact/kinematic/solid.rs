@@ -74,7 +74,7 @@ impl KinematicContact<'_> {
                             let mut best: Option<SolidHit> = None;
                             for hit in tree.locate_all_at_point(p) {
                                 let f = &faces[hit.data];
-                                let c = crate::contact::faces::corners(f);
+                                let c = crate::model::face_corners(f);
                                 if c.contains(&s) {
                                     continue;
                                 }

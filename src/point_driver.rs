@@ -161,9 +161,9 @@ fn targets<const V: usize>(p: &PathSpec, t: f64) -> [(bool, f64); V] {
 /// Validates the path: every number finite, steps that fit a counter, a table path
 /// with as many strains as strictly increasing times.
 fn check(p: &PathSpec) -> Result<()> {
-    crate::config::positive_pub("path.dt", p.dt)?;
-    crate::config::positive_pub("path.t_end", p.t_end)?;
-    crate::config::positive_pub("path.length", p.length)?;
+    crate::config::positive("path.dt", p.dt)?;
+    crate::config::positive("path.t_end", p.t_end)?;
+    crate::config::positive("path.length", p.length)?;
     let steps = (p.t_end / p.dt).round();
     if steps.is_nan() || steps > MAX_POINT_STEPS {
         return Err(Error::config(
@@ -171,9 +171,9 @@ fn check(p: &PathSpec) -> Result<()> {
             format!("t_end / dt = {steps:e} steps; at most {MAX_POINT_STEPS:e} are taken"),
         ));
     }
-    crate::config::finite_pub("path.amplitude", &[p.amplitude])?;
-    crate::config::finite_pub("path.ratio", &[p.ratio])?;
-    crate::config::check_function_pub("path.function", &p.function)?;
+    crate::config::finite("path.amplitude", &[p.amplitude])?;
+    crate::config::finite("path.ratio", &[p.ratio])?;
+    crate::config::check_function("path.function", &p.function)?;
     if p.kind == PathKind::Table {
         // The table prescribes every component itself: the keys of the other kinds
         // would be ignored.
@@ -200,7 +200,7 @@ fn check(p: &PathSpec) -> Result<()> {
                 ),
             ));
         }
-        crate::config::finite_pub("path.times", &p.times)?;
+        crate::config::finite("path.times", &p.times)?;
         let v = p.plane.voigt();
         for (i, e) in p.strains.iter().enumerate() {
             if e.len() != v {
@@ -217,7 +217,7 @@ fn check(p: &PathSpec) -> Result<()> {
                     ),
                 ));
             }
-            crate::config::finite_pub(&format!("path.strains[{i}]"), e)?;
+            crate::config::finite(&format!("path.strains[{i}]"), e)?;
         }
         if let Some(i) = p.times.windows(2).position(|w| w[1] <= w[0]) {
             return Err(Error::config(

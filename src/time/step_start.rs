@@ -1,0 +1,98 @@
+//! The start of a generalized-α step: the vectors of `v_n`, `a_n` and their mass
+//! products that stay fixed through the step's iterations (what the residual pass
+//! reads as its `History`), and the initial acceleration `a_0` they start from.
+//! Theory: `theory/trapezoidal.md`.
+
+use super::generalized_alpha::Alpha;
+use super::operators::Operators;
+use super::State;
+use crate::error::{Error, Result};
+use crate::model::Model;
+use crate::system::{EffectiveSystem, Factored};
+
+/// Generalized-α's vectors of the step's start, fixed through its iterations (what
+/// `residual::History` reads), and `M a_n`.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct StartVectors {
+    pub p: Vec<f64>,
+    pub q: Vec<f64>,
+    pub mq: Vec<f64>,
+    pub d: Vec<f64>,
+    ma_n: Vec<f64>,
+}
+
+impl StartVectors {
+    /// The vectors as the residual pass reads them.
+    pub fn history(&self) -> super::residual::History<'_> {
+        super::residual::History {
+            p: &self.p,
+            q: &self.q,
+            mq: &self.mq,
+            d: &self.d,
+        }
+    }
+}
+
+/// Fills `out` for the step from `s`: `p`, `q`, `mq` and `d` from `v_n`, `M v_n`, `a_n`
+/// and `M a_n`.
+pub(crate) fn history(ops: &Operators, a: &Alpha, s: &State, out: &mut StartVectors) {
+    let StartVectors { p, q, mq, d, ma_n } = out;
+    let st = a.at(ops.h());
+    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
+    let n = s.v.len();
+    ma_n.resize(n, 0.0);
+    ops.mass.matvec(&ops.asm.pattern, &s.a, ma_n);
+    let (v, mv, acc, ma) = (&s.v, &s.mv, &s.a, &*ma_n);
+    p.clear();
+    p.extend((0..n).map(|i| st.p_v * mv[i] + st.p_a * ma[i]));
+    q.clear();
+    q.extend((0..n).map(|i| st.q_v * v[i] + st.q_a * acc[i]));
+    mq.clear();
+    mq.extend((0..n).map(|i| st.q_v * mv[i] + st.q_a * ma[i]));
+    // C v_{n+1−α_f} less its Δu part: damp_m M(w q + (1 − w) v_n) + damp_k K(…).
+    let wq = st.w;
+    d.clear();
+    d.extend((0..n).map(|i| damp_m * (wq * mq[i] + (1.0 - wq) * mv[i])));
+    if damp_k != 0.0 {
+        let x: Vec<f64> = (0..n).map(|i| wq * q[i] + (1.0 - wq) * v[i]).collect();
+        let mut kx = vec![0.0; n];
+        ops.asm.pattern.matvec(&ops.k, &x, &mut kx);
+        for (di, k) in d.iter_mut().zip(&kx) {
+            *di += damp_k * k;
+        }
+    }
+}
+
+/// Generalized-α's `a_0`: `M a_0 = f_ext(0) − f_int(u_0) − C v_0` on the free dofs
+/// (zero on the constrained ones), one factorisation of `M` on the system's pattern.
+pub(crate) fn initial_acceleration(
+    model: &Model,
+    ops: &Operators,
+    sys: &mut EffectiveSystem,
+) -> Result<Vec<f64>> {
+    let s = ops.initial_state(model);
+    let n = s.v.len();
+    let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
+    let mut kv = vec![0.0; n];
+    if damp_k != 0.0 {
+        ops.asm.pattern.matvec(&ops.k, &s.v, &mut kv);
+    }
+    let free = sys.dofs().free.clone();
+    let mut rhs: Vec<f64> = free
+        .iter()
+        .map(|&d| s.f_ext[d] - s.f_int[d] - damp_m * s.mv[d] - damp_k * kv[d])
+        .collect();
+    sys.refill(1.0, &ops.mass, &[]);
+    if let Factored::NotPositiveDefinite { message, .. } = sys.factorize()? {
+        return Err(Error::Solver {
+            backend: sys.backend(),
+            message: format!("the mass matrix for generalized-α's initial acceleration: {message}"),
+        });
+    }
+    sys.solve(&mut rhs)?;
+    let mut a0 = vec![0.0; n];
+    for (&d, x) in free.iter().zip(rhs) {
+        a0[d] = x;
+    }
+    Ok(a0)
+}
