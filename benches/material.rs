@@ -1,6 +1,9 @@
 //! Criterion bench of single Gauss-point updates (updates per second) for every
 //! material model, along a fixed pseudo-random strain path of 1000 increments.
 
+#[path = "common/workload.rs"]
+mod workload;
+
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use rothe::config::MaterialSpec;
 use rothe::material::StrainStep;
@@ -71,7 +74,7 @@ fn solid_pass(c: &mut Criterion) {
     use rothe::assembly::internal::{new_stores, PointPass};
     let mut g = c.benchmark_group("solid_gauss_point_pass");
     for (name, text) in [MODELS[0], MODELS[3]] {
-        let scenario = rothe::workload::w3_scenario(16).replace("model = \"elastic\"", text);
+        let scenario = workload::w3_scenario(16).replace("model = \"elastic\"", text);
         let model = rothe::config::from_str(&scenario, std::path::Path::new(".")).unwrap();
         let asm = rothe::assembly::Assembler::new(&model.mesh);
         let mut stores = new_stores(&model.mesh, &model.materials);

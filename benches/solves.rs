@@ -4,6 +4,9 @@
 //! prints the bytes the factor streams (`2 nnz(L) · 8 B` per solve) so the ratio to
 //! the triad bandwidth can be read off the same run.
 
+#[path = "common/workload.rs"]
+mod workload;
+
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
@@ -16,7 +19,7 @@ use rothe::linsolve::SymmetricSolver;
 /// plain read of one array (one sequential stream per thread, as a triangular
 /// solve reads its factor).
 fn triad(c: &mut Criterion) {
-    use rothe::workload::{read_sum, triad};
+    use crate::workload::{read_sum, triad};
     let n = 1 << 24; // 3 arrays of 128 MB
     let b = vec![1.0f64; n];
     let cc = vec![2.0f64; n];
@@ -43,9 +46,9 @@ fn triad(c: &mut Criterion) {
 }
 
 fn w1_factor(ny: usize) -> (FaerCholesky, usize, usize) {
-    let model = rothe::workload::w1(ny).unwrap();
+    let model = workload::w1(ny).unwrap();
     let h = model.analysis.time.dt;
-    let a = rothe::workload::effective_matrix(&model, 1.0 / (h * h), 1.0);
+    let a = workload::effective_matrix(&model, 1.0 / (h * h), 1.0);
     let mut f = FaerCholesky::new();
     f.analyze(&a).unwrap();
     f.factorize(&a).unwrap();

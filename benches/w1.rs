@@ -1,8 +1,11 @@
-//! Criterion benches of workload W1 (see `rothe::workload`): element assembly of K and
+//! Criterion benches of workload W1 (see `benches/common/workload.rs`): element assembly of K and
 //! M, numeric factorisation of the effective matrix, and one backward-Euler step and
 //! one trapezoidal step, each
 //! at several sizes (`ny`), with setup outside the timed loop. Larger sizes and the
 //! CHOLMOD backend: `cargo run --release --example w1 -- NY [faer|cholmod]`.
+
+#[path = "common/workload.rs"]
+mod workload;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use rothe::assembly::internal::{new_stores, PointPass};
@@ -17,7 +20,7 @@ fn assembly(c: &mut Criterion) {
     let mut g = c.benchmark_group("w1_assembly");
     g.sample_size(10);
     for ny in [25usize, 100] {
-        let model = rothe::workload::w1(ny).unwrap();
+        let model = workload::w1(ny).unwrap();
         let asm = Assembler::new(&model.mesh);
         g.bench_with_input(BenchmarkId::new("stiffness", ny), &ny, |b, _| {
             b.iter(|| asm.stiffness(&model.mesh, &model.materials, model.idealisation))
@@ -36,7 +39,7 @@ fn factorisation_and_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("w1_solver");
     g.sample_size(10);
     for ny in [25usize, 100] {
-        let model = rothe::workload::w1(ny).unwrap();
+        let model = workload::w1(ny).unwrap();
         let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
         g.bench_with_input(BenchmarkId::new("refactorize", ny), &ny, |b, _| {
             b.iter(|| be.set_step(model.analysis.time.dt).unwrap())
@@ -64,7 +67,7 @@ fn sls(c: &mut Criterion) {
     g.sample_size(10);
     for ny in [25usize, 100] {
         for state in [ViscoelasticState::Nodal, ViscoelasticState::Points] {
-            let mut model = rothe::workload::w1_with(ny, rothe::workload::W1_SLS).unwrap();
+            let mut model = workload::w1_with(ny, workload::W1_SLS).unwrap();
             model.analysis.time.viscoelastic_state = state;
             let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
             let mut s = be.initial_state();
@@ -73,7 +76,7 @@ fn sls(c: &mut Criterion) {
                 b.iter(|| be.step_accepted(&mut s).unwrap())
             });
         }
-        let model = rothe::workload::w1_with(ny, rothe::workload::W1_SLS).unwrap();
+        let model = workload::w1_with(ny, workload::W1_SLS).unwrap();
         let asm = Assembler::new(&model.mesh);
         let mut points = new_stores(&model.mesh, &model.materials);
         let n = model.mesh.n_dofs();
@@ -110,7 +113,7 @@ fn nonlinear(c: &mut Criterion) {
     g.sample_size(10);
     let ny = 25;
     for variant in ["elastic", "mazars", "mazars-fixed", "rankine-hill"] {
-        let model = rothe::workload::w1_variant(ny, variant).unwrap();
+        let model = workload::w1_variant(ny, variant).unwrap();
         let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
         let mut s0 = be.initial_state();
         for _ in 0..10 {

@@ -5,6 +5,9 @@
 //! (secant refactorised every iteration), `mazars-fixed` (one factorisation per step),
 //! `rankine-hill` (Newton). ORDERING: `auto`, `amd` or `nested_dissection`.
 
+#[path = "../benches/common/workload.rs"]
+mod workload;
+
 use std::time::Instant;
 
 use rothe::linsolve::Backend;
@@ -40,7 +43,7 @@ fn main() -> rothe::Result<()> {
         .unwrap_or_default();
     let t0 = Instant::now();
     let variant = args.get(2).map(String::as_str).unwrap_or("elastic");
-    let mut model = rothe::workload::w1_variant(ny, variant)?;
+    let mut model = workload::w1_variant(ny, variant)?;
     model.analysis.iteration.ordering = match args.get(3).map(String::as_str) {
         None | Some("auto") => rothe::model::Ordering::Auto,
         Some("amd") => rothe::model::Ordering::Amd,
@@ -104,10 +107,10 @@ fn main() -> rothe::Result<()> {
     // and on all (the solve runs on both cores; the bound uses the all-core figure),
     // and the solve's and the step's shares of it; beside it the bandwidth of
     // reading one stream per core, which is how a solve reads its factor.
-    let triad_one = rothe::workload::triad_bandwidth(1 << 24, 10, false);
-    let triad = rothe::workload::triad_bandwidth(1 << 24, 10, true);
-    let read_one = rothe::workload::read_bandwidth(1 << 25, 5, false);
-    let read = rothe::workload::read_bandwidth(1 << 25, 5, true);
+    let triad_one = workload::triad_bandwidth(1 << 24, 10, false);
+    let triad = workload::triad_bandwidth(1 << 24, 10, true);
+    let read_one = workload::read_bandwidth(1 << 25, 5, false);
+    let read = workload::read_bandwidth(1 << 25, 5, true);
     let bytes = 2.0 * nnz_l as f64 * 8.0;
     let bound = bytes / triad;
     let read_bound = bytes / read;

@@ -4,6 +4,9 @@
 //! tip deflection and the total wall time (the figure `benches/peers/w3_fenicsx.py`
 //! prints for FEniCSx on the same problem).
 
+#[path = "../benches/common/workload.rs"]
+mod workload;
+
 use std::time::Instant;
 
 use rothe::linsolve::Backend;
@@ -22,7 +25,7 @@ fn main() -> rothe::Result<()> {
         .map(|s| s.parse().expect("backend is faer or cholmod"))
         .unwrap_or_default();
     let t0 = Instant::now();
-    let model = rothe::workload::w3(n)?;
+    let model = workload::w3(n)?;
     let setup_s = t0.elapsed().as_secs_f64();
     let mut be = BackwardEuler::new(&model, backend)?;
     let mut s = be.initial_state();

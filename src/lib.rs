@@ -52,7 +52,5 @@ pub mod run;
 pub mod study;
 pub mod system;
 pub mod time;
-#[doc(hidden)]
-pub mod workload;
 
 pub use error::{Error, Result};

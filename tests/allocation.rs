@@ -6,6 +6,9 @@
 //! injected into its pool; those are bounded in size and number. The test allows
 //! allocations below 4 KiB, at most 8 per step on average, and none larger.
 
+#[path = "../benches/common/workload.rs"]
+mod workload;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -52,7 +55,7 @@ fn steps_allocate_nothing_the_size_of_the_problem() {
     for variant in VARIANTS {
         // W1 at ny = 12 (48 x 12 Q4, 1250 dofs): the damage and plasticity variants
         // iterate from the first steps on.
-        let model = rothe::workload::w1_variant(12, variant).unwrap();
+        let model = workload::w1_variant(12, variant).unwrap();
         let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
         let mut s = be.initial_state();
         be.step_accepted(&mut s).unwrap();

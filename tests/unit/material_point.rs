@@ -3,7 +3,7 @@
 //! exact point energy identity, and properties over random parameters and paths.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
-mod common;
+use crate::common;
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;

@@ -21,6 +21,10 @@
 //! displacements as the bits of each number (`DIR/NAME.bits`, the kept-factor runs
 //! as `NAME.kept.bits`); run it before and after, then `diff -r` the two folders.
 
+mod reproducible;
+#[path = "../../benches/common/workload.rs"]
+mod workload;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

@@ -15,7 +15,7 @@
 //! model or an error, never a panic.
 //!
 //! `FUZZ_SHOW=1` prints every refusal. A few hundred seeded cases run by default;
-//! `cargo test --release --test fuzz -- --ignored` runs a long campaign (20,000
+//! `cargo test --release --test application fuzz -- --ignored` runs a long campaign (20,000
 //! cases, about 15 s).
 
 use std::panic::{catch_unwind, AssertUnwindSafe};

@@ -17,7 +17,7 @@ fn fingerprint(ny: usize, variant: &str, steps: usize, threads: usize) -> Vec<f6
         .build()
         .unwrap();
     pool.install(|| {
-        let mut model = rothe::workload::w1_variant(ny, variant).unwrap();
+        let mut model = crate::workload::w1_variant(ny, variant).unwrap();
         model.analysis.time.t_end = steps as f64 * model.analysis.time.dt;
         let mut be = BackwardEuler::new(&model, Backend::default()).unwrap();
         let mut s = be.initial_state();

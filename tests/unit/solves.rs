@@ -85,9 +85,9 @@ fn random(n: usize, per_col: usize, band: Option<usize>, seed: u64) -> LowerCsc 
 }
 
 fn w1(ny: usize) -> LowerCsc {
-    let model = rothe::workload::w1(ny).unwrap();
+    let model = crate::workload::w1(ny).unwrap();
     let h: f64 = 1e-5;
-    rothe::workload::effective_matrix(&model, 1.0 / (h * h), 1.0)
+    crate::workload::effective_matrix(&model, 1.0 / (h * h), 1.0)
 }
 
 fn matrices() -> Vec<(String, LowerCsc)> {
@@ -197,7 +197,7 @@ fn the_two_thread_solve_gives_the_sequential_one() {
     // Large systems cut the elimination forest into two parts solved at once and a
     // top solved after (forward) and before (backward) them. W1 at ny = 60 (29k
     // unknowns) with faer's AMD and with rothe's nested dissection, and a grid.
-    let model = rothe::workload::w1(60).unwrap();
+    let model = crate::workload::w1(60).unwrap();
     let a = w1(60);
     let dofs =
         rothe::system::DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));

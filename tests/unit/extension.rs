@@ -8,7 +8,7 @@
 //! every ledger line and probe within 1e-9 of its column's scale, and the ledger
 //! of the custom run closing by itself.
 
-#[path = "fixtures/trivial_elastic.rs"]
+#[path = "../fixtures/trivial_elastic.rs"]
 mod trivial_elastic;
 
 use std::path::Path;

@@ -2,9 +2,10 @@
 //! thickness 0.2 m, structured Q4 with `nx = 4 ny`, `E = 30e9, ν = 0.2, ρ = 2400`,
 //! consistent mass, left edge fixed, a step traction of 1e6 Pa downwards on the top
 //! edge, backward Euler `h = 1e-5`, 100 steps from rest; probe `u_y` at (2.0, 0.25).
+#![allow(dead_code)] // each bench, example and test uses a part
 
-use crate::error::Result;
-use crate::model::Model;
+use rothe::error::Result;
+use rothe::model::Model;
 
 /// The W1 material block with the standard linear solid of eq. (10) in place of
 /// elasticity (`α = 0.5`, `β = 1e-4 s`), for cost comparisons.
@@ -33,7 +34,7 @@ pub fn w1_variant(ny: usize, name: &str) -> Result<Model> {
         "mazars-nonlocal" => (W1_MAZARS_NONLOCAL, "newton"),
         "rankine-hill" => (W1_RANKINE_HILL, "newton"),
         other => {
-            return Err(crate::error::Error::config(
+            return Err(rothe::error::Error::config(
                 "variant",
                 format!(
                 "unknown W1 variant `{other}` (elastic, sls, mazars, mazars-fixed, mazars-nonlocal, rankine-hill)"
@@ -45,7 +46,7 @@ pub fn w1_variant(ny: usize, name: &str) -> Result<Model> {
         "vtk_every = 0",
         &format!("vtk_every = 0\niteration = \"{iteration}\""),
     );
-    crate::config::from_str(&text, std::path::Path::new("."))
+    rothe::config::from_str(&text, std::path::Path::new("."))
 }
 
 /// The W1 scenario text for `ny` cells across the height.
@@ -146,17 +147,17 @@ set = "beam.top_right_front"
 
 /// The W3 model for `n` cells across the height.
 pub fn w3(n: usize) -> Result<Model> {
-    crate::config::from_str(&w3_scenario(n), std::path::Path::new("."))
+    rothe::config::from_str(&w3_scenario(n), std::path::Path::new("."))
 }
 
 /// The W1 model for `ny` cells across the height.
 pub fn w1(ny: usize) -> Result<Model> {
-    crate::config::from_str(&w1_scenario(ny), std::path::Path::new("."))
+    rothe::config::from_str(&w1_scenario(ny), std::path::Path::new("."))
 }
 
 /// The W1 model with the material block `model_lines`.
 pub fn w1_with(ny: usize, model_lines: &str) -> Result<Model> {
-    crate::config::from_str(
+    rothe::config::from_str(
         &w1_scenario_with(ny, model_lines),
         std::path::Path::new("."),
     )
@@ -165,13 +166,13 @@ pub fn w1_with(ny: usize, model_lines: &str) -> Result<Model> {
 /// The reduced effective matrix `c_m M + c_k K` of a model (consistent mass unless
 /// the model's analysis lumps it), as the integrators build it: the matrices the
 /// solver tests and benches factorise.
-pub fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> crate::linsolve::LowerCsc {
-    let asm = crate::assembly::Assembler::new(&model.mesh);
+pub fn effective_matrix(model: &Model, c_m: f64, c_k: f64) -> rothe::linsolve::LowerCsc {
+    let asm = rothe::assembly::Assembler::new(&model.mesh);
     let k = asm.stiffness(&model.mesh, &model.materials, model.idealisation);
     let mass = asm.mass(&model.mesh, &model.materials, false);
     let dofs =
-        crate::system::DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let mut reduced = crate::system::ReducedMatrix::new(&asm.pattern, &dofs);
+        rothe::system::DofMap::new(model.mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
+    let mut reduced = rothe::system::ReducedMatrix::new(&asm.pattern, &dofs);
     reduced.fill(&dofs, c_m, &mass, &[(c_k, &k)]);
     reduced.csc
 }

@@ -4,7 +4,7 @@
 //! peak, ledger closure to the iteration tolerance, step cuts, failure reports).
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
-mod common;
+use crate::common;
 
 use proptest::prelude::*;
 use rothe::config::MaterialSpec;

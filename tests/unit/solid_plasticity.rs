@@ -5,7 +5,7 @@
 //! finite differences, and invariants along random paths.
 #![allow(clippy::needless_range_loop)]
 
-mod common;
+use crate::common;
 
 use proptest::prelude::*;
 use rothe::fe::frame::eigen_sym3;

@@ -24,7 +24,7 @@ fn model(text: &str) -> Model {
 
 /// The cantilever of W1 with a ramped (or step) traction `q` (Pa) on the top edge.
 fn cantilever(divisions: [usize; 2], material: &str, q: f64, analysis: &str) -> String {
-    rothe::workload::cantilever_scenario(divisions, 1e-5, 2e-4, material, analysis)
+    crate::workload::cantilever_scenario(divisions, 1e-5, 2e-4, material, analysis)
         .replace("value = [0.0, -1.0e6]", &format!("value = [0.0, {q:e}]"))
 }
 

@@ -25,7 +25,7 @@ fn scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 fn good() -> String {
-    rothe::workload::cantilever_scenario(
+    crate::workload::cantilever_scenario(
         [8, 2],
         1e-5,
         1e-4,
@@ -242,7 +242,7 @@ fn a_killed_run_is_marked_running() {
     // summary.json exists from the first step on with status "running": a run killed
     // part way is never taken for a complete one.
     let dir = tempfile::tempdir().unwrap();
-    let text = rothe::workload::cantilever_scenario(
+    let text = crate::workload::cantilever_scenario(
         [40, 10],
         1e-6,
         1.0,

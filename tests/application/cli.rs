@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn good() -> String {
-    rothe::workload::cantilever_scenario(
+    crate::workload::cantilever_scenario(
         [8, 2],
         1e-5,
         1e-4,

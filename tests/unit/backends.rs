@@ -100,7 +100,7 @@ fn residual(a: &LowerCsc, x: &[f64], b: &[f64]) -> f64 {
 }
 
 fn cantilever_text(kind: &str, divisions: [usize; 2], t_end: f64) -> String {
-    rothe::workload::cantilever_scenario(
+    crate::workload::cantilever_scenario(
         divisions,
         1e-5,
         t_end,
@@ -114,7 +114,7 @@ fn cantilever(kind: &str, divisions: [usize; 2], t_end: f64) -> Model {
         .expect("valid scenario")
 }
 
-use rothe::workload::effective_matrix;
+use crate::workload::effective_matrix;
 
 fn stiffness_matrix(model: &Model) -> LowerCsc {
     let n = model.mesh.n_dofs();
@@ -535,7 +535,7 @@ fn full_run_histories_agree() {
 }
 
 /// Factorisation and solve times of both backends on the same matrices; run with
-/// `cargo test --release --features cholmod --test backends -- --ignored --nocapture`.
+/// `cargo test --release --features cholmod --test unit backends -- --ignored --nocapture`.
 #[cfg(feature = "cholmod")]
 #[test]
 #[ignore]

@@ -2,7 +2,7 @@
 //! Each test opens with its reference, what it checks, mesh, loading and parameters.
 #![allow(clippy::needless_range_loop)]
 
-mod common;
+use crate::common;
 
 use common::{load_from, model_of};
 use rothe::assembly::loads::add_face_traction;

@@ -2,7 +2,7 @@
 //! Each test opens with its reference, what it checks, mesh, loading and parameters.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
-mod common;
+use crate::common;
 
 use common::{load_from, model_of, orders, prescribe};
 use rothe::assembly::loads::{accurate_rule, add_body_force};
@@ -434,7 +434,7 @@ fn run_ledger(text: &str) -> rothe::energy::Ledger {
 }
 
 fn cantilever() -> String {
-    rothe::workload::cantilever_scenario(
+    crate::workload::cantilever_scenario(
         [16, 4],
         2e-5,
         2e-3,

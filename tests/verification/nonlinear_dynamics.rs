@@ -12,7 +12,7 @@ const MAZARS: &str =
 const RH: &str = "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.65e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.65e9 }";
 
 fn cantilever(material: &str, extra: &str) -> String {
-    rothe::workload::cantilever_scenario(
+    crate::workload::cantilever_scenario(
         [16, 4],
         1e-5,
         1e-3,
