@@ -28,6 +28,7 @@
 
 // Element and material kernels index small fixed-size arrays by component: index
 // loops read like the formulas they implement.
+#![warn(missing_docs)]
 #![allow(clippy::needless_range_loop)]
 
 pub mod assembly;
