@@ -94,7 +94,7 @@ fn block_radius(mesh: &Mesh, materials: &[Material], bi: usize) -> Option<f64> {
 /// The table's entries before it is built (for the memory estimate): its points
 /// and the neighbours each point's radius reaches, counted with the same R-trees
 /// the build queries, so a mesh refined where it matters (a notch) is counted as it
-/// is, not at its mean density. Counting stops past [`COUNT_CAP`] entries (a table
+/// is, not at its mean density. Counting stops past `COUNT_CAP` entries (a table
 /// beyond any machine), and a mean-density estimate beyond it is not counted at all.
 pub fn estimated_entries(mesh: &Mesh, materials: &[Material]) -> (u64, u64) {
     let Some(m) = Members::of(mesh, materials) else {

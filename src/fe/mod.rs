@@ -347,7 +347,7 @@ pub fn kinematics(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKinem
     kinematics_from(kind, x, &shape(kind, xi))
 }
 
-/// [`kinematics`] from the shape values and reference derivatives `reference` of the
+/// [`kinematics()`] from the shape values and reference derivatives `reference` of the
 /// point (as [`rule_shapes`] holds them).
 #[inline]
 pub fn kinematics_from(

@@ -7,7 +7,7 @@
 //! writes them as commands and a Slurm job array instead; [`collect::collect`] reads
 //! the outputs back ([`run_data`]), however they were made, and writes the tables
 //! (`study.csv`), the plots (`plots/`) and the summary (`study.md`, or `report.md`).
-//! The study kinds read runs through [`run_data`] and are called by [`collect`]
+//! The study kinds read runs through [`run_data`] and are called by [`collect()`]
 //! alone, so no module of a kind imports the one that dispatches to it. Theory:
 //! `theory/studies.md` and `theory/benchmarks.md`.
 

@@ -1,6 +1,6 @@
 //! What a sweep runs: a [`Plan`] of independent runs, each a scenario with its
 //! overrides and its own output directory, kept as `plan.json` in the study's
-//! directory. The in-process sweep runs it ([`super::sweep`]); `--emit` writes it out
+//! directory. The in-process sweep runs it ([`super::sweep()`]); `--emit` writes it out
 //! as shell commands and a Slurm job-array script instead, and `rothe study collect`
 //! reads the same `plan.json` back, so both ways give the same tables.
 

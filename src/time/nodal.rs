@@ -16,7 +16,7 @@
 //! The stored energy and the dissipation of a step are quadratic forms of these
 //! fields: with `y = K_g u` and `y_d = K_g u_d` kept, each is a dot product
 //! (`y_d¹ = (y_d⁰ + k y¹)/(1 + k)` needs no product of its own). The Gauss-point
-//! state is materialised from the fields for output ([`NodalLaws::materialise`]).
+//! state is materialised from the fields for output (`NodalLaws::materialise`).
 
 use rayon::prelude::*;
 

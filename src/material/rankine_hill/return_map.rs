@@ -335,7 +335,7 @@ const MAX_SUBSTEPS: usize = 64;
 ///
 /// When the return of the whole increment finds no admissible state (the active-set
 /// Newton projection fails on a large increment), the increment is split into 2, 4,
-/// …, [`MAX_SUBSTEPS`] equal substeps, each returned from the state the last left;
+/// …, `MAX_SUBSTEPS` (64) equal substeps, each returned from the state the last left;
 /// the step's plastic dissipation is the substeps' sum, its stress and tangent the
 /// last substep's, and `D_num` closes the step's split `σ¹:Δε = Δψ + D_plastic +
 /// D_num` as for a single return. A strength that is exhausted fails at every
