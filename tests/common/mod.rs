@@ -177,3 +177,29 @@ pub fn point_update<const V: usize, K: rothe::fe::StrainSpace<V>>(
     );
     (r, st)
 }
+
+/// Asserts that the consistent tangent of `m`'s update from `state_n` (strain
+/// `eps_n` to `eps`) in the idealisation `K` is the derivative of its stress:
+/// central differences with δε = 1e-9, within `tol`. The one tangent check of every
+/// model in plane stress, plane strain and solids.
+pub fn assert_point_tangent<const V: usize, K: rothe::fe::StrainSpace<V>>(
+    m: &Material,
+    eps_n: [f64; V],
+    eps: [f64; V],
+    state_n: &[f64],
+    tol: f64,
+) {
+    let (r, _) = point_update::<V, K>(m, eps_n, eps, state_n);
+    assert_tangent_is_the_derivative(
+        &r.tangent,
+        eps,
+        |e| point_update::<V, K>(m, eps_n, e, state_n).0.sigma,
+        tol,
+    );
+}
+
+/// The model of a scenario given as text (mesh paths relative to the working
+/// directory); panics with the validation error.
+pub fn model(text: &str) -> Model {
+    rothe::config::from_str(text, std::path::Path::new(".")).unwrap()
+}

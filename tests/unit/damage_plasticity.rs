@@ -342,16 +342,6 @@ fn rankine_hill_corner_return_satisfies_kkt() {
     }
 }
 
-fn fd_tangent_check(m: &Material, eps_n: [f64; 3], eps: [f64; 3], state_n: &[f64]) {
-    let (r, _) = rh_point(m, eps_n, eps, state_n);
-    common::assert_tangent_is_the_derivative(
-        &r.tangent,
-        eps,
-        |e| rh_point(m, eps_n, e, state_n).0.sigma,
-        1e-4 * E,
-    );
-}
-
 #[test]
 fn rankine_hill_consistent_tangent_matches_finite_differences() {
     // Elastic, Rankine only, von Mises only, and corner states, from virgin and from
@@ -369,7 +359,13 @@ fn rankine_hill_consistent_tangent_matches_finite_differences() {
             ([4e-4, -1e-4, 2e-4], hardened),
             ([-2.5e-3, -1e-3, -5e-4], hardened),
         ] {
-            fd_tangent_check(mm, [0.0; 3], eps, &st);
+            common::assert_point_tangent::<3, rothe::fe::PlaneStress>(
+                mm,
+                [0.0; 3],
+                eps,
+                &st,
+                1e-4 * E,
+            );
         }
     }
 }

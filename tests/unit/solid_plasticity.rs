@@ -459,13 +459,7 @@ fn solid_consistent_tangents_match_finite_differences() {
             ([-2.5e-3, -1e-3, -5e-4], hardened),
         ] {
             let eps = strain_along(&q, d);
-            let (r, _) = point(&m, [0.0; 6], eps, &h);
-            common::assert_tangent_is_the_derivative(
-                &r.tangent,
-                eps,
-                |e| point(&m, [0.0; 6], e, &h).0.sigma,
-                1e-4 * E,
-            );
+            common::assert_point_tangent::<6, rothe::fe::Solid>(&m, [0.0; 6], eps, &h, 1e-4 * E);
         }
     }
 }
@@ -592,11 +586,11 @@ fn plane_strain_tangents_match_finite_differences() {
             ([1.5e-3, -1.6e-3, 2e-4], [0.0; 6]),
             ([4e-4, -1e-4, 2e-4], hardened),
         ] {
-            let (r, _) = plane_strain_point(&m, [0.0; 3], eps, &st);
-            common::assert_tangent_is_the_derivative(
-                &r.tangent,
+            common::assert_point_tangent::<3, rothe::fe::PlaneStrain>(
+                &m,
+                [0.0; 3],
                 eps,
-                |e| plane_strain_point(&m, [0.0; 3], e, &st).0.sigma,
+                &st,
                 1e-4 * E,
             );
         }

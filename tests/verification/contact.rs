@@ -19,9 +19,7 @@ fn example(name: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
-fn model(text: &str) -> Model {
-    rothe::config::from_str(text, Path::new(".")).unwrap()
-}
+use crate::common::model;
 
 /// Momentum `Σ M v` of the nodes of `body` in direction `dir`, and the body's mass.
 fn momentum(m: &Model, s: &State, body: usize, mass: &[f64], dir: usize) -> (f64, f64) {

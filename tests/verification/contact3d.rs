@@ -14,9 +14,7 @@ use rothe::time::central_difference::CentralDifference;
 use rothe::time::march::{march, Marched, StepControl};
 use rothe::time::{Integrator, State};
 
-fn model(text: &str) -> Model {
-    rothe::config::from_str(text, Path::new(".")).unwrap()
-}
+use crate::common::model;
 
 fn refusal(text: &str) -> String {
     rothe::config::from_str(text, Path::new("."))

@@ -4,11 +4,9 @@
 //! per unit crack area whatever the mesh, and a failed material return is reported as
 //! an outcome with its element.
 
-use std::path::Path;
 
 use rothe::linsolve::Backend;
 use rothe::mesh::{Block, Elements};
-use rothe::model::Model;
 use rothe::nonlinear::Outcome;
 use rothe::time::backward_euler::BackwardEuler;
 use rothe::time::march::{march, StepControl};
@@ -18,9 +16,7 @@ use rothe::time::{Integrator, StepOutcome};
 const RH: &str = "model = \"rankine_hill\"\ntension = { law = \"bilinear\", strength = 2.9e6, post_yield_modulus = 1.5e9 }\ncompression = { law = \"bilinear\", strength = 30.0e6, post_yield_modulus = 1.5e9 }\nE = 30e9\nnu = 0.2\nrho = 2400.0";
 const ELASTIC: &str = "model = \"elastic\"\nE = 30e9\nnu = 0.2\nrho = 2400.0";
 
-fn model(text: &str) -> Model {
-    rothe::config::from_str(text, Path::new(".")).unwrap()
-}
+use crate::common::model;
 
 /// The cantilever of W1 with a ramped (or step) traction `q` (Pa) on the top edge.
 fn cantilever(divisions: [usize; 2], material: &str, q: f64, analysis: &str) -> String {

@@ -4,16 +4,13 @@
 //! oblique impact of two free blocks keeps its tangential impulse within the cone
 //! and conserves momentum.
 
-use std::path::Path;
 
 use rothe::linsolve::Backend;
 use rothe::model::Model;
 use rothe::time::backward_euler::BackwardEuler;
 use rothe::time::{Integrator, State};
 
-fn model(text: &str) -> Model {
-    rothe::config::from_str(text, Path::new(".")).unwrap()
-}
+use crate::common::model;
 
 const G: f64 = 9.81;
 

@@ -5,14 +5,11 @@
 use std::path::Path;
 
 use rothe::linsolve::Backend;
-use rothe::model::Model;
 use rothe::output::post::cell_stress;
 use rothe::time::statics::Statics;
 use rothe::time::{Integrator, State};
 
-fn model(text: &str) -> Model {
-    rothe::config::from_str(text, Path::new(".")).unwrap()
-}
+use crate::common::model;
 
 /// Two blocks 1 x 0.5 m, one on the other, the lower with `lower` columns of
 /// elements and the upper with `upper`: the lower's bottom on rollers, both left

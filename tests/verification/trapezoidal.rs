@@ -11,9 +11,7 @@ use rothe::model::Model;
 use rothe::time::backward_euler::BackwardEuler;
 use rothe::time::{Integrator, State};
 
-fn model(text: &str) -> Model {
-    rothe::config::from_str(text, Path::new(".")).unwrap()
-}
+use crate::common::model;
 
 /// A concrete cantilever 2 x 0.5 m (thickness 0.2 m, 8 x 2 elements) clamped on
 /// the left, with `scheme`, step `h` to `t_end`, and `extra` lines (a velocity, a
