@@ -14,7 +14,9 @@ use serde::Deserialize;
 
 use crate::config::MaterialSpec;
 use crate::error::{Error, Result};
-use crate::fe::{Idealisation, PlaneStrain, PlaneStress, Solid, StrainSpace};
+use crate::fe::{
+    Idealisation, PlaneStrain, PlaneStress, Solid, StrainSpace, STRAIN_NAMES, STRESS_NAMES,
+};
 use crate::material::linalg::{solve_in_place, MAX_DIM};
 use crate::material::{Material, PointResponse, StrainStep};
 use crate::model::TimeFunction;
@@ -459,19 +461,7 @@ fn write_csv<const V: usize, K: StrainSpace<V>>(
     let path = out.join("material.csv");
     let mut w =
         std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| Error::io(&path, e))?);
-    let (strains, stresses): (&[&str], &[&str]) = if V == 6 {
-        (
-            &[
-                "eps_xx", "eps_yy", "gamma_xy", "eps_zz", "gamma_yz", "gamma_zx",
-            ],
-            &["sig_xx", "sig_yy", "sig_xy", "sig_zz", "sig_yz", "sig_zx"],
-        )
-    } else {
-        (
-            &["eps_xx", "eps_yy", "gamma_xy"],
-            &["sig_xx", "sig_yy", "sig_xy"],
-        )
-    };
+    let (strains, stresses) = (&STRAIN_NAMES[..V], &STRESS_NAMES[..V]);
     let mut header = vec!["t"];
     header.extend(strains);
     header.extend(stresses);

@@ -21,6 +21,15 @@ use super::frame::{Frame, PlaneFrame, SolidFrame};
 use super::principal::{principal_values, principal_voigt6};
 use super::{PointKinematics, QuadPoint};
 
+/// The names of the Voigt strain components, in the order of `fe` (a plane
+/// vector's are the first three).
+pub const STRAIN_NAMES: [&str; 6] = [
+    "eps_xx", "eps_yy", "gamma_xy", "eps_zz", "gamma_yz", "gamma_zx",
+];
+
+/// The names of the Voigt stress components, in the order of `fe`.
+pub const STRESS_NAMES: [&str; 6] = ["sig_xx", "sig_yy", "sig_xy", "sig_zz", "sig_yz", "sig_zx"];
+
 /// The idealisation of a run's bodies: what a scenario's `analysis.plane` chooses
 /// (`"stress"`, `"strain"`; a solid mesh is `"solid"`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]

@@ -16,6 +16,7 @@ pub mod principal;
 
 pub use kinematics::{
     FrameUser, Idealisation, Kinematics, PlaneStrain, PlaneStress, Solid, StrainSpace,
+    STRAIN_NAMES, STRESS_NAMES,
 };
 
 /// The element types rothe knows.

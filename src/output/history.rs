@@ -67,10 +67,8 @@ impl History {
         cols.push("iterations".into());
         cols.push("nl_residual".into());
         for p in probes {
-            cols.push(format!("{p}_ux"));
-            cols.push(format!("{p}_uy"));
-            if dim == 3 {
-                cols.push(format!("{p}_uz"));
+            for c in &["ux", "uy", "uz"][..dim] {
+                cols.push(format!("{p}_{c}"));
             }
         }
         for p in pairs {
@@ -166,9 +164,8 @@ impl History {
             d.contact, d.friction, d.predictor, d.mass, d.numerical, l.residual()
         );
         for p in probes {
-            line.push_str(&format!(",{:.12e},{:.12e}", p[0], p[1]));
-            if self.dim == 3 {
-                line.push_str(&format!(",{:.12e}", p[2]));
+            for x in &p[..self.dim] {
+                line.push_str(&format!(",{x:.12e}"));
             }
         }
         for p in pairs {

@@ -4,7 +4,6 @@
 //! per unit crack area whatever the mesh, and a failed material return is reported as
 //! an outcome with its element.
 
-
 use rothe::linsolve::Backend;
 use rothe::mesh::{Block, Elements};
 use rothe::nonlinear::Outcome;

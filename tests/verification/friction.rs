@@ -4,7 +4,6 @@
 //! oblique impact of two free blocks keeps its tangential impulse within the cone
 //! and conserves momentum.
 
-
 use rothe::linsolve::Backend;
 use rothe::model::Model;
 use rothe::time::backward_euler::BackwardEuler;
