@@ -9,8 +9,9 @@
 //! strains and stresses with their out-of-plane parts and the principal frame of
 //! the return mappings. Code above `fe` is written once, generic over
 //! `K: Kinematics<D, V>`, and enters it through one dispatch from the runtime
-//! choice, [`dispatch_kinematics!`](crate::dispatch_kinematics); nothing outside
-//! `fe` and that dispatch branches on a dimension to pick a formula.
+//! choice, [`dispatch_kinematics!`](crate::dispatch_kinematics): no formula of an
+//! element or a material point branches on the dimension outside `fe` (the mesh,
+//! the output formats and contact still read `Mesh::dim` for their own facts).
 //!
 //! Voigt order (module `fe`): `[ε_xx, ε_yy, γ_xy]` in the plane,
 //! `[ε_xx, ε_yy, γ_xy, ε_zz, γ_yz, γ_zx]` in a solid (engineering shears).
