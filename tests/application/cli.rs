@@ -2,8 +2,9 @@
 //! clear message naming the field and a non-zero exit, never a panic.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
+
+use crate::common::{rothe, scenario};
 
 fn good() -> String {
     crate::workload::cantilever_scenario(
@@ -13,24 +14,6 @@ fn good() -> String {
         "model = \"elastic\"\nE = 30e9\nnu = 0.2\nrho = 2400.0",
         "vtk_every = 5",
     )
-}
-
-fn rothe(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rothe"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
-
-fn scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
 }
 
 #[test]

@@ -2,27 +2,11 @@
 //! of bad input and runaway run, as a user meets it through the `rothe` command (or
 //! the library where the command cannot reach the case).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
+
+use crate::common::{rothe, scenario};
 use std::time::{Duration, Instant};
-
-fn rothe(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_rothe"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
-
-fn scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
 
 fn good() -> String {
     crate::workload::cantilever_scenario(

@@ -203,3 +203,24 @@ pub fn assert_point_tangent<const V: usize, K: rothe::fe::StrainSpace<V>>(
 pub fn model(text: &str) -> Model {
     rothe::config::from_str(text, std::path::Path::new(".")).unwrap()
 }
+
+/// Runs the `rothe` command with `args`: whether it succeeded, its standard output
+/// and its standard error.
+pub fn rothe(args: &[&str]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rothe"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+/// Writes the scenario `text` to `dir/name` and returns its path.
+pub fn scenario(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
