@@ -39,6 +39,7 @@ pub mod contact;
 pub mod energy;
 pub mod error;
 pub mod fe;
+pub mod geometry;
 pub mod halves;
 pub mod linsolve;
 pub mod material;

@@ -85,8 +85,7 @@ pub fn quad_face_weights(mesh: &Mesh, face: &[usize; 4]) -> [f64; 4] {
                 ts[i] += ds[a] * x[a][i];
             }
         }
-        let c = crate::mesh::cross(tr, ts);
-        let da = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt() * w;
+        let da = crate::geometry::norm(crate::geometry::cross(tr, ts)) * w;
         for a in 0..4 {
             out[a] += n[a] * da;
         }

@@ -127,59 +127,11 @@ pub struct TriangleHit {
 type V2 = [f64; 2];
 type V3 = [f64; 3];
 
-fn sub2(x: V2, y: V2) -> V2 {
-    [x[0] - y[0], x[1] - y[1]]
-}
+use crate::geometry::{axpy, cross, det3, dot, perp_dot, sub};
 
-/// `x + t·y`.
-fn axpy2(x: V2, t: f64, y: V2) -> V2 {
-    [t.mul_add(y[0], x[0]), t.mul_add(y[1], x[1])]
-}
-
-fn dot2(x: V2, y: V2) -> f64 {
-    x[0] * y[0] + x[1] * y[1]
-}
-
-fn cross2(x: V2, y: V2) -> f64 {
-    x[0] * y[1] - x[1] * y[0]
-}
-
+/// `|x|` of a plane vector, as `hypot`.
 fn norm2(x: V2) -> f64 {
     x[0].hypot(x[1])
-}
-
-fn sub3(x: V3, y: V3) -> V3 {
-    [x[0] - y[0], x[1] - y[1], x[2] - y[2]]
-}
-
-/// `x + t·y`.
-fn axpy3(x: V3, t: f64, y: V3) -> V3 {
-    [
-        t.mul_add(y[0], x[0]),
-        t.mul_add(y[1], x[1]),
-        t.mul_add(y[2], x[2]),
-    ]
-}
-
-fn dot3(x: V3, y: V3) -> f64 {
-    x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
-}
-
-fn cross3(x: V3, y: V3) -> V3 {
-    [
-        x[1] * y[2] - x[2] * y[1],
-        x[2] * y[0] - x[0] * y[2],
-        x[0] * y[1] - x[1] * y[0],
-    ]
-}
-
-fn norm3(x: V3) -> f64 {
-    dot3(x, x).sqrt()
-}
-
-/// `det[x, y, z] = (x × y)·z`.
-fn det3(x: V3, y: V3, z: V3) -> f64 {
-    dot3(cross3(x, y), z)
 }
 
 /// The coefficients `[c0, c1, c2]` of `q(t) = c0 + c1 t + c2 t² = −cross(d(t), e(t))`,
@@ -194,12 +146,12 @@ pub fn segment_quadratic(
     b: [f64; 2],
     vb: [f64; 2],
 ) -> [f64; 3] {
-    let (d0, dd) = (sub2(b, a), sub2(vb, va));
-    let (e0, de) = (sub2(p, a), sub2(vp, va));
+    let (d0, dd) = (sub(b, a), sub(vb, va));
+    let (e0, de) = (sub(p, a), sub(vp, va));
     [
-        -cross2(d0, e0),
-        -(cross2(d0, de) + cross2(dd, e0)),
-        -cross2(dd, de),
+        -perp_dot(d0, e0),
+        -(perp_dot(d0, de) + perp_dot(dd, e0)),
+        -perp_dot(dd, de),
     ]
 }
 
@@ -218,9 +170,9 @@ pub fn triangle_cubic(
     c: [f64; 3],
     vc: [f64; 3],
 ) -> [f64; 4] {
-    let (u0, du) = (sub3(b, a), sub3(vb, va));
-    let (w0, dw) = (sub3(c, a), sub3(vc, va));
-    let (e0, de) = (sub3(p, a), sub3(vp, va));
+    let (u0, du) = (sub(b, a), sub(vb, va));
+    let (w0, dw) = (sub(c, a), sub(vc, va));
+    let (e0, de) = (sub(p, a), sub(vp, va));
     [
         det3(u0, w0, e0),
         det3(du, w0, e0) + det3(u0, dw, e0) + det3(u0, w0, de),
@@ -252,14 +204,14 @@ pub fn node_segment(
     if !valid {
         return None;
     }
-    let (d0, dd) = (sub2(b, a), sub2(vb, va));
-    let (e0, de) = (sub2(p, a), sub2(vp, va));
+    let (d0, dd) = (sub(b, a), sub(vb, va));
+    let (e0, de) = (sub(p, a), sub(vp, va));
     let len0 = norm2(d0);
     let len_bound = h.mul_add(norm2(dd), len0);
     let gap_tol = GAP_TOL * len0.max(h * norm2(de)).max(h * norm2(dd));
-    let at = |t: f64| (axpy2(d0, t, dd), axpy2(e0, t, de));
+    let at = |t: f64| (axpy(d0, t, dd), axpy(e0, t, de));
     let collapsed = |d: V2| norm2(d) <= COLLAPSE_TOL * len_bound;
-    let xi_of = |d: V2, e: V2| dot2(e, d) / dot2(d, d);
+    let xi_of = |d: V2, e: V2| dot(e, d) / dot(d, d);
     let in_range = |xi: f64| (-XI_TOL..=1.0 + XI_TOL).contains(&xi);
     if collapsed(d0) {
         return None;
@@ -363,29 +315,31 @@ pub fn node_triangle(
     if !valid {
         return None;
     }
-    let (u0, du) = (sub3(b, a), sub3(vb, va));
-    let (w0, dw) = (sub3(c, a), sub3(vc, va));
-    let (e0, de) = (sub3(p, a), sub3(vp, va));
-    let (f0, df) = (sub3(w0, u0), sub3(dw, du));
-    let edge0 = norm3(u0).max(norm3(w0)).max(norm3(f0));
+    let (u0, du) = (sub(b, a), sub(vb, va));
+    let (w0, dw) = (sub(c, a), sub(vc, va));
+    let (e0, de) = (sub(p, a), sub(vp, va));
+    let (f0, df) = (sub(w0, u0), sub(dw, du));
+    let edge0 = crate::geometry::norm(u0)
+        .max(crate::geometry::norm(w0))
+        .max(crate::geometry::norm(f0));
     let ell = h
-        .mul_add(norm3(du), norm3(u0))
-        .max(h.mul_add(norm3(dw), norm3(w0)))
-        .max(h.mul_add(norm3(df), norm3(f0)));
+        .mul_add(crate::geometry::norm(du), crate::geometry::norm(u0))
+        .max(h.mul_add(crate::geometry::norm(dw), crate::geometry::norm(w0)))
+        .max(h.mul_add(crate::geometry::norm(df), crate::geometry::norm(f0)));
     let gap_tol = GAP_TOL
         * edge0
-            .max(h * norm3(de))
-            .max(h * norm3(du))
-            .max(h * norm3(dw));
+            .max(h * crate::geometry::norm(de))
+            .max(h * crate::geometry::norm(du))
+            .max(h * crate::geometry::norm(dw));
     let area_min = COLLAPSE_TOL * ell * ell;
     let frame = |t: f64| {
-        let (u, w) = (axpy3(u0, t, du), axpy3(w0, t, dw));
-        (u, w, axpy3(e0, t, de), cross3(u, w))
+        let (u, w) = (axpy(u0, t, du), axpy(w0, t, dw));
+        (u, w, axpy(e0, t, de), cross(u, w))
     };
     let bary_of = |u: V3, w: V3, e: V3, n: V3| {
-        let nn = dot3(n, n);
-        let beta = dot3(cross3(e, w), n) / nn;
-        let gamma = dot3(cross3(u, e), n) / nn;
+        let nn = dot(n, n);
+        let beta = dot(cross(e, w), n) / nn;
+        let gamma = dot(cross(u, e), n) / nn;
         [1.0 - beta - gamma, beta, gamma]
     };
     let in_range = |l: [f64; 3]| l.iter().all(|x| (-BARY_TOL..=1.0 + BARY_TOL).contains(x));
@@ -395,8 +349,8 @@ pub fn node_triangle(
         l.map(|x| x / s)
     };
 
-    let n0 = cross3(u0, w0);
-    let area0 = norm3(n0);
+    let n0 = cross(u0, w0);
+    let area0 = crate::geometry::norm(n0);
     if area0 <= area_min {
         return None;
     }
@@ -425,10 +379,10 @@ pub fn node_triangle(
     first_crossing_cubic(
         cc,
         h,
-        |t| gap_tol * norm3(frame(t).3),
+        |t| gap_tol * crate::geometry::norm(frame(t).3),
         |t| {
             let (u, w, e, n) = frame(t);
-            if norm3(n) <= area_min {
+            if crate::geometry::norm(n) <= area_min {
                 return None;
             }
             let l = bary_of(u, w, e, n);
@@ -970,8 +924,8 @@ mod tests {
     /// Barycentric coordinates of the projection of `e` on span(u, w) by the 2×2
     /// normal equations (independent of the cross-product formula in the module).
     fn gram_bary(u: [f64; 3], w: [f64; 3], e: [f64; 3]) -> [f64; 3] {
-        let (uu, uw, ww) = (dot3(u, u), dot3(u, w), dot3(w, w));
-        let (eu, ew) = (dot3(e, u), dot3(e, w));
+        let (uu, uw, ww) = (dot(u, u), dot(u, w), dot(w, w));
+        let (eu, ew) = (dot(e, u), dot(e, w));
         let det = uu * ww - uw * uw;
         let beta = (eu * ww - ew * uw) / det;
         let gamma = (ew * uu - eu * uw) / det;
@@ -992,7 +946,7 @@ mod tests {
     ) -> [f64; 3] {
         let at = |x: [f64; 3], v: [f64; 3]| [x[0] + t * v[0], x[1] + t * v[1], x[2] + t * v[2]];
         let (pt, at_, bt, ct) = (at(p, vp), at(a, va), at(b, vb), at(c, vc));
-        gram_bary(sub3(bt, at_), sub3(ct, at_), sub3(pt, at_))
+        gram_bary(sub(bt, at_), sub(ct, at_), sub(pt, at_))
     }
 
     #[test]
@@ -1202,7 +1156,7 @@ mod tests {
         // root) while the barycentric coordinates stay (0.5, 0.2, 0.3); the crossing is
         // at the collapse, so it is none.
         let g = [1.0 / 3.0, 1.0 / 3.0, 0.0];
-        let v = |x: [f64; 3]| sub3(x, g).map(|c| -c / 0.4);
+        let v = |x: [f64; 3]| sub(x, g).map(|c| -c / 0.4);
         let p = [0.2, 0.3, 0.5];
         let k = triangle_cubic(p, v(p), TA, v(TA), TB, v(TB), TC, v(TC));
         assert!(k[0] > 0.0 && k[3] < 0.0);
@@ -1455,7 +1409,7 @@ mod tests {
             let vs = ls / ts;
             let a = rng.v2(ls);
             let mut b = rng.v2(ls);
-            while norm2(sub2(b, a)) < 0.05 * ls {
+            while norm2(sub(b, a)) < 0.05 * ls {
                 b = rng.v2(ls);
             }
             let (va, vb) = match case % 4 {
@@ -1472,15 +1426,15 @@ mod tests {
                 // Aim the node at a point of the segment's line at a random time, most
                 // often moving in there.
                 let (t, xi) = (rng.range(0.0, h), rng.range(-0.3, 1.3));
-                let at = axpy2(a, t, va);
-                let d = sub2(axpy2(b, t, vb), at);
-                let target = axpy2(at, xi, d);
-                let vt = axpy2(va, xi, sub2(vb, va));
-                let r = sub2(vp, vt);
+                let at = axpy(a, t, va);
+                let d = sub(axpy(b, t, vb), at);
+                let target = axpy(at, xi, d);
+                let vt = axpy(va, xi, sub(vb, va));
+                let r = sub(vp, vt);
                 if r[0] * d[1] - r[1] * d[0] > 0.0 && rng.unit() < 0.75 {
-                    vp = sub2(vt, r);
+                    vp = sub(vt, r);
                 }
-                axpy2(target, -t, vp)
+                axpy(target, -t, vp)
             } else {
                 rng.v2(2.0 * ls)
             };
@@ -1499,12 +1453,10 @@ mod tests {
                     [pb[0] - pa[0], pb[1] - pa[1]],
                     [pp[0] - pa[0], pp[1] - pa[1]],
                 );
-                ([dot2(e, d) / dot2(d, d), 0.0, 0.0], norm2(d))
+                ([dot(e, d) / dot(d, d), 0.0, 0.0], norm2(d))
             };
-            let len0 = norm2(sub2(b, a));
-            let scale = len0
-                .max(h * norm2(sub2(vp, va)))
-                .max(h * norm2(sub2(vb, va)));
+            let len0 = norm2(sub(b, a));
+            let scale = len0.max(h * norm2(sub(vp, va))).max(h * norm2(sub(vb, va)));
             let expect = if (g(0.0) / len0).abs() < 1e-7 * scale {
                 Expect::Skip
             } else {
@@ -1531,7 +1483,7 @@ mod tests {
             let vs = ls / ts;
             let a = rng.v3(ls);
             let (mut b, mut c) = (rng.v3(ls), rng.v3(ls));
-            while norm3(cross3(sub3(b, a), sub3(c, a))) < 0.05 * ls * ls {
+            while crate::geometry::norm(cross(sub(b, a), sub(c, a))) < 0.05 * ls * ls {
                 (b, c) = (rng.v3(ls), rng.v3(ls));
             }
             let (va, vb, vc) = match case % 4 {
@@ -1550,34 +1502,37 @@ mod tests {
                 let t = rng.range(0.0, h);
                 let beta = rng.range(-0.2, 1.1);
                 let gamma = rng.range(-0.2, 1.2 - beta);
-                let at = axpy3(a, t, va);
-                let u = sub3(axpy3(b, t, vb), at);
-                let w = sub3(axpy3(c, t, vc), at);
-                let target = axpy3(axpy3(at, beta, u), gamma, w);
-                let vt = axpy3(axpy3(va, beta, sub3(vb, va)), gamma, sub3(vc, va));
-                let r = sub3(vp, vt);
-                if dot3(cross3(u, w), r) > 0.0 && rng.unit() < 0.75 {
-                    vp = sub3(vt, r);
+                let at = axpy(a, t, va);
+                let u = sub(axpy(b, t, vb), at);
+                let w = sub(axpy(c, t, vc), at);
+                let target = axpy(axpy(at, beta, u), gamma, w);
+                let vt = axpy(axpy(va, beta, sub(vb, va)), gamma, sub(vc, va));
+                let r = sub(vp, vt);
+                if dot(cross(u, w), r) > 0.0 && rng.unit() < 0.75 {
+                    vp = sub(vt, r);
                 }
-                axpy3(target, -t, vp)
+                axpy(target, -t, vp)
             } else {
                 rng.v3(2.0 * ls)
             };
             let g = |t: f64| direct_volume(p, vp, a, va, b, vb, c, vc, t);
-            let pos = |x: [f64; 3], v: [f64; 3], t: f64| axpy3(x, t, v);
+            let pos = |x: [f64; 3], v: [f64; 3], t: f64| axpy(x, t, v);
             let proj = |t: f64| {
                 let (pa, pb, pc, pp) = (pos(a, va, t), pos(b, vb, t), pos(c, vc, t), pos(p, vp, t));
-                let (u, w) = (sub3(pb, pa), sub3(pc, pa));
-                (gram_bary(u, w, sub3(pp, pa)), norm3(cross3(u, w)).sqrt())
+                let (u, w) = (sub(pb, pa), sub(pc, pa));
+                (
+                    gram_bary(u, w, sub(pp, pa)),
+                    crate::geometry::norm(cross(u, w)).sqrt(),
+                )
             };
-            let area0 = norm3(cross3(sub3(b, a), sub3(c, a)));
-            let edge0 = norm3(sub3(b, a))
-                .max(norm3(sub3(c, a)))
-                .max(norm3(sub3(c, b)));
+            let area0 = crate::geometry::norm(cross(sub(b, a), sub(c, a)));
+            let edge0 = crate::geometry::norm(sub(b, a))
+                .max(crate::geometry::norm(sub(c, a)))
+                .max(crate::geometry::norm(sub(c, b)));
             let scale = edge0
-                .max(h * norm3(sub3(vp, va)))
-                .max(h * norm3(sub3(vb, va)))
-                .max(h * norm3(sub3(vc, va)));
+                .max(h * crate::geometry::norm(sub(vp, va)))
+                .max(h * crate::geometry::norm(sub(vb, va)))
+                .max(h * crate::geometry::norm(sub(vc, va)));
             let expect = if (g(0.0) / area0).abs() < 1e-7 * scale {
                 Expect::Skip
             } else {

@@ -55,17 +55,6 @@ pub(super) fn closest(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> (f64, f64) {
     (xi, (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2))
 }
 
-/// Outward unit normal of a segment oriented with its body on the left.
-fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
-    if l > 0.0 {
-        [d[1] / l, -d[0] / l]
-    } else {
-        [0.0, 0.0]
-    }
-}
-
 /// The topology of a master's segments at the current geometry: each segment's
 /// outward normal and its neighbours along the surface (the segment ending where it
 /// starts, the one starting where it ends).
@@ -86,7 +75,7 @@ impl Chain {
         let mut normal = Vec::with_capacity(m);
         for (k, &[a, b]) in segments.iter().enumerate() {
             starting.insert(a, k);
-            let n = outward(x(a), x(b));
+            let n = crate::geometry::outward(x(a), x(b)).0;
             normal.push(n);
             for v in [a, b] {
                 let e = at_node.entry(v).or_insert([0.0, 0.0]);

@@ -47,26 +47,8 @@ pub const VALLEY_SINE: f64 = 1e-2;
 
 pub(super) type V3 = [f64; 3];
 
-pub(super) fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(super) fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: V3) -> Option<V3> {
-    let l = dot(a, a).sqrt();
-    (l > 0.0 && l.is_finite()).then(|| [a[0] / l, a[1] / l, a[2] / l])
-}
+use crate::geometry::{cross, unit};
+pub(super) use crate::geometry::{dot, sub};
 
 /// The box of `points` grown by `pad` on every side.
 pub(super) fn bounding_box(points: impl Iterator<Item = V3>, pad: f64) -> AABB<V3> {

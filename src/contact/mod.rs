@@ -61,6 +61,7 @@ pub fn candidates(model: &crate::model::Model, u: &[f64], out: &mut Vec<Candidat
 /// quadrilateral: the integrals of its shape functions over a parallelogram); zero
 /// on a slave node set, which has no faces.
 pub fn tributary_areas(model: &crate::model::Model) -> Vec<f64> {
+    use crate::geometry::{cross, distance, norm, sub};
     let mesh = &model.mesh;
     let mut area = vec![0.0; mesh.n_nodes()];
     if mesh.dim == 3 {
@@ -68,20 +69,14 @@ pub fn tributary_areas(model: &crate::model::Model) -> Vec<f64> {
             for f in &side.faces {
                 let c = crate::model::face_corners(f);
                 let x = |k: usize| mesh.coords[c[k % c.len()]];
-                let d = |a: [f64; 3], b: [f64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
                 // Half the cross product of the diagonals (of two edges for a
                 // triangle).
                 let (p, q) = if c.len() == 3 {
-                    (d(x(0), x(1)), d(x(0), x(2)))
+                    (sub(x(1), x(0)), sub(x(2), x(0)))
                 } else {
-                    (d(x(0), x(2)), d(x(1), x(3)))
+                    (sub(x(2), x(0)), sub(x(3), x(1)))
                 };
-                let n = [
-                    p[1] * q[2] - p[2] * q[1],
-                    p[2] * q[0] - p[0] * q[2],
-                    p[0] * q[1] - p[1] * q[0],
-                ];
-                let a = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                let a = 0.5 * norm(cross(p, q));
                 for &v in c {
                     area[v] += a / c.len() as f64;
                 }
@@ -103,8 +98,7 @@ pub fn tributary_areas(model: &crate::model::Model) -> Vec<f64> {
                     for k in 0..nodes.len() {
                         let (p, q) = (nodes[k], nodes[(k + 1) % nodes.len()]);
                         if is_slave[p] && is_slave[q] && seen.insert((p.min(q), p.max(q))) {
-                            let (xp, xq) = (mesh.coords[p], mesh.coords[q]);
-                            let l = ((xp[0] - xq[0]).powi(2) + (xp[1] - xq[1]).powi(2)).sqrt();
+                            let l = distance(mesh.xy(p), mesh.xy(q));
                             area[p] += 0.5 * l * t;
                             area[q] += 0.5 * l * t;
                         }

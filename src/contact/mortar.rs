@@ -32,15 +32,11 @@ use rstar::{RTree, RTreeObject};
 
 use super::rows::{Candidate, Contactee, Weights};
 
-/// The least covered fraction of a slave node's shape-function integral for the node
-/// to get a row: below it the node sees the master over a sliver of its support
-/// only (a master edge ending just inside its segment), too little to weigh a gap
-/// on. A millionth: far below any fraction a real overlap leaves.
-pub const COVERED_FRACTION: f64 = 1e-6;
-
-/// Outward unit normal of a segment with its body on the left.
+/// Outward unit normal of a segment with its body on the left, and its length (as
+/// `hypot`, whose last bits the mortar rows have always had; detection's
+/// [`crate::geometry::outward`] takes `√(Δx² + Δy²)`).
 fn outward(a: [f64; 2], b: [f64; 2]) -> ([f64; 2], f64) {
-    let d = [b[0] - a[0], b[1] - a[1]];
+    let d = crate::geometry::sub(b, a);
     let l = d[0].hypot(d[1]);
     if l > 0.0 {
         ([d[1] / l, -d[0] / l], l)
@@ -48,6 +44,12 @@ fn outward(a: [f64; 2], b: [f64; 2]) -> ([f64; 2], f64) {
         ([0.0, 0.0], 0.0)
     }
 }
+
+/// The least covered fraction of a slave node's shape-function integral for the node
+/// to get a row: below it the node sees the master over a sliver of its support
+/// only (a master edge ending just inside its segment), too little to weigh a gap
+/// on. A millionth: far below any fraction a real overlap leaves.
+pub const COVERED_FRACTION: f64 = 1e-6;
 
 /// What one slave node gathers over its segments.
 #[derive(Clone, Copy)]

@@ -126,7 +126,7 @@ fn behind_line(mesh: &Mesh, body: usize, a: [f64; 2], b: [f64; 2], n: [f64; 2], 
 /// Nodes of `body` behind the rigid plane by more than `tol`.
 fn behind_plane(mesh: &Mesh, body: usize, point: Point, n: Point, tol: f64) -> Found {
     let hits = body_nodes(mesh, body).filter_map(|k| {
-        let gap = super::faces::dot(super::faces::sub(mesh.coords[k], point), n);
+        let gap = crate::geometry::dot(crate::geometry::sub(mesh.coords[k], point), n);
         (gap < -tol).then_some((k, -gap))
     });
     deepest_of(hits, |_| {
@@ -290,9 +290,9 @@ fn inside_solid(p: Point, x: &[Point]) -> bool {
 }
 
 fn inside_tet(p: Point, t: [Point; 4]) -> bool {
-    use super::faces::{dot, sub};
+    use crate::geometry::{dot, sub};
     let vol = |a: Point, b: Point, c: Point, d: Point| {
-        dot(crate::mesh::cross(sub(b, a), sub(c, a)), sub(d, a))
+        dot(crate::geometry::cross(sub(b, a), sub(c, a)), sub(d, a))
     };
     let v = vol(t[0], t[1], t[2], t[3]);
     if v == 0.0 {

@@ -320,7 +320,7 @@ fn oriented_faces(
     coords: &[[f64; 3]],
     faces: Vec<(String, [usize; 4], u64)>,
 ) -> std::result::Result<BTreeMap<String, Vec<[usize; 4]>>, String> {
-    use crate::mesh::{cross, sub};
+    use crate::geometry::{cross, dot, sub};
     // The elements (block, index) at each node.
     let mut at_node: HashMap<usize, Vec<(usize, usize)>> = HashMap::new();
     for (bi, b) in blocks.iter().enumerate() {
@@ -362,7 +362,7 @@ fn oriented_faces(
             sub(coords[f[2]], coords[f[0]]),
         );
         let out_dir = sub(coords[f[0]], centre);
-        if normal[0] * out_dir[0] + normal[1] * out_dir[1] + normal[2] * out_dir[2] < 0.0 {
+        if dot(normal, out_dir) < 0.0 {
             f[1..n].reverse();
         }
         out.entry(name).or_default().push(f);

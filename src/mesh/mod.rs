@@ -65,11 +65,7 @@ impl Elements {
 /// A point in space: `[x, y, z]`; plane models keep `z = 0`.
 pub type Point = [f64; 3];
 
-/// The distance between two points.
-#[inline]
-pub fn distance(p: Point, q: Point) -> f64 {
-    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-}
+pub use crate::geometry::distance;
 
 /// The in-plane coordinates `[x, y]` of a point.
 #[inline]
@@ -525,24 +521,4 @@ impl Mesh {
     }
 }
 
-/// The area of the triangle `a b c` in space.
-pub fn triangle_area(a: Point, b: Point, c: Point) -> f64 {
-    let n = cross(sub(b, a), sub(c, a));
-    0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
-}
-
-/// `a − b`.
-#[inline]
-pub fn sub(a: Point, b: Point) -> Point {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// `a × b`.
-#[inline]
-pub fn cross(a: Point, b: Point) -> Point {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
+pub use crate::geometry::triangle_area;

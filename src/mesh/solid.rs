@@ -207,9 +207,9 @@ mod tests {
                 let mut area = 0.0;
                 for f in faces {
                     let x = |s: usize| p.coords[f[s]];
-                    let nrm = crate::mesh::cross(
-                        crate::mesh::sub(x(1), x(0)),
-                        crate::mesh::sub(x(2), x(0)),
+                    let nrm = crate::geometry::cross(
+                        crate::geometry::sub(x(1), x(0)),
+                        crate::geometry::sub(x(2), x(0)),
                     );
                     let sign = if high { 1.0 } else { -1.0 };
                     assert!(sign * nrm[axis] > 0.0, "{kind:?} {name}: inward face");

@@ -4,12 +4,9 @@
 use super::checks::{finite, positive};
 use crate::config::{ContactSpec, Scenario};
 use crate::error::{Error, Result};
+use crate::geometry::distance as dist;
 use crate::mesh::Mesh;
 use crate::model::{ContactPair, ContactSide, Formulation, Master};
-
-fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
-    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
-}
 
 /// The nodes of a node set or of an edge set.
 fn slave_nodes(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<usize>> {

@@ -185,8 +185,7 @@ fn edge_lengths(mesh: &Mesh, faces: &[[usize; 4]]) -> (f64, f64) {
     for f in faces {
         let c = crate::model::face_corners(f);
         for i in 0..c.len() {
-            let (p, q) = (mesh.coords[c[i]], mesh.coords[c[(i + 1) % c.len()]]);
-            let l = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+            let l = crate::geometry::distance(mesh.coords[c[i]], mesh.coords[c[(i + 1) % c.len()]]);
             long = long.max(l);
             short = short.min(l);
         }

@@ -108,16 +108,6 @@ fn coupling(a: &Dofs, b: &Dofs, m_inv: &[f64]) -> f64 {
     w
 }
 
-fn outward(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
-    if l > 0.0 {
-        [d[1] / l, -d[0] / l]
-    } else {
-        [0.0, 0.0]
-    }
-}
-
 /// What the correction of the last step did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct KinematicStats {
@@ -280,7 +270,7 @@ impl<'m> KinematicContact<'m> {
                                 let pb = at(b);
                                 let va = vel(a);
                                 let vb = vel(b);
-                                let n = outward(
+                                let (n, _) = crate::geometry::outward(
                                     [pa[0] + t_c * va[0], pa[1] + t_c * va[1]],
                                     [pb[0] + t_c * vb[0], pb[1] + t_c * vb[1]],
                                 );

@@ -4,6 +4,7 @@
 
 use super::{Dofs, KinematicContact, Row, ROW_DOFS};
 use crate::contact::collision::node_triangle;
+use crate::geometry::{add, cross, dot, norm, scale, sub};
 use crate::model::Master;
 
 /// A solid's row along `d`: `+d` on the slave, `−w_k d` on the corners `nodes`.
@@ -102,21 +103,10 @@ impl KinematicContact<'_> {
                                         continue;
                                     }
                                     // The triangle's outward normal at the impact.
-                                    let x = |n: usize| {
-                                        let (q, w) = (at(n), vel(n));
-                                        [q[0] + t.t * w[0], q[1] + t.t * w[1], q[2] + t.t * w[2]]
-                                    };
+                                    let x = |n: usize| add(at(n), scale(vel(n), t.t));
                                     let (xa, xb, xc) = (x(a), x(b), x(cc));
-                                    let (e1, e2) = (
-                                        [xb[0] - xa[0], xb[1] - xa[1], xb[2] - xa[2]],
-                                        [xc[0] - xa[0], xc[1] - xa[1], xc[2] - xa[2]],
-                                    );
-                                    let nn = [
-                                        e1[1] * e2[2] - e1[2] * e2[1],
-                                        e1[2] * e2[0] - e1[0] * e2[2],
-                                        e1[0] * e2[1] - e1[1] * e2[0],
-                                    ];
-                                    let l = (nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]).sqrt();
+                                    let nn = cross(sub(xb, xa), sub(xc, xa));
+                                    let l = norm(nn);
                                     // A degenerate triangle (NaN counts as one).
                                     if l.is_nan() || l <= 0.0 {
                                         continue;
@@ -127,7 +117,7 @@ impl KinematicContact<'_> {
                                         face: hit.data,
                                         corners: [(a, t.bary[0]), (b, t.bary[1]), (cc, t.bary[2])],
                                         n_corners: 3,
-                                        normal: [nn[0] / l, nn[1] / l, nn[2] / l],
+                                        normal: nn.map(|c| c / l),
                                     });
                                 }
                             }
@@ -137,8 +127,8 @@ impl KinematicContact<'_> {
                     Master::Plane { point, n, .. } => {
                         for &s in &side.slaves {
                             let (p, w) = (at(s), vel(s));
-                            let g0: f64 = (0..3).map(|i| (p[i] - point[i]) * n[i]).sum();
-                            let vn: f64 = (0..3).map(|i| w[i] * n[i]).sum();
+                            let g0 = dot(sub(p, *point), *n);
+                            let vn = dot(w, *n);
                             // Reaching the plane from its side within the step (a node
                             // on it at the start and moving in meets it at once).
                             if g0 >= 0.0 && vn < 0.0 && g0 + h * vn <= 0.0 {
