@@ -4,7 +4,7 @@
 
 use crate::fe::Idealisation;
 use crate::material::Material;
-use crate::mesh::Mesh;
+use crate::mesh::{Face, Mesh};
 
 /// A scalar function of time that scales a load or a prescribed displacement.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -389,10 +389,9 @@ pub enum Master {
         /// Unit normal pointing to the side the slave body lies on.
         n: [f64; 2],
     },
-    /// Faces of a solid (triangles or quadrilaterals, a triangle's fourth node
-    /// `usize::MAX`), numbered counter-clockwise seen from outside, so their normal
-    /// points out of the body.
-    Faces(Vec<[usize; 4]>),
+    /// Faces of a solid (triangles or quadrilaterals), numbered counter-clockwise
+    /// seen from outside, so their normal points out of the body.
+    Faces(Vec<Face>),
     /// A rigid plane through `point` with unit normal `n` towards the slave body: a
     /// unilateral support of a solid, unbounded.
     Plane {
@@ -417,21 +416,11 @@ pub struct ContactSide {
     pub mortar: Vec<[usize; 2]>,
     /// A solid's slave faces, when the slave is a face set: the tributary areas of
     /// its nodes for the contact pressure; empty otherwise.
-    pub faces: Vec<[usize; 4]>,
+    pub faces: Vec<Face>,
     /// A master face set's boundary edges (sorted node pairs, each an edge of one
     /// face only), where node to face ends: topology, so found once at validation
     /// (`contact::faces::boundary_edges`); empty for other masters.
     pub master_boundary: Vec<[usize; 2]>,
-}
-
-/// The corners of a face: three for a triangle (fourth node `usize::MAX`), else
-/// four.
-pub fn face_corners(face: &[usize; 4]) -> &[usize] {
-    if face[3] == usize::MAX {
-        &face[..3]
-    } else {
-        &face[..]
-    }
 }
 
 impl ContactSide {
@@ -442,7 +431,7 @@ impl ContactSide {
             Master::Segments(segs) => segs.iter().flatten().copied().collect(),
             Master::Faces(faces) => faces
                 .iter()
-                .flat_map(|f| face_corners(f).iter().copied())
+                .flat_map(|f| f.corners().iter().copied())
                 .collect(),
             _ => Vec::new(),
         }

@@ -4,7 +4,7 @@
 use std::sync::OnceLock;
 
 use crate::fe::{kinematics, QuadPoint};
-use crate::mesh::{triangle_area, ElementKind, Mesh};
+use crate::mesh::{triangle_area, ElementKind, Face, Mesh};
 
 /// Consistent nodal forces of a uniform traction `q` (force per area) on the edges
 /// `edges`, for a wall of thickness `thickness`: each node of an edge of length `L`
@@ -26,19 +26,18 @@ pub fn add_edge_traction(
 }
 
 /// Consistent nodal forces of a uniform traction `q` (force per area) on the faces
-/// `faces` of a solid (triangles and quadrilaterals, `usize::MAX` closing a
-/// triangle's fourth slot): a triangle gives each node a third of `q A`; a
+/// `faces` of a solid (triangles and quadrilaterals): a triangle gives each node a third of `q A`; a
 /// quadrilateral `∫ N_a q dA` over its bilinear surface, 2x2 Gauss (exact for a
 /// parallelogram). Adds into `f` (three dofs per node).
-pub fn add_face_traction(mesh: &Mesh, faces: &[[usize; 4]], q: [f64; 3], f: &mut [f64]) {
+pub fn add_face_traction(mesh: &Mesh, faces: &[Face], q: [f64; 3], f: &mut [f64]) {
     for face in faces {
-        if face[3] == usize::MAX {
+        if face.is_triangle() {
             let a = triangle_area(
                 mesh.coords[face[0]],
                 mesh.coords[face[1]],
                 mesh.coords[face[2]],
             );
-            for &n in &face[..3] {
+            for &n in face.corners() {
                 for i in 0..3 {
                     f[3 * n + i] += q[i] * a / 3.0;
                 }
@@ -54,7 +53,7 @@ pub fn add_face_traction(mesh: &Mesh, faces: &[[usize; 4]], q: [f64; 3], f: &mut
 }
 
 /// `∫ N_a dA` over the bilinear surface through the four nodes of `face` (2x2 Gauss).
-pub fn quad_face_weights(mesh: &Mesh, face: &[usize; 4]) -> [f64; 4] {
+pub fn quad_face_weights(mesh: &Mesh, face: &Face) -> [f64; 4] {
     let x: [[f64; 3]; 4] = std::array::from_fn(|a| mesh.coords[face[a]]);
     let mut out = [0.0; 4];
     for &(xi, w) in &crate::fe::QUAD_2X2 {

@@ -27,6 +27,7 @@ use rstar::RTree;
 use crate::model::{ContactPair, Master};
 
 use super::rows::{Candidate, Contactee};
+use super::state::Slave;
 
 /// How close (relative to the segment's length) to a concave vertex a slave's
 /// closest point must be for the segment on the other side of the vertex to hold it
@@ -146,12 +147,7 @@ pub const RIGID_DEPTH_TOLERANCES: f64 = 2.0;
 /// slave stays passed over until it rises above the line's level again. A slave that
 /// starts a run below a line within its ends is not passed over: the constraint
 /// holds it (or reports an infeasible QP).
-pub fn beneath_rigid<X>(
-    pairs: &[ContactPair],
-    x: X,
-    depth: f64,
-    previous: &[(usize, usize, usize)],
-) -> Vec<(usize, usize, usize)>
+pub fn beneath_rigid<X>(pairs: &[ContactPair], x: X, depth: f64, previous: &[Slave]) -> Vec<Slave>
 where
     X: Fn(usize) -> [f64; 2],
 {
@@ -168,7 +164,7 @@ where
 /// A slave of a rigid line at some geometry.
 struct RigidSlave {
     /// `(pair, side, slave)`.
-    key: (usize, usize, usize),
+    key: Slave,
     /// Distance above the line's level.
     gap: f64,
     /// Position along the line (0 and 1 at its ends).
@@ -190,7 +186,7 @@ where
                 for &s in &side.slaves {
                     let p = x(s);
                     f(RigidSlave {
-                        key: (pi, si, s),
+                        key: Slave::new(pi, si, s),
                         gap: (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1],
                         xi: ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2,
                         reach: pair.radius / l2.sqrt(),
@@ -216,18 +212,18 @@ where
     detect_except(pairs, x, &RigidHistory::default(), out)
 }
 
-/// The candidate of slave `key.2` (of pair `key.0`, side `key.1`) against master
+/// The candidate of slave `key` against master
 /// segment `k` with nodes `[a, b]` at the geometry `x`: the point at `ξ` on it and
 /// the normal `n`.
 pub(super) fn segment_candidate<X: Fn(usize) -> [f64; 2]>(
-    key: (usize, usize, usize),
+    key: Slave,
     k: usize,
     [a, b]: [usize; 2],
     x: &X,
     xi: f64,
     n: [f64; 2],
 ) -> Candidate {
-    let (p, xa, xb) = (x(key.2), x(a), x(b));
+    let (p, xa, xb) = (x(key.node), x(a), x(b));
     let q = [xa[0] + xi * (xb[0] - xa[0]), xa[1] + xi * (xb[1] - xa[1])];
     Candidate::nodal(
         key,
@@ -246,12 +242,7 @@ pub(super) fn segment_candidate<X: Fn(usize) -> [f64; 2]>(
 /// (a held slave that slides past an end stays held while it stays on the level),
 /// as sorted `(pair, side, slave)`. The explicit path keeps this list itself; the
 /// implicit one takes it from its active set.
-pub fn held_rigid<X>(
-    pairs: &[ContactPair],
-    x: X,
-    depth: f64,
-    previous: &[(usize, usize, usize)],
-) -> Vec<(usize, usize, usize)>
+pub fn held_rigid<X>(pairs: &[ContactPair], x: X, depth: f64, previous: &[Slave]) -> Vec<Slave>
 where
     X: Fn(usize) -> [f64; 2],
 {
@@ -273,12 +264,12 @@ where
 #[derive(Clone, Debug, Default)]
 pub struct RigidHistory {
     /// Slaves that came around a line's end ([`beneath_rigid`]): not candidates.
-    pub beneath: Vec<(usize, usize, usize)>,
+    pub beneath: Vec<Slave>,
     /// Slaves the line held at the end of the last step: candidates even a little
     /// beyond the line's ends (within the pair's radius), so that a slave at the very
     /// end of a support, which slides outward as the body above it bends, stays on
     /// it instead of slipping off and coming back around the end.
-    pub held: Vec<(usize, usize, usize)>,
+    pub held: Vec<Slave>,
 }
 
 /// [`detect`] with what the committed state knows of the rigid lines' slaves.
@@ -358,7 +349,7 @@ where
                             None
                         };
                         let candidate = |k: usize, xi: f64, n: [f64; 2]| {
-                            segment_candidate((pi, si, s), k, segments[k], &x, xi, n)
+                            segment_candidate(Slave::new(pi, si, s), k, segments[k], &x, xi, n)
                         };
                         let xi = xi.clamp(0.0, 1.0);
                         match notch {
@@ -391,17 +382,17 @@ where
                     let t = [b[0] - a[0], b[1] - a[1]];
                     let l2 = t[0] * t[0] + t[1] * t[1];
                     for &s in &side.slaves {
-                        if rigid.beneath.binary_search(&(pi, si, s)).is_ok() {
+                        if rigid.beneath.binary_search(&Slave::new(pi, si, s)).is_ok() {
                             continue;
                         }
                         let p = x(s);
                         let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
                         let gap = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
-                        let within =
-                            within_ends(xi) || rigid.held.binary_search(&(pi, si, s)).is_ok();
+                        let within = within_ends(xi)
+                            || rigid.held.binary_search(&Slave::new(pi, si, s)).is_ok();
                         if within && gap * gap <= r2 {
                             out.push(Candidate::nodal(
-                                (pi, si, s),
+                                Slave::new(pi, si, s),
                                 Contactee::Rigid,
                                 xi.clamp(0.0, 1.0),
                                 gap,
@@ -515,8 +506,8 @@ mod tests {
         );
         let at4: Vec<_> = out.iter().filter(|c| c.slave == 4).collect();
         assert_eq!(at4.len(), 2, "{out:?}");
-        assert_eq!(at4[0].key().3, 0);
-        assert_eq!(at4[1].key().3, 1);
+        assert_eq!(at4[0].key().target, super::super::state::Target::Facet(0));
+        assert_eq!(at4[1].key().target, super::super::state::Target::Facet(1));
         for c in &at4 {
             // Each along its own segment's normal, the gap that of its line.
             let n = c.normal;
@@ -574,11 +565,14 @@ mod tests {
         // it came around the end (it was passed over at the last step).
         let pairs = [pair];
         assert!(beneath_rigid(&pairs, |n| coords[n], 5e-4, &[]).is_empty());
-        let beneath = beneath_rigid(&pairs, |n| coords[n], 5e-4, &[(0, 0, 2)]);
-        assert_eq!(beneath, [(0, 0, 2)]);
+        let beneath = beneath_rigid(&pairs, |n| coords[n], 5e-4, &[Slave::new(0, 0, 2)]);
+        assert_eq!(beneath, [Slave::new(0, 0, 2)]);
         // Beyond the end and below: passed over.
         let beyond = [[0.1, 0.2], [0.3, -0.001], [0.2, 0.0]];
-        assert_eq!(beneath_rigid(&pairs, |n| beyond[n], 5e-4, &[]), [(0, 0, 1)]);
+        assert_eq!(
+            beneath_rigid(&pairs, |n| beyond[n], 5e-4, &[]),
+            [Slave::new(0, 0, 1)]
+        );
         let mut rigid = RigidHistory {
             beneath,
             held: Vec::new(),
@@ -587,22 +581,39 @@ mod tests {
         assert!(out.is_empty());
         // A held slave stays a candidate beyond the line's end (node 1 at ξ = 2.2
         // is within the radius of the line's level).
-        rigid.held = vec![(0, 0, 1)];
+        rigid.held = vec![Slave::new(0, 0, 1)];
         detect_except(&pairs, |n| coords[n], &rigid, &mut out);
         assert_eq!(out.len(), 1);
         assert_eq!((out[0].slave, out[0].xi), (1, 1.0));
-        assert!(beneath_rigid(&pairs, |n| coords[n], 2e-3, &[(0, 0, 2)]).is_empty());
+        assert!(beneath_rigid(&pairs, |n| coords[n], 2e-3, &[Slave::new(0, 0, 2)]).is_empty());
         // Held: on the line's level within its ends, or past an end if held before.
         let on = [[0.1, 0.0], [0.2305, 0.0], [0.3, 0.0]];
-        assert_eq!(held_rigid(&pairs, |n| on[n], 1e-6, &[]), [(0, 0, 0)]);
         assert_eq!(
-            held_rigid(&pairs, |n| on[n], 1e-6, &[(0, 0, 1), (0, 0, 2)]),
-            [(0, 0, 0), (0, 0, 1), (0, 0, 2)]
+            held_rigid(&pairs, |n| on[n], 1e-6, &[]),
+            [Slave::new(0, 0, 0)]
+        );
+        assert_eq!(
+            held_rigid(
+                &pairs,
+                |n| on[n],
+                1e-6,
+                &[Slave::new(0, 0, 1), Slave::new(0, 0, 2)]
+            ),
+            [
+                Slave::new(0, 0, 0),
+                Slave::new(0, 0, 1),
+                Slave::new(0, 0, 2)
+            ]
         );
         let off = [[0.1, 0.01], [0.2305, 0.0], [0.5, 0.0]];
         assert_eq!(
-            held_rigid(&pairs, |n| off[n], 1e-6, &[(0, 0, 1), (0, 0, 2)]),
-            [(0, 0, 1)]
+            held_rigid(
+                &pairs,
+                |n| off[n],
+                1e-6,
+                &[Slave::new(0, 0, 1), Slave::new(0, 0, 2)]
+            ),
+            [Slave::new(0, 0, 1)]
         );
     }
 }

@@ -21,13 +21,14 @@
 //! common boundary, both faces hold it, each as the half-space of its own plane, as
 //! the plane's notches are (`theory/contact3d.md`).
 
-use crate::model::face_corners;
+use crate::mesh::Face;
 use std::collections::HashMap;
 
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
 use super::rows::{Candidate, Contactee, Weights};
+use super::state::Slave;
 use crate::model::{ContactPair, Master};
 
 /// How close (in the face's local coordinates, relative to its size) to an edge a
@@ -68,7 +69,7 @@ pub(super) type FaceTree = RTree<GeomWithData<Rectangle<V3>, usize>>;
 
 /// See [`FaceTree`].
 pub(super) fn face_tree<I: Iterator<Item = V3>>(
-    faces: &[[usize; 4]],
+    faces: &[Face],
     at: impl Fn(usize) -> I,
     pad: f64,
 ) -> FaceTree {
@@ -77,7 +78,7 @@ pub(super) fn face_tree<I: Iterator<Item = V3>>(
             .iter()
             .enumerate()
             .map(|(k, f)| {
-                let b = bounding_box(face_corners(f).iter().flat_map(|&n| at(n)), pad);
+                let b = bounding_box(f.corners().iter().flat_map(|&n| at(n)), pad);
                 GeomWithData::new(Rectangle::from_aabb(b), k)
             })
             .collect(),
@@ -280,8 +281,8 @@ fn quadrilateral(p: V3, x: [V3; 4]) -> Option<Projection> {
 
 /// The closest point of `face` (corner positions from `x`) to `p`; `None` for a
 /// degenerate face.
-pub fn project<X: Fn(usize) -> V3>(p: V3, face: &[usize; 4], x: &X) -> Option<Projection> {
-    if face[3] == usize::MAX {
+pub fn project<X: Fn(usize) -> V3>(p: V3, face: &Face, x: &X) -> Option<Projection> {
+    if face.is_triangle() {
         triangle(p, [x(face[0]), x(face[1]), x(face[2])])
     } else {
         quadrilateral(p, [x(face[0]), x(face[1]), x(face[2]), x(face[3])])
@@ -296,11 +297,11 @@ pub(super) struct Surface {
 }
 
 impl Surface {
-    pub(super) fn new<X: Fn(usize) -> V3>(faces: &[[usize; 4]], x: &X) -> Surface {
+    pub(super) fn new<X: Fn(usize) -> V3>(faces: &[Face], x: &X) -> Surface {
         let mut normal = Vec::with_capacity(faces.len());
         let mut at_node: HashMap<usize, V3> = HashMap::with_capacity(faces.len());
         for f in faces {
-            let c = face_corners(f);
+            let c = f.corners();
             let n = if c.len() == 3 {
                 cross(sub(x(c[1]), x(c[0])), sub(x(c[2]), x(c[0])))
             } else {
@@ -329,9 +330,9 @@ impl Surface {
     /// faces' own from one iteration to the next; on a flat surface it is the
     /// surface's normal. Over a convex ridge or corner it is the ridge's or corner's
     /// mean normal.
-    pub(super) fn normal(&self, face: &[usize; 4], pr: &Projection) -> V3 {
+    pub(super) fn normal(&self, face: &Face, pr: &Projection) -> V3 {
         let mut n = [0.0; 3];
-        for (k, &v) in face_corners(face).iter().enumerate() {
+        for (k, &v) in face.corners().iter().enumerate() {
             if let Some(m) = self.at_node.get(&v) {
                 for i in 0..3 {
                     n[i] += pr.weights[k] * m[i];
@@ -344,11 +345,11 @@ impl Surface {
 
 /// The boundary edges of a face set: the sorted node pairs that one face only has,
 /// sorted. Where a master surface ends (validation stores them with the side).
-pub fn boundary_edges(faces: &[[usize; 4]]) -> Vec<[usize; 2]> {
+pub fn boundary_edges(faces: &[Face]) -> Vec<[usize; 2]> {
     let mut edges: Vec<[usize; 2]> = faces
         .iter()
         .flat_map(|f| {
-            let c = face_corners(f);
+            let c = f.corners();
             (0..c.len()).map(move |i| {
                 let (a, b) = (c[i], c[(i + 1) % c.len()]);
                 [a.min(b), a.max(b)]
@@ -372,11 +373,11 @@ pub fn boundary_edges(faces: &[[usize; 4]]) -> Vec<[usize; 2]> {
 fn beyond_boundary<X: Fn(usize) -> V3>(
     (edges, rim): (&[[usize; 2]], &[usize]),
     p: V3,
-    face: &[usize; 4],
+    face: &Face,
     pr: &Projection,
     x: &X,
 ) -> bool {
-    let c = face_corners(face);
+    let c = face.corners();
     let on_edge = match pr.region {
         Region::Edge(i) => {
             let (a, b) = (c[i], c[(i + 1) % c.len()]);
@@ -418,32 +419,32 @@ pub fn plane_tangents(n: V3) -> [V3; 2] {
     [t1, cross(n, t1)]
 }
 
-/// The row of slave `key.2` against master face `index` at its projection `pr`,
+/// The row of slave `key` against master face `index` at its projection `pr`,
 /// along `normal`.
 pub(super) fn face_candidate<X: Fn(usize) -> V3>(
-    key: (usize, usize, usize),
+    key: Slave,
     index: usize,
-    face: &[usize; 4],
+    face: &Face,
     pr: &Projection,
     normal: V3,
     x: &X,
 ) -> Candidate {
     let mut weights = Weights::EMPTY;
-    weights.add(key.2, 1.0);
-    for (k, &v) in face_corners(face).iter().enumerate() {
+    weights.add(key.node, 1.0);
+    for (k, &v) in face.corners().iter().enumerate() {
         weights.add(v, -pr.weights[k]);
     }
     let tangents = plane_tangents(normal);
     Candidate {
-        pair: key.0,
-        side: key.1,
-        slave: key.2,
+        pair: key.pair,
+        side: key.side,
+        slave: key.node,
         master: Contactee::Face {
             index,
             nodes: *face,
         },
         xi: 0.0,
-        gap: dot(sub(x(key.2), pr.point), normal),
+        gap: dot(sub(x(key.node), pr.point), normal),
         normal,
         tangents,
         dim: 3,
@@ -499,7 +500,7 @@ where
 fn faces_side<X: Fn(usize) -> V3>(
     (pi, si): (usize, usize),
     side: &crate::model::ContactSide,
-    faces: &[[usize; 4]],
+    faces: &[Face],
     r: f64,
     x: &X,
     out: &mut Vec<Candidate>,
@@ -521,7 +522,7 @@ fn faces_side<X: Fn(usize) -> V3>(
         near.clear();
         for hit in tree.locate_in_envelope_intersecting(reach) {
             let f = &faces[hit.data];
-            if face_corners(f).contains(&s) {
+            if f.corners().contains(&s) {
                 continue;
             }
             if let Some(pr) = project(p, f, x) {
@@ -555,7 +556,7 @@ fn faces_side<X: Fn(usize) -> V3>(
         if beyond_boundary((edges, &rim), p, &faces[k], &pr, x) {
             continue;
         }
-        let key = (pi, si, s);
+        let key = Slave::new(pi, si, s);
         // Faces rising beyond the edge or corner the point is at (or near): a
         // valley, each face its own half-space.
         let on_boundary = match pr.region {
@@ -566,9 +567,10 @@ fn faces_side<X: Fn(usize) -> V3>(
         if on_boundary {
             let nk = surface.normal[k];
             let shared = |f: usize| {
-                face_corners(&faces[f])
+                faces[f]
+                    .corners()
                     .iter()
-                    .any(|v| face_corners(&faces[k]).contains(v))
+                    .any(|v| faces[k].corners().contains(v))
             };
             for (f, prf) in &near {
                 if *f == k || !shared(*f) {
@@ -581,8 +583,9 @@ fn faces_side<X: Fn(usize) -> V3>(
                 // The corners of the neighbour it does not share with the nearest
                 // face (a shared one lies on the boundary, where round-off decides
                 // the sign).
-                let own = face_corners(&faces[k]);
-                let rises = face_corners(&faces[*f])
+                let own = faces[k].corners();
+                let rises = faces[*f]
+                    .corners()
                     .iter()
                     .filter(|v| !own.contains(v))
                     .any(|&v| {
@@ -682,7 +685,7 @@ mod tests {
         }
     }
 
-    fn side(slaves: Vec<usize>, faces: Vec<[usize; 4]>) -> ContactPair {
+    fn side(slaves: Vec<usize>, faces: Vec<Face>) -> ContactPair {
         ContactPair {
             name: "p".into(),
             sides: vec![crate::model::ContactSide {
@@ -716,7 +719,10 @@ mod tests {
                 [0.0, 1e-9, 0.5], // slave over the common edge
             ]
         };
-        let faces = vec![[0, 1, 2, 3], [1, 0, 4, 5]];
+        let faces = vec![
+            Face::quadrilateral([0, 1, 2, 3]),
+            Face::quadrilateral([1, 0, 4, 5]),
+        ];
         let mut out = Vec::new();
         let x = geometry(0.2);
         detect(&[side(vec![6], faces.clone())], |n| x[n], &mut out);

@@ -30,7 +30,7 @@ pub mod sweep;
 
 pub use implicit::ContactCorrection;
 pub use rows::{gap_matrix, Candidate, Contactee};
-pub use state::{ContactState, PairRecord};
+pub use state::{ContactState, Key, PairRecord, Slave, Target};
 
 /// The candidates of every pair at displacements `u` (all dofs), by the detection
 /// of the model's dimension: segments and rigid lines in the plane
@@ -67,7 +67,7 @@ pub fn tributary_areas(model: &crate::model::Model) -> Vec<f64> {
     if mesh.dim == 3 {
         for side in model.contacts.iter().flat_map(|p| &p.sides) {
             for f in &side.faces {
-                let c = crate::model::face_corners(f);
+                let c = f.corners();
                 let x = |k: usize| mesh.coords[c[k % c.len()]];
                 // Half the cross product of the diagonals (of two edges for a
                 // triangle).

@@ -209,7 +209,7 @@ fn inside_body(
 /// An edge (plane) or face (solid) on a body's boundary.
 enum Facet {
     Edge([usize; 2]),
-    Face([usize; 4]),
+    Face(crate::mesh::Face),
 }
 
 impl Facet {
@@ -241,11 +241,12 @@ fn exterior(mesh: &Mesh, body: usize) -> Vec<Facet> {
                 kind.faces()
                     .iter()
                     .map(|f| {
-                        let mut face = [usize::MAX; 4];
+                        let mut face = [0; 4];
                         for (k, &a) in f.iter().enumerate() {
                             face[k] = nodes[a];
                         }
-                        Facet::Face(face)
+                        let face = crate::mesh::Face::from_corners(&face[..f.len()]);
+                        Facet::Face(face.expect("an element face has three or four corners"))
                     })
                     .collect()
             } else {
@@ -256,7 +257,7 @@ fn exterior(mesh: &Mesh, body: usize) -> Vec<Facet> {
             for f in facets {
                 let mut key: Vec<usize> = match &f {
                     Facet::Edge(e) => e.to_vec(),
-                    Facet::Face(f) => crate::model::face_corners(f).to_vec(),
+                    Facet::Face(f) => f.corners().to_vec(),
                 };
                 key.sort_unstable();
                 uses.entry(key).or_insert((0, f)).0 += 1;

@@ -7,6 +7,8 @@
 //! ([`super::mortar`]) build them, the implicit correction, friction and the ledger
 //! read them the same way. Here too the sparse gap matrices of a set of rows.
 
+use super::state::{Key, Slave, Target};
+
 /// What a slave node is in contact with.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Contactee {
@@ -17,13 +19,12 @@ pub enum Contactee {
         /// End nodes.
         nodes: [usize; 2],
     },
-    /// Face `index` of the side's master (a solid's triangle or quadrilateral),
-    /// its nodes (a triangle's fourth `usize::MAX`).
+    /// Face `index` of the side's master (a solid's triangle or quadrilateral).
     Face {
         /// Index among the side's master faces.
         index: usize,
-        /// Corner nodes.
-        nodes: [usize; 4],
+        /// The face.
+        nodes: crate::mesh::Face,
     },
     /// The rigid line (plane: rigid plane) of the pair's side.
     Rigid,
@@ -129,25 +130,26 @@ pub struct Candidate {
     pub length: f64,
 }
 
-/// The key of a mortar row's master in [`Candidate::key`].
-pub const MORTAR_KEY: usize = usize::MAX - 1;
-
 impl Candidate {
-    /// The key of the constraint: pair, side, slave node and master segment (the
-    /// segment's index in the side, `usize::MAX` for a rigid line, [`MORTAR_KEY`]
-    /// for a mortar row).
-    pub fn key(&self) -> (usize, usize, usize, usize) {
-        let master = match self.master {
-            Contactee::Segment { index, .. } | Contactee::Face { index, .. } => index,
-            Contactee::Rigid => usize::MAX,
-            Contactee::Mortar => MORTAR_KEY,
+    /// The key of the constraint: its slave and the master facet, rigid master or
+    /// mortar projection it meets.
+    pub fn key(&self) -> Key {
+        let target = match self.master {
+            Contactee::Segment { index, .. } | Contactee::Face { index, .. } => {
+                Target::Facet(index)
+            }
+            Contactee::Rigid => Target::Rigid,
+            Contactee::Mortar => Target::Mortar,
         };
-        (self.pair, self.side, self.slave, master)
+        Key {
+            slave: self.slave_key(),
+            target,
+        }
     }
 
     /// The slave's key: pair, side, slave node.
-    pub fn slave_key(&self) -> (usize, usize, usize) {
-        (self.pair, self.side, self.slave)
+    pub fn slave_key(&self) -> Slave {
+        Slave::new(self.pair, self.side, self.slave)
     }
 
     /// The unit tangent `t = (n_y, −n_x)` of a plane row: the direction of its
@@ -211,7 +213,11 @@ impl Candidate {
     /// A node-to-segment or rigid-line candidate: the weights `+1` on the slave and
     /// `−(1−ξ), −ξ` on a segment's ends.
     pub fn nodal(
-        (pair, side, slave): (usize, usize, usize),
+        Slave {
+            pair,
+            side,
+            node: slave,
+        }: Slave,
         master: Contactee,
         xi: f64,
         gap: f64,

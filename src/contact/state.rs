@@ -5,9 +5,44 @@
 
 use crate::model::Model;
 
-/// Key of a constraint across re-linearisations: pair, side, slave node, master
-/// segment (`rows::Candidate::key`).
-pub type Key = (usize, usize, usize, usize);
+/// A slave node of one side of a pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Slave {
+    /// Pair index.
+    pub pair: usize,
+    /// Direction within the pair.
+    pub side: usize,
+    /// The slave node.
+    pub node: usize,
+}
+
+impl Slave {
+    /// The slave `node` of side `side` of pair `pair`.
+    pub fn new(pair: usize, side: usize, node: usize) -> Slave {
+        Slave { pair, side, node }
+    }
+}
+
+/// What a constraint's slave node meets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Target {
+    /// Facet `k` (segment or face) of the side's deformable master.
+    Facet(usize),
+    /// The master surface as mortar sees it: the node's weighted gap.
+    Mortar,
+    /// The side's rigid line or plane.
+    Rigid,
+}
+
+/// Key of a constraint across re-linearisations: its slave and what it meets
+/// (`rows::Candidate::key`), ordered by pair, side, slave node, then target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Key {
+    /// The slave node.
+    pub slave: Slave,
+    /// What it meets.
+    pub target: Target,
+}
 
 /// One pair's contact at the end of a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]

@@ -3,18 +3,18 @@
 //! [`super::detect`] (or [`super::faces`] in a solid) reaches (theory/contact.md,
 //! "Nothing crosses unseen"; theory/contact3d.md).
 
-use crate::model::face_corners;
 use rstar::primitives::GeomWithData;
 use rstar::{RTree, RTreeObject};
 
 use super::detect::{closest, segment_candidate, within_ends, Chain, RigidHistory};
 use super::faces::{bounding_box, dot, face_candidate, face_tree, project, sub, Surface, V3};
 use super::rows::{Candidate, Contactee, Weights};
+use super::state::Slave;
 use crate::model::{ContactPair, Master};
 
 /// Whether slave `key` has a candidate among `found` (ordered by slave key: a binary
 /// search, no set built on this per-iteration path).
-fn known(found: &[Candidate], key: (usize, usize, usize)) -> bool {
+fn known(found: &[Candidate], key: Slave) -> bool {
     found
         .binary_search_by_key(&key, Candidate::slave_key)
         .is_ok()
@@ -69,7 +69,7 @@ pub fn crossed<X0, X1>(
                         segments.iter().flatten().copied(),
                         pair.radius,
                         |n| dist(x0(n), x1(n)),
-                        |s| known(&out[..before], (pi, si, s)),
+                        |s| known(&out[..before], Slave::new(pi, si, s)),
                     );
                     if movers.is_empty() {
                         continue;
@@ -111,7 +111,7 @@ pub fn crossed<X0, X1>(
                             let [a, b] = segments[k];
                             let xi = closest(p1, x1(a), x1(b)).0.clamp(0.0, 1.0);
                             out.push(segment_candidate(
-                                (pi, si, s),
+                                Slave::new(pi, si, s),
                                 k,
                                 segments[k],
                                 &x1,
@@ -132,8 +132,8 @@ pub fn crossed<X0, X1>(
                         // Moving into the line and behind it at the end (a slave resting
                         // on it starts at a gap of round-off, of either sign).
                         if !(g1 < 0.0 && g1 < g0)
-                            || known(&out[..before], (pi, si, s))
-                            || rigid.beneath.binary_search(&(pi, si, s)).is_ok()
+                            || known(&out[..before], Slave::new(pi, si, s))
+                            || rigid.beneath.binary_search(&Slave::new(pi, si, s)).is_ok()
                         {
                             continue;
                         }
@@ -141,7 +141,7 @@ pub fn crossed<X0, X1>(
                         let pc = [p0[0] + c * (p1[0] - p0[0]), p0[1] + c * (p1[1] - p0[1])];
                         if within_ends(along(pc)) {
                             out.push(Candidate::nodal(
-                                (pi, si, s),
+                                Slave::new(pi, si, s),
                                 Contactee::Rigid,
                                 along(p1).clamp(0.0, 1.0),
                                 g1,
@@ -195,10 +195,10 @@ where
                 Master::Faces(faces) => {
                     let movers = movers(
                         &side.slaves,
-                        faces.iter().flat_map(|f| face_corners(f).iter().copied()),
+                        faces.iter().flat_map(|f| f.corners().iter().copied()),
                         pair.radius,
                         |n| dist(x0(n), x1(n)),
-                        |s| known(&out[..before], (pi, si, s)),
+                        |s| known(&out[..before], Slave::new(pi, si, s)),
                     );
                     if movers.is_empty() {
                         continue;
@@ -211,7 +211,7 @@ where
                         let mut first: Option<(f64, usize)> = None;
                         for hit in tree.locate_in_envelope_intersecting(reach) {
                             let f = &faces[hit.data];
-                            let c = face_corners(f);
+                            let c = f.corners();
                             if c.contains(&s) {
                                 continue;
                             }
@@ -245,7 +245,7 @@ where
                             if let Some(pr) = project(p1, &faces[k], &x1) {
                                 let normal = surface.normal(&faces[k], &pr);
                                 out.push(face_candidate(
-                                    (pi, si, s),
+                                    Slave::new(pi, si, s),
                                     k,
                                     &faces[k],
                                     &pr,
@@ -259,7 +259,7 @@ where
                 Master::Plane { point, n, tangents } => {
                     for &s in &side.slaves {
                         let (g0, g1) = (dot(sub(x0(s), *point), *n), dot(sub(x1(s), *point), *n));
-                        if g0 >= 0.0 && g1 < 0.0 && !known(&out[..before], (pi, si, s)) {
+                        if g0 >= 0.0 && g1 < 0.0 && !known(&out[..before], Slave::new(pi, si, s)) {
                             let mut weights = Weights::EMPTY;
                             weights.add(s, 1.0);
                             out.push(Candidate {

@@ -17,7 +17,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use super::msh41::{self, MshFile};
-use super::{ElementKind, Elements, Part};
+use super::{ElementKind, Elements, Face, Part};
 use crate::error::{Error, Result};
 
 /// Reads a Gmsh v4.1 file into a [`Part`].
@@ -220,7 +220,7 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
     let (coords, node_tags, tag_to_index) = nodes(msh, true)?;
     let set_names = group_names(msh)?;
     let mut volumes: [(Vec<usize>, Vec<u64>); 2] = Default::default();
-    let mut faces: Vec<(String, [usize; 4], u64)> = Vec::new();
+    let mut faces: Vec<(String, Face, u64)> = Vec::new();
     let mut volume_elements: HashMap<Vec<usize>, u64> = HashMap::new();
     let node_sets = walk_elements(msh, &tag_to_index, &set_names, |el| {
         let (tag, ns) = (el.tag, &mut *el.nodes);
@@ -253,8 +253,7 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
                 volumes[slot].1.push(tag);
             }
             2 | 3 => {
-                let mut f = [usize::MAX; 4];
-                f[..ns.len()].copy_from_slice(ns);
+                let f = Face::from_corners(ns).expect("a triangle's or quadrilateral's nodes");
                 for g in el.groups {
                     faces.push((g.clone(), f, tag));
                 }
@@ -318,8 +317,8 @@ fn parse_solid(msh: &MshFile) -> std::result::Result<Part, String> {
 fn oriented_faces(
     blocks: &[Elements],
     coords: &[[f64; 3]],
-    faces: Vec<(String, [usize; 4], u64)>,
-) -> std::result::Result<BTreeMap<String, Vec<[usize; 4]>>, String> {
+    faces: Vec<(String, Face, u64)>,
+) -> std::result::Result<BTreeMap<String, Vec<Face>>, String> {
     use crate::geometry::{cross, dot, sub};
     // The elements (block, index) at each node.
     let mut at_node: HashMap<usize, Vec<(usize, usize)>> = HashMap::new();
@@ -338,12 +337,11 @@ fn oriented_faces(
             .iter()
             .any(|f| corners.iter().all(|c| f.iter().any(|&a| el[a] == *c)))
     };
-    let mut out: BTreeMap<String, Vec<[usize; 4]>> = BTreeMap::new();
+    let mut out: BTreeMap<String, Vec<Face>> = BTreeMap::new();
     for (name, mut f, tag) in faces {
-        let n = if f[3] == usize::MAX { 3 } else { 4 };
         let owner = at_node
             .get(&f[0])
-            .and_then(|els| els.iter().find(|&&(bi, e)| lies_on(&f[..n], bi, e)));
+            .and_then(|els| els.iter().find(|&&(bi, e)| lies_on(f.corners(), bi, e)));
         let Some(&(bi, e)) = owner else {
             return Err(format!(
                 "surface element with Gmsh tag {tag} (group `{name}`) does not lie on a \
@@ -363,7 +361,7 @@ fn oriented_faces(
         );
         let out_dir = sub(coords[f[0]], centre);
         if dot(normal, out_dir) < 0.0 {
-            f[1..n].reverse();
+            f.corners_mut()[1..].reverse();
         }
         out.entry(name).or_default().push(f);
     }

@@ -5,6 +5,7 @@
 //! prefixed by the body name, `beam.left`), plus the bar elements that share the
 //! continuum's nodes. Start with [`structured::rectangle`] and [`Mesh::add_part`].
 
+pub mod face;
 pub mod gmsh;
 pub mod msh41;
 pub mod solid;
@@ -14,6 +15,7 @@ use std::collections::BTreeMap;
 
 use crate::error::{Error, Result};
 pub use crate::fe::{polygon_area, ElementKind};
+pub use face::Face;
 
 /// Elements of one kind with flattened connectivity (`nodes()` indices per element).
 #[derive(Clone, Debug, PartialEq)]
@@ -155,9 +157,9 @@ pub struct Part {
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Named boundary edge sets (node pairs, oriented with the body on the left).
     pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
-    /// Named boundary face sets of a solid (quadrilaterals, or triangles with
-    /// `usize::MAX` in the fourth slot; counter-clockwise seen from outside).
-    pub face_sets: BTreeMap<String, Vec<[usize; 4]>>,
+    /// Named boundary face sets of a solid (triangles and quadrilaterals,
+    /// counter-clockwise seen from outside).
+    pub face_sets: BTreeMap<String, Vec<Face>>,
     /// The node tags of the file the part came from (Gmsh), for messages.
     pub node_tags: Option<Vec<u64>>,
 }
@@ -262,7 +264,7 @@ pub struct Mesh {
     /// Edge sets, named `body.set`.
     pub edge_sets: BTreeMap<String, Vec<[usize; 2]>>,
     /// Face sets of solids, named `body.set` (see [`Part::face_sets`]).
-    pub face_sets: BTreeMap<String, Vec<[usize; 4]>>,
+    pub face_sets: BTreeMap<String, Vec<Face>>,
 }
 
 impl Default for Mesh {
@@ -354,10 +356,7 @@ impl Mesh {
         for (name, faces) in &part.face_sets {
             self.face_sets.insert(
                 format!("{body_name}.{name}"),
-                faces
-                    .iter()
-                    .map(|f| f.map(|n| if n == usize::MAX { n } else { n + off }))
-                    .collect(),
+                faces.iter().map(|f| f.map(|n| n + off)).collect(),
             );
         }
         let all: Vec<usize> = (off..off + part.coords.len()).collect();

@@ -109,7 +109,7 @@ pub fn block(origin: [f64; 3], xs: &[f64], ys: &[f64], zs: &[f64], kind: Element
             }
         }
     }
-    let mut face_sets: BTreeMap<String, Vec<[usize; 4]>> = BTreeMap::new();
+    let mut face_sets: BTreeMap<String, Vec<crate::mesh::Face>> = BTreeMap::new();
     let elements = Elements::new(kind, conn);
     for &(name, axis, high) in &FACES {
         let value = at(axis, high);
@@ -127,11 +127,11 @@ pub fn block(origin: [f64; 3], xs: &[f64], ys: &[f64], zs: &[f64], kind: Element
                     ijk[axis] == value
                 });
                 if on {
-                    let mut q = [usize::MAX; 4];
+                    let mut q = [0; 4];
                     for (s, &a) in f.iter().enumerate() {
                         q[s] = el[a];
                     }
-                    faces.push(q);
+                    faces.extend(crate::mesh::Face::from_corners(&q[..f.len()]));
                 }
             }
         }
@@ -213,7 +213,7 @@ mod tests {
                     );
                     let sign = if high { 1.0 } else { -1.0 };
                     assert!(sign * nrm[axis] > 0.0, "{kind:?} {name}: inward face");
-                    area += if f[3] == usize::MAX {
+                    area += if f.is_triangle() {
                         crate::mesh::triangle_area(x(0), x(1), x(2))
                     } else {
                         crate::mesh::triangle_area(x(0), x(1), x(2))

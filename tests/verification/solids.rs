@@ -569,7 +569,10 @@ fn a_gmsh_solid_is_read_oriented_and_carries_uniaxial_stress_exactly() {
     for (name, sign) in [("left", -1.0), ("right", 1.0)] {
         for f in &part.face_sets[name] {
             let x = |s: usize| part.coords[f[s]];
-            let n = rothe::mesh::cross(rothe::mesh::sub(x(1), x(0)), rothe::mesh::sub(x(2), x(0)));
+            let n = rothe::geometry::cross(
+                rothe::geometry::sub(x(1), x(0)),
+                rothe::geometry::sub(x(2), x(0)),
+            );
             assert!(sign * n[0] > 0.0, "{name}: the face points inwards");
         }
     }

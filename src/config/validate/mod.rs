@@ -282,7 +282,8 @@ fn initial_overlap(model: &Model) -> Result<()> {
         crate::contact::rows::Contactee::Mortar => "the master surface (mortar)".to_string(),
         crate::contact::rows::Contactee::Face { nodes, .. } => format!(
             "the master face of nodes {}",
-            crate::model::face_corners(&nodes)
+            nodes
+                .corners()
                 .iter()
                 .map(|n| n.to_string())
                 .collect::<Vec<_>>()

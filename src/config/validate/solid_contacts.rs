@@ -4,7 +4,7 @@
 use super::checks::finite;
 use crate::config::{ContactSpec, RigidPlaneSpec};
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
+use crate::mesh::{Face, Mesh};
 use crate::model::{ContactSide, Formulation, Master};
 
 /// The sides of pair `field` in a solid, its search radius and its shortest master
@@ -47,7 +47,7 @@ pub(super) fn sides(
             let faces = master_faces(mesh, &format!("{field}.master"), m)?;
             let mut master_nodes: Vec<usize> = faces
                 .iter()
-                .flat_map(|f| crate::model::face_corners(f).iter().copied())
+                .flat_map(|f| f.corners().iter().copied())
                 .collect();
             master_nodes.sort_unstable();
             master_nodes.dedup();
@@ -124,14 +124,14 @@ pub(super) fn sides(
 }
 
 /// The nodes of a node set or a face set, and the faces of a face set.
-fn slave_set(mesh: &Mesh, field: &str, name: &str) -> Result<(Vec<usize>, Vec<[usize; 4]>)> {
+fn slave_set(mesh: &Mesh, field: &str, name: &str) -> Result<(Vec<usize>, Vec<Face>)> {
     if let Some(faces) = mesh.face_sets.get(name) {
         if faces.is_empty() {
             return Err(Error::config(field, format!("face set `{name}` is empty")));
         }
         let mut nodes: Vec<usize> = faces
             .iter()
-            .flat_map(|f| crate::model::face_corners(f).iter().copied())
+            .flat_map(|f| f.corners().iter().copied())
             .collect();
         nodes.sort_unstable();
         nodes.dedup();
@@ -161,7 +161,7 @@ fn known<'a>(names: impl Iterator<Item = &'a String>) -> String {
 }
 
 /// The faces of a face set.
-fn master_faces(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<[usize; 4]>> {
+fn master_faces(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<Face>> {
     match mesh.face_sets.get(name) {
         Some(f) if !f.is_empty() => Ok(f.clone()),
         Some(_) => Err(Error::config(field, format!("face set `{name}` is empty"))),
@@ -180,10 +180,10 @@ fn master_faces(mesh: &Mesh, field: &str, name: &str) -> Result<Vec<[usize; 4]>>
 }
 
 /// The longest and the shortest edge of a set of faces.
-fn edge_lengths(mesh: &Mesh, faces: &[[usize; 4]]) -> (f64, f64) {
+fn edge_lengths(mesh: &Mesh, faces: &[Face]) -> (f64, f64) {
     let (mut long, mut short) = (0.0f64, f64::INFINITY);
     for f in faces {
-        let c = crate::model::face_corners(f);
+        let c = f.corners();
         for i in 0..c.len() {
             let l = crate::geometry::distance(mesh.coords[c[i]], mesh.coords[c[(i + 1) % c.len()]]);
             long = long.max(l);

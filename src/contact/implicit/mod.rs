@@ -33,8 +33,8 @@ use crate::model::{ContactPair, ContactQp, Model};
 use crate::nonlinear::{ConstraintStatus, Corrected, Correction};
 use crate::system::EffectiveSystem;
 
-use super::state::Key;
 pub use super::state::{ContactState, PairRecord};
+use super::state::{Key, Slave, Target};
 
 /// A sparse row of `G` times a vector over the free dofs.
 fn row_dot(row: &nalgebra_sparse::csr::CsrRow<'_, f64>, x: &[f64]) -> f64 {
@@ -46,10 +46,10 @@ fn row_dot(row: &nalgebra_sparse::csr::CsrRow<'_, f64>, x: &[f64]) -> f64 {
 }
 
 /// The slaves (pair, side, node) of a sorted list of constraint keys, distinct.
-fn slaves(keys: &[Key]) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+fn slaves(keys: &[Key]) -> impl Iterator<Item = Slave> + '_ {
     let mut last = None;
     keys.iter().filter_map(move |k| {
-        let s = (k.0, k.1, k.2);
+        let s = k.slave;
         (last.replace(s) != Some(s)).then_some(s)
     })
 }
@@ -310,8 +310,8 @@ impl<'m> ContactCorrection<'m> {
         self.rigid.held = self
             .current
             .iter()
-            .filter(|k| k.3 == usize::MAX)
-            .map(|k| (k.0, k.1, k.2))
+            .filter(|k| k.target == Target::Rigid)
+            .map(|k| k.slave)
             .collect();
         self.rigid.held.sort_unstable();
         self.rigid.held.dedup();
@@ -372,8 +372,8 @@ impl<'m> ContactCorrection<'m> {
                 }
             }
         }
-        for (pair, _, _) in slaves(&self.current) {
-            out.pairs[pair].active += 1;
+        for s in slaves(&self.current) {
+            out.pairs[s.pair].active += 1;
         }
         (work - friction, friction)
     }
@@ -600,7 +600,7 @@ impl Correction for ContactCorrection<'_> {
             keep
         });
         for (k, l) in moved_t {
-            let slave = (k.0, k.1, k.2);
+            let slave = k.slave;
             let at = self.cands.partition_point(|c| c.slave_key() < slave);
             if let Some(c) = self.cands.get(at).filter(|c| c.slave_key() == slave) {
                 let e = self.lambda_t.entry(c.key()).or_insert([0.0; 2]);
@@ -609,7 +609,7 @@ impl Correction for ContactCorrection<'_> {
             }
         }
         for &(k, l) in &self.moved {
-            let slave = (k.0, k.1, k.2);
+            let slave = k.slave;
             let at = self.cands.partition_point(|c| c.slave_key() < slave);
             match self.cands.get(at).filter(|c| c.slave_key() == slave) {
                 Some(c) => {

@@ -26,7 +26,7 @@ use super::qp::{on_active_set, solve_by_active_set, DualQp};
 
 mod solid;
 use super::rows::Candidate;
-use super::state::{ContactState, Key, PairRecord};
+use super::state::{ContactState, Key, PairRecord, Slave, Target};
 use crate::error::{Error, Result};
 use crate::model::{Master, Model};
 
@@ -277,7 +277,10 @@ impl<'m> KinematicContact<'m> {
                                 let (normal, tangents, n_tangents) =
                                     plane_rows(s, Some(([a, b], xi)), n);
                                 self.rows.push(Row {
-                                    key: (pi, si, s, k),
+                                    key: Key {
+                                        slave: Slave::new(pi, si, s),
+                                        target: Target::Facet(k),
+                                    },
                                     t_c,
                                     normal,
                                     tangents,
@@ -304,10 +307,20 @@ impl<'m> KinematicContact<'m> {
                         ];
                         let (a_x, b_x) = ([a[0] - e[0], a[1] - e[1]], [b[0] + e[0], b[1] + e[1]]);
                         for &s in &side.slaves {
-                            if self.rigid.beneath.binary_search(&(pi, si, s)).is_ok() {
+                            if self
+                                .rigid
+                                .beneath
+                                .binary_search(&Slave::new(pi, si, s))
+                                .is_ok()
+                            {
                                 continue;
                             }
-                            let (a, b) = if self.rigid.held.binary_search(&(pi, si, s)).is_ok() {
+                            let (a, b) = if self
+                                .rigid
+                                .held
+                                .binary_search(&Slave::new(pi, si, s))
+                                .is_ok()
+                            {
                                 (a_x, b_x)
                             } else {
                                 (a, b)
@@ -317,7 +330,10 @@ impl<'m> KinematicContact<'m> {
                             {
                                 let (normal, tangents, n_tangents) = plane_rows(s, None, *n);
                                 self.rows.push(Row {
-                                    key: (pi, si, s, usize::MAX),
+                                    key: Key {
+                                        slave: Slave::new(pi, si, s),
+                                        target: Target::Rigid,
+                                    },
                                     t_c: c.t,
                                     normal,
                                     tangents,
@@ -535,8 +551,8 @@ impl<'m> KinematicContact<'m> {
             // rows' tangents differ, its magnitude.
             let [a, b] = tangential[i];
             let size = a.hypot(b);
-            self.tangential[r.key.0] += if r.n_tangents == 1 { a } else { size };
-            self.magnitude[r.key.0] += if r.n_tangents == 1 { a.abs() } else { size };
+            self.tangential[r.key.slave.pair] += if r.n_tangents == 1 { a } else { size };
+            self.magnitude[r.key.slave.pair] += if r.n_tangents == 1 { a.abs() } else { size };
         }
         self.p = normal;
     }
@@ -675,14 +691,14 @@ impl<'m> KinematicContact<'m> {
         for &(key, p) in &self.impulses {
             let f = p / h;
             out.active.push((key, f));
-            let rec = &mut out.pairs[key.0];
+            let rec = &mut out.pairs[key.slave.pair];
             rec.force += f;
-            let slave = (key.0, key.1, key.2);
+            let slave = key.slave;
             if last.replace(slave) != Some(slave) {
                 rec.active += 1;
             }
-            if self.area[key.2] > 0.0 {
-                out.pressure[key.2] += f / self.area[key.2];
+            if self.area[key.slave.node] > 0.0 {
+                out.pressure[key.slave.node] += f / self.area[key.slave.node];
             }
         }
     }

@@ -4,6 +4,7 @@
 
 use super::{Dofs, KinematicContact, Row, ROW_DOFS};
 use crate::contact::collision::node_triangle;
+use crate::contact::state::{Key, Slave, Target};
 use crate::geometry::{add, cross, dot, norm, scale, sub};
 use crate::model::Master;
 
@@ -23,13 +24,13 @@ fn row_of_face(slave: usize, nodes: &[(usize, f64)], d: [f64; 3]) -> Dofs {
     r
 }
 
-/// A slave's earliest impact in a solid: when, on which face (`usize::MAX`: the
-/// rigid plane) at which corners and weights, along which normal.
+/// A slave's earliest impact in a solid: when, on which face (or the rigid plane)
+/// at which corners and weights, along which normal.
 #[derive(Clone, Copy, Debug)]
 struct SolidHit {
     slave: usize,
     t_c: f64,
-    face: usize,
+    target: Target,
     /// The triangle's corners and their barycentric weights (none on a plane).
     corners: [(usize, f64); 3],
     n_corners: usize,
@@ -75,7 +76,7 @@ impl KinematicContact<'_> {
                             let mut best: Option<SolidHit> = None;
                             for hit in tree.locate_all_at_point(p) {
                                 let f = &faces[hit.data];
-                                let c = crate::model::face_corners(f);
+                                let c = f.corners();
                                 if c.contains(&s) {
                                     continue;
                                 }
@@ -114,7 +115,7 @@ impl KinematicContact<'_> {
                                     best = Some(SolidHit {
                                         slave: s,
                                         t_c: t.t,
-                                        face: hit.data,
+                                        target: Target::Facet(hit.data),
                                         corners: [(a, t.bary[0]), (b, t.bary[1]), (cc, t.bary[2])],
                                         n_corners: 3,
                                         normal: nn.map(|c| c / l),
@@ -135,7 +136,7 @@ impl KinematicContact<'_> {
                                 hits.push(SolidHit {
                                     slave: s,
                                     t_c: g0 / -vn,
-                                    face: usize::MAX,
+                                    target: Target::Rigid,
                                     corners: [(0, 0.0); 3],
                                     n_corners: 0,
                                     normal: *n,
@@ -149,7 +150,10 @@ impl KinematicContact<'_> {
                     let (normal, tangents, n_tangents) =
                         solid_rows(hit.slave, &hit.corners[..hit.n_corners], hit.normal);
                     self.rows.push(Row {
-                        key: (pi, si, hit.slave, hit.face),
+                        key: Key {
+                            slave: Slave::new(pi, si, hit.slave),
+                            target: hit.target,
+                        },
                         t_c: hit.t_c,
                         normal,
                         tangents,
