@@ -454,12 +454,7 @@ pub fn write_matrices(model: &Model, dir: &std::path::Path) -> Result<Vec<std::p
     written.push(path);
     if !model.contacts.is_empty() {
         let mut cands = Vec::new();
-        let coords = &model.mesh.coords;
-        crate::contact::detect::detect(
-            &model.contacts,
-            |nd| crate::mesh::xy(coords[nd]),
-            &mut cands,
-        );
+        crate::contact::candidates(model, &vec![0.0; n], &mut cands);
         let all: Vec<usize> = (0..n).collect();
         let g = crate::contact::gap_matrix(&cands, &all, n);
         let path = dir.join("G.mtx");

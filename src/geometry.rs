@@ -112,6 +112,24 @@ pub fn triangle_area(a: Vector<3>, b: Vector<3>, c: Vector<3>) -> f64 {
     0.5 * norm(cross(sub(b, a), sub(c, a)))
 }
 
+/// Two unit tangents orthonormal with the unit vector `n`: the coordinate axis
+/// after `n`'s largest component (cyclically) projected on the plane normal to `n`,
+/// and `n ×` it. A function of the normal alone, continuous while the largest
+/// component stays the same (normals within 45° of an axis), so the tangents of a
+/// slave passing from a face to its neighbour (the interpolated normal is
+/// continuous there) are the same and its tangential forces keep their meaning.
+/// Rigid planes take them at validation.
+pub fn tangents(n: Vector<3>) -> [Vector<3>; 2] {
+    let k = (0..3)
+        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
+        .unwrap_or(0);
+    let mut a = [0.0; 3];
+    a[(k + 1) % 3] = 1.0;
+    let an = dot(a, n);
+    let t1 = unit(sub(a, [an * n[0], an * n[1], an * n[2]])).unwrap_or([1.0, 0.0, 0.0]);
+    [t1, cross(n, t1)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -149,5 +167,27 @@ mod tests {
             triangle_area([0.0; 3], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0]),
             3.0
         );
+    }
+
+    #[test]
+    fn tangents_are_orthonormal_with_the_normal() {
+        for n in [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [1.0, 0.0, 0.0],
+            [0.3, -0.2, 0.9327379053088815],
+        ] {
+            let n = unit(n).unwrap();
+            {
+                let t = tangents(n);
+                assert!(dot(t[0], n).abs() < 1e-15 && dot(t[1], n).abs() < 1e-15);
+                assert!(dot(t[0], t[1]).abs() < 1e-15);
+                assert!((dot(t[0], t[0]) - 1.0).abs() < 1e-15);
+                assert!((dot(t[1], t[1]) - 1.0).abs() < 1e-15);
+                // Right-handed: t1 × t2 = n.
+                let c = cross(t[0], t[1]);
+                assert!(dot(sub(c, n), sub(c, n)) < 1e-28);
+            }
+        }
     }
 }

@@ -419,7 +419,7 @@ pub struct ContactSide {
     pub faces: Vec<Face>,
     /// A master face set's boundary edges (sorted node pairs, each an edge of one
     /// face only), where node to face ends: topology, so found once at validation
-    /// (`contact::faces::boundary_edges`); empty for other masters.
+    /// (`contact::master::faces::boundary_edges`); empty for other masters.
     pub master_boundary: Vec<[usize; 2]>,
 }
 

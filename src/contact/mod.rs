@@ -1,9 +1,11 @@
 //! Contact: detection (geometry only) apart from enforcement.
 //!
-//! - [`detect`] finds, for the current geometry, the candidate constraints of every
-//!   contact pair: slave node, closest master segment (or rigid line), `ξ`, gap and
-//!   normal, as plain data ([`rows::Candidate`]), with an R-tree (`rstar`) over the
-//!   master segments as the broad phase.
+//! - [`master`] holds the master surfaces (segment chains, rigid lines, face sets,
+//!   rigid planes) behind one interface, [`master::MasterSurface`]: a slave's rows
+//!   within reach, its row after crossing the master over a step, its first impact
+//!   within a step. [`detect`] is the one loop over pairs, sides and slaves that
+//!   asks it, in the plane and in a solid, giving rows of one shape
+//!   ([`rows::Candidate`]); [`mortar`] gives a mortar side's weighted gaps.
 //! - [`implicit`] enforces impenetrability in the implicit schemes: per step a convex
 //!   QP (solved with Clarabel) inside the equilibrium loop, as a
 //!   [`crate::nonlinear::Correction`], condensed on the factor by default.
@@ -18,41 +20,42 @@ pub mod collision;
 mod compliance;
 pub(crate) mod coulomb;
 pub mod detect;
-pub mod faces;
 pub mod implicit;
 pub mod kinematic;
+pub mod master;
 pub mod mortar;
 pub mod overlap;
 mod qp;
 pub mod rows;
 pub mod state;
-pub mod sweep;
 
 pub use implicit::ContactCorrection;
+pub use master::Positions;
 pub use rows::{gap_matrix, Candidate, Contactee};
 pub use state::{ContactState, Key, PairRecord, Slave, Target};
 
-/// The candidates of every pair at displacements `u` (all dofs), by the detection
-/// of the model's dimension: segments and rigid lines in the plane
-/// ([`detect::detect`]), faces and rigid planes in a solid ([`faces::detect`]).
+/// The node positions `X + u` of a model at displacements `u` (all dofs), flat.
+pub fn positions(model: &crate::model::Model, u: &[f64]) -> Vec<f64> {
+    let dim = model.mesh.dim;
+    model
+        .mesh
+        .coords
+        .iter()
+        .enumerate()
+        .flat_map(|(n, c)| (0..dim).map(move |i| c[i] + u[dim * n + i]))
+        .collect()
+}
+
+/// The candidates of every pair at displacements `u` (all dofs), with no history of
+/// the rigid lines ([`detect::detect`]).
 pub fn candidates(model: &crate::model::Model, u: &[f64], out: &mut Vec<Candidate>) {
-    let coords = &model.mesh.coords;
-    if model.mesh.dim == 3 {
-        faces::detect(
-            &model.contacts,
-            |n| {
-                let c = coords[n];
-                [c[0] + u[3 * n], c[1] + u[3 * n + 1], c[2] + u[3 * n + 2]]
-            },
-            out,
-        );
-    } else {
-        detect::detect(
-            &model.contacts,
-            |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-            out,
-        );
-    }
+    let x = positions(model, u);
+    detect::detect(
+        &model.contacts,
+        Positions::new(&x, model.mesh.dim),
+        &Default::default(),
+        out,
+    );
 }
 
 /// The tributary area (length × thickness) of every node as a slave, for contact

@@ -189,7 +189,7 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
         let n = [gj.master_normal[0] / l, gj.master_normal[1] / l];
         gj.weights.scale(1.0 / gj.covered);
         let slave = super::state::Slave::new(pair, side, slaves[j]);
-        let mut c = Candidate::nodal(slave, Contactee::Mortar, 0.0, 0.0, n);
+        let mut c = Candidate::nodal::<2>(slave, Contactee::Mortar, &[], 0.0, 0.0, n);
         c.weights = gj.weights;
         c.length = gj.covered;
         let p = c.combine(x);

@@ -50,7 +50,7 @@ pub fn deepest(mesh: &Mesh, pairs: &[ContactPair], tolerance: f64) -> Option<Ove
                         segments
                             .iter()
                             .map(|&[a, b]| {
-                                super::detect::closest(
+                                super::master::segments::closest(
                                     [p[0], p[1]],
                                     crate::mesh::xy(mesh.coords[a]),
                                     crate::mesh::xy(mesh.coords[b]),
@@ -65,7 +65,9 @@ pub fn deepest(mesh: &Mesh, pairs: &[ContactPair], tolerance: f64) -> Option<Ove
                     inside_body(mesh, body, &side.slaves, tolerance, |p| {
                         faces
                             .iter()
-                            .filter_map(|f| super::faces::project(p, f, &|n| mesh.coords[n]))
+                            .filter_map(|f| {
+                                super::master::faces::project(p, f, &|n| mesh.coords[n])
+                            })
                             .map(|pr| pr.d2)
                             .fold(f64::INFINITY, f64::min)
                     })
@@ -116,7 +118,7 @@ fn behind_line(mesh: &Mesh, body: usize, a: [f64; 2], b: [f64; 2], n: [f64; 2], 
         let p = mesh.coords[k];
         let xi = ((p[0] - a[0]) * t[0] + (p[1] - a[1]) * t[1]) / l2;
         let gap = (p[0] - a[0]) * n[0] + (p[1] - a[1]) * n[1];
-        (super::detect::within_ends(xi) && gap < -tol).then_some((k, -gap))
+        (super::master::rigid::within_ends(xi) && gap < -tol).then_some((k, -gap))
     });
     deepest_of(hits, |_| {
         "behind its rigid line (the line cuts the slave body)".into()
@@ -155,7 +157,7 @@ fn inside_body(
         }
         for e in 0..b.elements.len() {
             let pts = b.elements.element(e).iter().map(|&k| mesh.coords[k]);
-            let bb = super::faces::bounding_box(pts, 0.0);
+            let bb = super::master::faces::bounding_box(pts, 0.0);
             items.push(rstar::primitives::GeomWithData::new(
                 rstar::primitives::Rectangle::from_corners(bb.lower(), bb.upper()),
                 (bi, e),
@@ -217,10 +219,16 @@ impl Facet {
         let x = |n: usize| mesh.coords[n];
         match self {
             Facet::Edge([a, b]) => {
-                super::detect::closest([p[0], p[1]], crate::mesh::xy(x(*a)), crate::mesh::xy(x(*b)))
-                    .1
+                super::master::segments::closest(
+                    [p[0], p[1]],
+                    crate::mesh::xy(x(*a)),
+                    crate::mesh::xy(x(*b)),
+                )
+                .1
             }
-            Facet::Face(f) => super::faces::project(p, f, &x).map_or(f64::INFINITY, |pr| pr.d2),
+            Facet::Face(f) => {
+                super::master::faces::project(p, f, &x).map_or(f64::INFINITY, |pr| pr.d2)
+            }
         }
     }
 }

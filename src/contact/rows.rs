@@ -210,35 +210,42 @@ impl Candidate {
         out
     }
 
-    /// A node-to-segment or rigid-line candidate: the weights `+1` on the slave and
-    /// `−(1−ξ), −ξ` on a segment's ends.
-    pub fn nodal(
-        Slave {
-            pair,
-            side,
-            node: slave,
-        }: Slave,
+    /// A node-to-master row of `slave`: the weights `+1` on the slave and `−w` on each
+    /// of the master's `corners` `(node, w)` (a segment's ends `1 − ξ` and `ξ`, a
+    /// face's shape functions at the projection, none on a rigid master), the gap
+    /// `gap` along the unit `normal` and the tangents of its contact plane: in the
+    /// plane (`D = 2`) the one `(n_y, −n_x)`, in a solid the two of
+    /// [`crate::geometry::tangents`]. `xi` is a segment's local coordinate (0 else).
+    pub fn nodal<const D: usize>(
+        slave: Slave,
         master: Contactee,
+        corners: &[(usize, f64)],
         xi: f64,
         gap: f64,
-        normal: [f64; 2],
+        normal: [f64; D],
     ) -> Candidate {
         let mut weights = Weights::EMPTY;
-        weights.add(slave, 1.0);
-        if let Contactee::Segment { nodes: [a, b], .. } = master {
-            weights.add(a, -(1.0 - xi));
-            weights.add(b, -xi);
+        weights.add(slave.node, 1.0);
+        for &(node, w) in corners {
+            weights.add(node, -w);
         }
+        let (normal, tangents) = if D == 2 {
+            let n = [normal[0], normal[1], 0.0];
+            (n, [[n[1], -n[0], 0.0], [0.0; 3]])
+        } else {
+            let n = [normal[0], normal[1], normal[2]];
+            (n, crate::geometry::tangents(n))
+        };
         Candidate {
-            pair,
-            side,
-            slave,
+            pair: slave.pair,
+            side: slave.side,
+            slave: slave.node,
             master,
             xi,
             gap,
-            normal: [normal[0], normal[1], 0.0],
-            tangents: [[normal[1], -normal[0], 0.0], [0.0; 3]],
-            dim: 2,
+            normal,
+            tangents,
+            dim: D as u8,
             weights,
             length: 0.0,
         }

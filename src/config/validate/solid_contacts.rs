@@ -71,7 +71,7 @@ pub(super) fn sides(
                 master: Master::Faces(faces.clone()),
                 mortar: Vec::new(),
                 faces: slave_faces.clone(),
-                master_boundary: crate::contact::faces::boundary_edges(&faces),
+                master_boundary: crate::contact::master::faces::boundary_edges(&faces),
             });
             if c.both_ways {
                 if slave_faces.is_empty() {
@@ -85,7 +85,7 @@ pub(super) fn sides(
                 shortest = shortest.min(short);
                 sides.push(ContactSide {
                     slaves: master_nodes,
-                    master_boundary: crate::contact::faces::boundary_edges(&slave_faces),
+                    master_boundary: crate::contact::master::faces::boundary_edges(&slave_faces),
                     master: Master::Faces(slave_faces),
                     mortar: Vec::new(),
                     faces,
@@ -106,7 +106,7 @@ pub(super) fn sides(
                 master: Master::Plane {
                     point,
                     n,
-                    tangents: crate::contact::faces::plane_tangents(n),
+                    tangents: crate::geometry::tangents(n),
                 },
                 mortar: Vec::new(),
                 faces: slave_faces,

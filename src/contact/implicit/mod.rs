@@ -26,6 +26,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use super::compliance::Compliance;
+use super::master::{rigid, Positions};
 use super::qp::DualQp;
 use super::rows::Candidate;
 use crate::error::Result;
@@ -172,7 +173,7 @@ pub struct ContactCorrection<'m> {
     qp_generation: usize,
     dual: DualQp,
     stats: ContactStats,
-    rigid: super::detect::RigidHistory,
+    rigid: rigid::RigidHistory,
     push_entries: Vec<(usize, f64)>,
 }
 
@@ -259,7 +260,7 @@ impl<'m> ContactCorrection<'m> {
         // those it holds stay on it a little beyond its ends.
         let coords = &self.model.mesh.coords;
         // The geometry at the start of the step: a slave's motion from it is swept
-        // for crossings ([`super::sweep::crossed`]).
+        // for crossings ([`super::detect::crossed`]).
         let dim = self.dim;
         self.x0.clear();
         self.x0.extend(
@@ -269,10 +270,10 @@ impl<'m> ContactCorrection<'m> {
                 .flat_map(|(n, c)| (0..dim).map(move |i| c[i] + u[dim * n + i])),
         );
         if dim == 2 {
-            self.rigid.beneath = super::detect::beneath_rigid(
+            self.rigid.beneath = rigid::beneath_rigid(
                 self.pairs,
                 |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-                super::detect::RIGID_DEPTH_TOLERANCES * self.tol,
+                rigid::RIGID_DEPTH_TOLERANCES * self.tol,
                 &self.rigid.beneath,
             );
         }
@@ -404,37 +405,11 @@ impl<'m> ContactCorrection<'m> {
                 self.x[dim * n + i] = c[i] + u[dim * n + i];
             }
         }
-        let x = &self.x;
-        if dim == 3 {
-            let at = |n: usize| [x[3 * n], x[3 * n + 1], x[3 * n + 2]];
-            super::faces::detect(self.pairs, at, &mut self.cands);
-            if !self.x0.is_empty() {
-                let x0 = &self.x0;
-                super::sweep::crossed_faces(
-                    self.pairs,
-                    |n| [x0[3 * n], x0[3 * n + 1], x0[3 * n + 2]],
-                    at,
-                    &mut self.cands,
-                );
-            }
-            self.stats.detect_s += t.elapsed().as_secs_f64();
-            return;
-        }
-        super::detect::detect_except(
-            self.pairs,
-            |n| [x[2 * n], x[2 * n + 1]],
-            &self.rigid,
-            &mut self.cands,
-        );
+        let x = Positions::new(&self.x, dim);
+        super::detect::detect(self.pairs, x, &self.rigid, &mut self.cands);
         if !self.x0.is_empty() {
-            let x0 = &self.x0;
-            super::sweep::crossed(
-                self.pairs,
-                |n| [x0[2 * n], x0[2 * n + 1]],
-                |n| [x[2 * n], x[2 * n + 1]],
-                &self.rigid,
-                &mut self.cands,
-            );
+            let x0 = Positions::new(&self.x0, dim);
+            super::detect::crossed(self.pairs, x0, x, &self.rigid, &mut self.cands);
         }
         self.stats.detect_s += t.elapsed().as_secs_f64();
     }

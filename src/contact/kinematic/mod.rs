@@ -18,23 +18,18 @@
 //! at the end of the step back onto it, mass-weighted (positions only, momentum
 //! unchanged). See `theory/explicit.md`.
 
-use rstar::primitives::{GeomWithData, Line};
-use rstar::RTree;
-
-use super::collision::node_segment;
+use super::master::{rigid, Positions};
 use super::qp::{on_active_set, solve_by_active_set, DualQp};
-
-mod solid;
 use super::rows::Candidate;
-use super::state::{ContactState, Key, PairRecord, Slave, Target};
+use super::state::{ContactState, Key, PairRecord, Slave};
 use crate::error::{Error, Result};
-use crate::model::{Master, Model};
+use crate::model::Model;
 
 /// Sweeps of the end-of-step projection.
 const PROJECTION_SWEEPS: usize = 4;
 
 /// The most dofs of a row: the slave and a solid's quadrilateral face, three each.
-pub(super) const ROW_DOFS: usize = 15;
+const ROW_DOFS: usize = 15;
 
 /// The dofs and coefficients of a row, and how many are used.
 pub(super) type Dofs = ([(usize, f64); ROW_DOFS], usize);
@@ -49,7 +44,7 @@ pub(super) struct Row {
     /// a face's corners `−N_k n`).
     pub(super) normal: Dofs,
     /// The same with the tangents: in the plane the one `(n_y, −n_x)` (the implicit
-    /// path's, [`Candidate::tangent`]), in a solid two ([`super::faces::plane_tangents`]).
+    /// path's, [`Candidate::tangent`]), in a solid two ([`crate::geometry::tangents`]).
     pub(super) tangents: [Dofs; 2],
     /// Tangents used: 1 in the plane, 2 in a solid.
     pub(super) n_tangents: usize,
@@ -59,36 +54,40 @@ pub(super) struct Row {
     pub(super) weight: f64,
 }
 
-/// A plane row along `d`: the slave and, against a segment, its ends.
-fn row_of(slave: usize, master: Option<([usize; 2], f64)>, d: [f64; 2]) -> Dofs {
-    let mut r = [(0usize, 0.0f64); ROW_DOFS];
-    r[0] = (2 * slave, d[0]);
-    r[1] = (2 * slave + 1, d[1]);
-    match master {
-        Some(([a, b], xi)) => {
-            r[2] = (2 * a, -(1.0 - xi) * d[0]);
-            r[3] = (2 * a + 1, -(1.0 - xi) * d[1]);
-            r[4] = (2 * b, -xi * d[0]);
-            r[5] = (2 * b + 1, -xi * d[1]);
-            (r, 6)
+/// A row along `d` in a `dim`-dimensional mesh: `+d` on the slave, `−w d` on each
+/// of the master's `corners` `(node, w)`.
+fn row_along(dim: usize, slave: usize, corners: &[(usize, f64)], d: [f64; 3]) -> Dofs {
+    let mut r = ([(0usize, 0.0f64); ROW_DOFS], 0);
+    let mut push = |node: usize, w: f64| {
+        for (i, di) in d.iter().enumerate().take(dim) {
+            r.0[r.1] = (dim * node + i, w * di);
+            r.1 += 1;
         }
-        None => (r, 2),
+    };
+    push(slave, 1.0);
+    for &(node, w) in corners {
+        push(node, -w);
     }
+    r
 }
 
-/// The rows of a plane impact along the normal `n`: the normal one and the tangent
-/// `(n_y, −n_x)`.
-fn plane_rows(
+/// The rows of an impact along its normal `n`: the normal one and the tangential
+/// ones, in the plane the one `(n_y, −n_x)` (the implicit path's,
+/// [`Candidate::tangent`]), in a solid the two of [`crate::geometry::tangents`].
+fn impact_rows(
+    dim: usize,
     slave: usize,
-    master: Option<([usize; 2], f64)>,
-    n: [f64; 2],
+    corners: &[(usize, f64)],
+    n: [f64; 3],
 ) -> (Dofs, [Dofs; 2], usize) {
-    let empty = ([(0usize, 0.0f64); ROW_DOFS], 0);
-    (
-        row_of(slave, master, n),
-        [row_of(slave, master, [n[1], -n[0]]), empty],
-        1,
-    )
+    let along = |d: [f64; 3]| row_along(dim, slave, corners, d);
+    if dim == 2 {
+        let empty = ([(0usize, 0.0f64); ROW_DOFS], 0);
+        (along(n), [along([n[1], -n[0], 0.0]), empty], 1)
+    } else {
+        let t = crate::geometry::tangents(n);
+        (along(n), [along(t[0]), along(t[1])], 2)
+    }
 }
 
 fn dot_row(row: &Dofs, x: &[f64]) -> f64 {
@@ -141,7 +140,9 @@ pub struct KinematicContact<'m> {
     dual: DualQp,
     step: KinematicStats,
     total: KinematicStats,
-    rigid: super::detect::RigidHistory,
+    rigid: rigid::RigidHistory,
+    /// Node positions (workspace).
+    x: Vec<f64>,
 }
 
 impl<'m> KinematicContact<'m> {
@@ -167,6 +168,7 @@ impl<'m> KinematicContact<'m> {
             step: KinematicStats::default(),
             total: KinematicStats::default(),
             rigid: Default::default(),
+            x: Vec::new(),
         }
     }
 
@@ -196,18 +198,18 @@ impl<'m> KinematicContact<'m> {
         let coords = &self.model.mesh.coords;
         let plane = self.model.mesh.dim == 2;
         if plane {
-            self.rigid.beneath = super::detect::beneath_rigid(
+            self.rigid.beneath = rigid::beneath_rigid(
                 &self.model.contacts,
                 |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-                super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
+                rigid::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
                 &self.rigid.beneath,
             );
             // Slaves on a rigid line stay on it a little past its ends.
             let previous = std::mem::take(&mut self.rigid.held);
-            self.rigid.held = super::detect::held_rigid(
+            self.rigid.held = rigid::held_rigid(
                 &self.model.contacts,
                 |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-                super::detect::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
+                rigid::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
                 &previous,
             );
         }
@@ -225,128 +227,38 @@ impl<'m> KinematicContact<'m> {
         Ok(())
     }
 
-    /// The earliest collision of every slave node within the step.
+    /// The earliest collision of every slave node within the step (`u` the
+    /// displacements at its start, `v` the velocities).
     fn collisions(&mut self, u: &[f64], v: &[f64], h: f64) {
         self.rows.clear();
-        if self.model.mesh.dim == 3 {
-            self.solid_collisions(u, v, h);
-            return;
-        }
-        let coords = &self.model.mesh.coords;
-        let at = |n: usize| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]];
-        let vel = |n: usize| [v[2 * n], v[2 * n + 1]];
+        let dim = self.model.mesh.dim;
+        self.x = super::positions(self.model, u);
+        let (x, v) = (Positions::new(&self.x, dim), Positions::new(v, dim));
         for (pi, pair) in self.model.contacts.iter().enumerate() {
             for (si, side) in pair.sides.iter().enumerate() {
-                match &side.master {
-                    Master::Segments(segments) => {
-                        // Reach: the pair's radius (a segment or element edge) covers
-                        // the motion of a stable step many times over.
-                        let r2 = pair.radius * pair.radius;
-                        let tree = RTree::bulk_load(
-                            segments
-                                .iter()
-                                .enumerate()
-                                .map(|(k, &[a, b])| GeomWithData::new(Line::new(at(a), at(b)), k))
-                                .collect(),
-                        );
-                        for &s in &side.slaves {
-                            let mut best: Option<(f64, usize, f64)> = None;
-                            for hit in tree.locate_within_distance(at(s), r2) {
-                                let [a, b] = segments[hit.data];
-                                if a == s || b == s {
-                                    continue;
-                                }
-                                if let Some(c) =
-                                    node_segment(at(s), vel(s), at(a), vel(a), at(b), vel(b), h)
-                                {
-                                    if best.is_none_or(|(t, _, _)| c.t < t) {
-                                        best = Some((c.t, hit.data, c.xi));
-                                    }
-                                }
-                            }
-                            if let Some((t_c, k, xi)) = best {
-                                let [a, b] = segments[k];
-                                let pa = at(a);
-                                let pb = at(b);
-                                let va = vel(a);
-                                let vb = vel(b);
-                                let (n, _) = crate::geometry::outward(
-                                    [pa[0] + t_c * va[0], pa[1] + t_c * va[1]],
-                                    [pb[0] + t_c * vb[0], pb[1] + t_c * vb[1]],
-                                );
-                                let (normal, tangents, n_tangents) =
-                                    plane_rows(s, Some(([a, b], xi)), n);
-                                self.rows.push(Row {
-                                    key: Key {
-                                        slave: Slave::new(pi, si, s),
-                                        target: Target::Facet(k),
-                                    },
-                                    t_c,
-                                    normal,
-                                    tangents,
-                                    n_tangents,
-                                    beta: pair.friction,
-                                    mu: pair.mu,
-                                    weight: pair.position_weight,
-                                });
-                            }
-                        }
-                    }
-                    Master::Rigid { a, b, n } => {
-                        // Oriented so that the segment convention's normal is n.
-                        let (a, b) = if (b[1] - a[1]) * n[0] - (b[0] - a[0]) * n[1] >= 0.0 {
-                            (*a, *b)
-                        } else {
-                            (*b, *a)
-                        };
-                        // A held slave meets the line extended by the pair's radius.
-                        let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
-                        let e = [
-                            (b[0] - a[0]) / len * pair.radius,
-                            (b[1] - a[1]) / len * pair.radius,
-                        ];
-                        let (a_x, b_x) = ([a[0] - e[0], a[1] - e[1]], [b[0] + e[0], b[1] + e[1]]);
-                        for &s in &side.slaves {
-                            if self
-                                .rigid
-                                .beneath
-                                .binary_search(&Slave::new(pi, si, s))
-                                .is_ok()
-                            {
-                                continue;
-                            }
-                            let (a, b) = if self
-                                .rigid
-                                .held
-                                .binary_search(&Slave::new(pi, si, s))
-                                .is_ok()
-                            {
-                                (a_x, b_x)
-                            } else {
-                                (a, b)
-                            };
-                            if let Some(c) =
-                                node_segment(at(s), vel(s), a, [0.0; 2], b, [0.0; 2], h)
-                            {
-                                let (normal, tangents, n_tangents) = plane_rows(s, None, *n);
-                                self.rows.push(Row {
-                                    key: Key {
-                                        slave: Slave::new(pi, si, s),
-                                        target: Target::Rigid,
-                                    },
-                                    t_c: c.t,
-                                    normal,
-                                    tangents,
-                                    n_tangents,
-                                    beta: pair.friction,
-                                    mu: pair.mu,
-                                    weight: pair.position_weight,
-                                });
-                            }
-                        }
-                    }
-                    // Validation keeps the explicit path to the plane.
-                    Master::Faces(_) | Master::Plane { .. } => {}
+                // Reach: the pair's radius (a segment or element edge) covers the
+                // motion of a stable step many times over.
+                let surface = super::master::surface(side, x);
+                for &s in &side.slaves {
+                    let slave = Slave::new(pi, si, s);
+                    let Some(hit) = surface.impact(slave, v, h, pair.radius, &self.rigid) else {
+                        continue;
+                    };
+                    let (normal, tangents, n_tangents) =
+                        impact_rows(dim, s, hit.corners(), hit.normal);
+                    self.rows.push(Row {
+                        key: Key {
+                            slave,
+                            target: hit.target,
+                        },
+                        t_c: hit.t,
+                        normal,
+                        tangents,
+                        n_tangents,
+                        beta: pair.friction,
+                        mu: pair.mu,
+                        weight: pair.position_weight,
+                    });
                 }
             }
         }
@@ -633,26 +545,23 @@ impl<'m> KinematicContact<'m> {
     /// Candidates at the geometry `u + du`.
     fn end_geometry(&mut self, u: &[f64], du: &[f64]) {
         let coords = &self.model.mesh.coords;
-        if self.model.mesh.dim == 3 {
-            super::faces::detect(
-                &self.model.contacts,
-                |n| {
-                    let c = coords[n];
-                    let d = |i: usize| u[3 * n + i] + du[3 * n + i];
-                    [c[0] + d(0), c[1] + d(1), c[2] + d(2)]
-                },
-                &mut self.cands,
-            );
-            return;
-        }
-        super::detect::detect_except(
+        let dim = self.model.mesh.dim;
+        self.x.clear();
+        // (X + u) + du in the plane, X + (u + du) in a solid: the sums each has
+        // always made, so that the end geometry keeps its last bits.
+        self.x.extend(coords.iter().enumerate().flat_map(|(n, c)| {
+            (0..dim).map(move |i| {
+                let d = dim * n + i;
+                if dim == 2 {
+                    c[i] + u[d] + du[d]
+                } else {
+                    c[i] + (u[d] + du[d])
+                }
+            })
+        }));
+        super::detect::detect(
             &self.model.contacts,
-            |n| {
-                [
-                    coords[n][0] + u[2 * n] + du[2 * n],
-                    coords[n][1] + u[2 * n + 1] + du[2 * n + 1],
-                ]
-            },
+            Positions::new(&self.x, dim),
             &self.rigid,
             &mut self.cands,
         );

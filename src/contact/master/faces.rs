@@ -1,6 +1,5 @@
-//! Contact detection in a solid: slave nodes against the faces of another solid
-//! (triangles and bilinear quadrilaterals) or a rigid plane, in the current
-//! geometry. Geometry only, as [`super::detect`] in the plane.
+//! A solid's master: a set of faces of another solid (triangles and bilinear
+//! quadrilaterals), numbered counter-clockwise seen from outside.
 //!
 //! Broad phase: an R-tree (`rstar`) of the faces' bounding boxes, queried with the
 //! box of the pair's search radius about each slave. Narrow phase: the closest point
@@ -20,20 +19,28 @@
 //! [`VALLEY_SINE`] (a valley) and the slave lies within [`NEAR_EDGE`] of their
 //! common boundary, both faces hold it, each as the half-space of its own plane, as
 //! the plane's notches are (`theory/contact3d.md`).
+//!
+//! The sweep and the explicit collisions take the time a node meets a moving
+//! triangle (a quadrilateral as its two) from
+//! [`crate::contact::collision::node_triangle`].
 
-use crate::mesh::Face;
+use std::cell::OnceCell;
 use std::collections::HashMap;
 
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
-use super::rows::{Candidate, Contactee, Weights};
-use super::state::Slave;
-use crate::model::{ContactPair, Master};
+use super::rigid::{RigidHistory, RIGID_END_MARGIN};
+use super::{Impact, MasterSurface, Positions};
+use crate::contact::collision::node_triangle;
+use crate::contact::rows::{Candidate, Contactee};
+use crate::contact::state::{Slave, Target};
+use crate::geometry::{add, norm, scale};
+use crate::mesh::Face;
 
 /// How close (in the face's local coordinates, relative to its size) to an edge a
 /// slave's closest point must be for a face rising beyond that edge to hold it too:
-/// a thousandth, as [`super::detect::NEAR_VERTEX`] in the plane.
+/// a thousandth, as [`super::segments::NEAR_VERTEX`] in the plane.
 pub const NEAR_EDGE: f64 = 1e-3;
 
 /// How steeply (the sine of the angle) a neighbouring face must rise out of the
@@ -46,13 +53,13 @@ pub const NEAR_EDGE: f64 = 1e-3;
 /// nearly equal rows, which make the condensed matrix singular.
 pub const VALLEY_SINE: f64 = 1e-2;
 
-pub(super) type V3 = [f64; 3];
+type V3 = [f64; 3];
 
 use crate::geometry::{cross, unit};
-pub(super) use crate::geometry::{dot, sub};
+use crate::geometry::{dot, sub};
 
 /// The box of `points` grown by `pad` on every side.
-pub(super) fn bounding_box(points: impl Iterator<Item = V3>, pad: f64) -> AABB<V3> {
+pub fn bounding_box(points: impl Iterator<Item = V3>, pad: f64) -> AABB<V3> {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in points {
         for i in 0..3 {
@@ -65,10 +72,10 @@ pub(super) fn bounding_box(points: impl Iterator<Item = V3>, pad: f64) -> AABB<V
 
 /// An R-tree of the faces, each by the box of the points `at(node)` yields for its
 /// corners (one geometry, or the start and end of a step), grown by `pad`.
-pub(super) type FaceTree = RTree<GeomWithData<Rectangle<V3>, usize>>;
+type FaceTree = RTree<GeomWithData<Rectangle<V3>, usize>>;
 
 /// See [`FaceTree`].
-pub(super) fn face_tree<I: Iterator<Item = V3>>(
+fn face_tree<I: Iterator<Item = V3>>(
     faces: &[Face],
     at: impl Fn(usize) -> I,
     pad: f64,
@@ -291,13 +298,13 @@ pub fn project<X: Fn(usize) -> V3>(p: V3, face: &Face, x: &X) -> Option<Projecti
 
 /// The faces' unit normals at their centres and the nodal normals of the surface:
 /// at each node the normalised sum of the unit normals of the faces meeting there.
-pub(super) struct Surface {
+struct Surface {
     normal: Vec<V3>,
     at_node: HashMap<usize, V3>,
 }
 
 impl Surface {
-    pub(super) fn new<X: Fn(usize) -> V3>(faces: &[Face], x: &X) -> Surface {
+    fn new<X: Fn(usize) -> V3>(faces: &[Face], x: &X) -> Surface {
         let mut normal = Vec::with_capacity(faces.len());
         let mut at_node: HashMap<usize, V3> = HashMap::with_capacity(faces.len());
         for f in faces {
@@ -330,7 +337,7 @@ impl Surface {
     /// faces' own from one iteration to the next; on a flat surface it is the
     /// surface's normal. Over a convex ridge or corner it is the ridge's or corner's
     /// mean normal.
-    pub(super) fn normal(&self, face: &Face, pr: &Projection) -> V3 {
+    fn normal(&self, face: &Face, pr: &Projection) -> V3 {
         let mut n = [0.0; 3];
         for (k, &v) in face.corners().iter().enumerate() {
             if let Some(m) = self.at_node.get(&v) {
@@ -368,7 +375,7 @@ pub fn boundary_edges(faces: &[Face]) -> Vec<[usize; 2]> {
 /// boundary (`edges`, sorted, and their sorted nodes `rim`: an edge of one face
 /// only, or a corner on one) with `p` beyond it: the slave's projection has left the
 /// master surface, and no force holds it. The margin, a thousandth of the face's
-/// longest edge (`detect::RIGID_END_MARGIN`), keeps a slave exactly at the edge from
+/// longest edge ([`RIGID_END_MARGIN`]), keeps a slave exactly at the edge from
 /// flickering on round-off.
 fn beyond_boundary<X: Fn(usize) -> V3>(
     (edges, rim): (&[[usize; 2]], &[usize]),
@@ -398,134 +405,103 @@ fn beyond_boundary<X: Fn(usize) -> V3>(
             dot(e, e)
         })
         .fold(0.0, f64::max);
-    t2 > super::detect::RIGID_END_MARGIN.powi(2) * longest
+    t2 > RIGID_END_MARGIN.powi(2) * longest
 }
 
-/// Two unit tangents orthonormal with the unit vector `n`: the coordinate axis
-/// after `n`'s largest component (cyclically) projected on the plane normal to `n`,
-/// and `n ×` it. A function of the normal alone, continuous while the largest
-/// component stays the same (normals within 45° of an axis), so the tangents of a
-/// slave passing from a face to its neighbour (the interpolated normal is
-/// continuous there) are the same and its tangential forces keep their meaning.
-/// Rigid planes take them at validation.
-pub fn plane_tangents(n: V3) -> [V3; 2] {
-    let k = (0..3)
-        .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
-        .unwrap_or(0);
-    let mut a = [0.0; 3];
-    a[(k + 1) % 3] = 1.0;
-    let an = dot(a, n);
-    let t1 = unit(sub(a, [an * n[0], an * n[1], an * n[2]])).unwrap_or([1.0, 0.0, 0.0]);
-    [t1, cross(n, t1)]
+/// A set of faces at a geometry.
+pub struct FaceSurface<'a> {
+    faces: &'a [Face],
+    /// The set's boundary edges (sorted) and their nodes (sorted): where it ends.
+    edges: &'a [[usize; 2]],
+    rim: Vec<usize>,
+    x: Positions<'a>,
+    surface: OnceCell<Surface>,
+    tree: OnceCell<FaceTree>,
+    swept: OnceCell<FaceTree>,
+    grown: OnceCell<FaceTree>,
 }
 
-/// The row of slave `key` against master face `index` at its projection `pr`,
-/// along `normal`.
-pub(super) fn face_candidate<X: Fn(usize) -> V3>(
-    key: Slave,
-    index: usize,
-    face: &Face,
-    pr: &Projection,
-    normal: V3,
-    x: &X,
-) -> Candidate {
-    let mut weights = Weights::EMPTY;
-    weights.add(key.node, 1.0);
-    for (k, &v) in face.corners().iter().enumerate() {
-        weights.add(v, -pr.weights[k]);
-    }
-    let tangents = plane_tangents(normal);
-    Candidate {
-        pair: key.pair,
-        side: key.side,
-        slave: key.node,
-        master: Contactee::Face {
-            index,
-            nodes: *face,
-        },
-        xi: 0.0,
-        gap: dot(sub(x(key.node), pr.point), normal),
-        normal,
-        tangents,
-        dim: 3,
-        weights,
-        length: 0.0,
-    }
-}
-
-/// Candidates of every pair of a solid at the geometry `x(node)`, appended to `out`
-/// (cleared first), ordered by pair, side and slave node (a slave in a valley gives
-/// one per face holding it, by face).
-pub fn detect<X>(pairs: &[ContactPair], x: X, out: &mut Vec<Candidate>)
-where
-    X: Fn(usize) -> V3,
-{
-    out.clear();
-    for (pi, pair) in pairs.iter().enumerate() {
-        let r = pair.radius;
-        for (si, side) in pair.sides.iter().enumerate() {
-            match &side.master {
-                Master::Faces(faces) => {
-                    faces_side((pi, si), side, faces, r, &x, out);
-                }
-                Master::Plane { point, n, tangents } => {
-                    for &s in &side.slaves {
-                        let gap = dot(sub(x(s), *point), *n);
-                        if gap * gap <= r * r {
-                            let mut weights = Weights::EMPTY;
-                            weights.add(s, 1.0);
-                            out.push(Candidate {
-                                pair: pi,
-                                side: si,
-                                slave: s,
-                                master: Contactee::Rigid,
-                                xi: 0.0,
-                                gap,
-                                normal: *n,
-                                tangents: *tangents,
-                                dim: 3,
-                                weights,
-                                length: 0.0,
-                            });
-                        }
-                    }
-                }
-                Master::Segments(_) | Master::Rigid { .. } => {}
-            }
+impl<'a> FaceSurface<'a> {
+    /// The faces `faces` with the boundary `edges` ([`boundary_edges`]) at the
+    /// geometry `x`.
+    pub fn new(faces: &'a [Face], edges: &'a [[usize; 2]], x: Positions<'a>) -> Self {
+        let mut rim: Vec<usize> = edges.iter().flatten().copied().collect();
+        rim.sort_unstable();
+        rim.dedup();
+        FaceSurface {
+            faces,
+            edges,
+            rim,
+            x,
+            surface: OnceCell::new(),
+            tree: OnceCell::new(),
+            swept: OnceCell::new(),
+            grown: OnceCell::new(),
         }
     }
+
+    fn x(&self, n: usize) -> V3 {
+        self.x.at::<3>(n)
+    }
+
+    /// The faces' and the nodes' normals at the surface's geometry.
+    fn surface(&self) -> &Surface {
+        self.surface
+            .get_or_init(|| Surface::new(self.faces, &|n| self.x(n)))
+    }
+
+    /// The row of `slave` against face `index` at its projection `pr`, along
+    /// `normal`.
+    fn candidate(&self, slave: Slave, index: usize, pr: &Projection, normal: V3) -> Candidate {
+        let face = &self.faces[index];
+        let mut corners = [(0, 0.0); 4];
+        for (k, &v) in face.corners().iter().enumerate() {
+            corners[k] = (v, pr.weights[k]);
+        }
+        Candidate::nodal::<3>(
+            slave,
+            Contactee::Face {
+                index,
+                nodes: *face,
+            },
+            &corners[..face.corners().len()],
+            0.0,
+            dot(sub(self.x(slave.node), pr.point), normal),
+            normal,
+        )
+    }
 }
 
-/// The candidates of one side with a deformable master.
-fn faces_side<X: Fn(usize) -> V3>(
-    (pi, si): (usize, usize),
-    side: &crate::model::ContactSide,
-    faces: &[Face],
-    r: f64,
-    x: &X,
-    out: &mut Vec<Candidate>,
-) {
-    let surface = Surface::new(faces, x);
-    let slaves = &side.slaves;
-    let edges = &side.master_boundary;
-    let mut rim: Vec<usize> = edges.iter().flatten().copied().collect();
-    rim.sort_unstable();
-    rim.dedup();
-    let tree = face_tree(faces, |n| std::iter::once(x(n)), 0.0);
-    let mut near: Vec<(usize, Projection)> = Vec::new();
-    for &s in slaves {
+/// The triangles of a face, as corner indices (a quadrilateral's two about its
+/// first diagonal).
+fn triangles(face: &Face) -> &'static [[usize; 3]] {
+    if face.is_triangle() {
+        &[[0, 1, 2]]
+    } else {
+        &[[0, 1, 2], [0, 2, 3]]
+    }
+}
+
+impl MasterSurface for FaceSurface<'_> {
+    fn detect(&self, slave: Slave, r: f64, _: &RigidHistory, out: &mut Vec<Candidate>) {
+        let faces = self.faces;
+        let x = |n: usize| self.x(n);
+        let tree = self
+            .tree
+            .get_or_init(|| face_tree(faces, |n| std::iter::once(x(n)), 0.0));
+        let s = slave.node;
         let p = x(s);
         let reach = AABB::from_corners(
             [p[0] - r, p[1] - r, p[2] - r],
             [p[0] + r, p[1] + r, p[2] + r],
         );
-        near.clear();
+        let mut near: Vec<(usize, Projection)> = Vec::new();
         for hit in tree.locate_in_envelope_intersecting(reach) {
             let f = &faces[hit.data];
             if f.corners().contains(&s) {
                 continue;
             }
-            if let Some(pr) = project(p, f, x) {
+            if let Some(pr) = project(p, f, &x) {
                 if pr.d2 <= r * r {
                     near.push((hit.data, pr));
                 }
@@ -550,13 +526,12 @@ fn faces_side<X: Fn(usize) -> V3>(
             })
             .copied()
         else {
-            continue;
+            return;
         };
         let (k, pr) = best;
-        if beyond_boundary((edges, &rim), p, &faces[k], &pr, x) {
-            continue;
+        if beyond_boundary((self.edges, &self.rim), p, &faces[k], &pr, &x) {
+            return;
         }
-        let key = Slave::new(pi, si, s);
         // Faces rising beyond the edge or corner the point is at (or near): a
         // valley, each face its own half-space.
         let on_boundary = match pr.region {
@@ -565,13 +540,9 @@ fn faces_side<X: Fn(usize) -> V3>(
         };
         let mut held: Vec<usize> = Vec::new();
         if on_boundary {
-            let nk = surface.normal[k];
-            let shared = |f: usize| {
-                faces[f]
-                    .corners()
-                    .iter()
-                    .any(|v| faces[k].corners().contains(v))
-            };
+            let nk = self.surface().normal[k];
+            let own = faces[k].corners();
+            let shared = |f: usize| faces[f].corners().iter().any(|v| own.contains(v));
             for (f, prf) in &near {
                 if *f == k || !shared(*f) {
                     continue;
@@ -583,7 +554,6 @@ fn faces_side<X: Fn(usize) -> V3>(
                 // The corners of the neighbour it does not share with the nearest
                 // face (a shared one lies on the boundary, where round-off decides
                 // the sign).
-                let own = faces[k].corners();
                 let rises = faces[*f]
                     .corners()
                     .iter()
@@ -598,23 +568,121 @@ fn faces_side<X: Fn(usize) -> V3>(
             }
         }
         if held.is_empty() {
-            let normal = surface.normal(&faces[k], &pr);
-            out.push(face_candidate(key, k, &faces[k], &pr, normal, x));
+            let normal = self.surface().normal(&faces[k], &pr);
+            out.push(self.candidate(slave, k, &pr, normal));
         } else {
             held.push(k);
             held.sort_unstable();
             for f in held {
                 let prf = near.iter().find(|(g, _)| *g == f).map(|(_, p)| *p);
                 if let Some(prf) = prf {
-                    out.push(face_candidate(key, f, &faces[f], &prf, prf.normal, x));
+                    out.push(self.candidate(slave, f, &prf, prf.normal));
                 }
             }
         }
+    }
+
+    fn nodes(&self) -> Option<Vec<usize>> {
+        Some(
+            self.faces
+                .iter()
+                .flat_map(|f| f.corners().iter().copied())
+                .collect(),
+        )
+    }
+
+    fn crossing(&self, slave: Slave, start: Positions, _: &RigidHistory) -> Option<Candidate> {
+        let x0 = |n: usize| start.at::<3>(n);
+        let x1 = |n: usize| self.x(n);
+        let faces = self.faces;
+        let tree = self
+            .swept
+            .get_or_init(|| face_tree(faces, |n| [x0(n), x1(n)].into_iter(), 0.0));
+        let s = slave.node;
+        let (p0, p1) = (x0(s), x1(s));
+        let reach = bounding_box([p0, p1].into_iter(), 0.0);
+        let mut first: Option<(f64, usize)> = None;
+        for hit in tree.locate_in_envelope_intersecting(reach) {
+            let f = &faces[hit.data];
+            let c = f.corners();
+            if c.contains(&s) {
+                continue;
+            }
+            let motion = |n: usize| (x0(n), sub(x1(n), x0(n)));
+            for tri in triangles(f) {
+                let [(a, va), (b, vb), (cc, vc)] = tri.map(|i| motion(c[i]));
+                let t = node_triangle(p0, sub(p1, p0), a, va, b, vb, cc, vc, 1.0);
+                if let Some(t) = t {
+                    if first.is_none_or(|(t0, _)| t.t < t0) {
+                        first = Some((t.t, hit.data));
+                    }
+                }
+            }
+        }
+        let (_, k) = first?;
+        let pr = project(p1, &faces[k], &x1)?;
+        let normal = self.surface().normal(&faces[k], &pr);
+        Some(self.candidate(slave, k, &pr, normal))
+    }
+
+    fn impact(
+        &self,
+        slave: Slave,
+        v: Positions,
+        h: f64,
+        r: f64,
+        _: &RigidHistory,
+    ) -> Option<Impact> {
+        let faces = self.faces;
+        let at = |n: usize| self.x(n);
+        let vel = |n: usize| v.at::<3>(n);
+        // Reach: the faces' boxes grown by the pair's radius.
+        let tree = self
+            .grown
+            .get_or_init(|| face_tree(faces, |n| std::iter::once(at(n)), r));
+        let s = slave.node;
+        let p = at(s);
+        let mut best: Option<Impact> = None;
+        for hit in tree.locate_all_at_point(p) {
+            let c = faces[hit.data].corners();
+            if c.contains(&s) {
+                continue;
+            }
+            for tri in triangles(&faces[hit.data]) {
+                let [a, b, cc] = tri.map(|i| c[i]);
+                let Some(t) =
+                    node_triangle(p, vel(s), at(a), vel(a), at(b), vel(b), at(cc), vel(cc), h)
+                else {
+                    continue;
+                };
+                if best.as_ref().is_some_and(|b| b.t <= t.t) {
+                    continue;
+                }
+                // The triangle's outward normal at the impact.
+                let x = |n: usize| add(at(n), scale(vel(n), t.t));
+                let (xa, xb, xc) = (x(a), x(b), x(cc));
+                let nn = cross(sub(xb, xa), sub(xc, xa));
+                let l = norm(nn);
+                // A degenerate triangle (NaN counts as one).
+                if l.is_nan() || l <= 0.0 {
+                    continue;
+                }
+                best = Some(Impact {
+                    t: t.t,
+                    target: Target::Facet(hit.data),
+                    corners: [(a, t.bary[0]), (b, t.bary[1]), (cc, t.bary[2])],
+                    n_corners: 3,
+                    normal: nn.map(|c| c / l),
+                });
+            }
+        }
+        best
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::detect;
     use super::*;
 
     #[test]
@@ -663,34 +731,12 @@ mod tests {
         assert_eq!(pr.region, Region::Edge(1));
     }
 
-    #[test]
-    fn tangents_are_orthonormal_with_the_normal() {
-        for n in [
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-            [1.0, 0.0, 0.0],
-            [0.3, -0.2, 0.9327379053088815],
-        ] {
-            let n = unit(n).unwrap();
-            {
-                let t = plane_tangents(n);
-                assert!(dot(t[0], n).abs() < 1e-15 && dot(t[1], n).abs() < 1e-15);
-                assert!(dot(t[0], t[1]).abs() < 1e-15);
-                assert!((dot(t[0], t[0]) - 1.0).abs() < 1e-15);
-                assert!((dot(t[1], t[1]) - 1.0).abs() < 1e-15);
-                // Right-handed: t1 × t2 = n.
-                let c = cross(t[0], t[1]);
-                assert!(dot(sub(c, n), sub(c, n)) < 1e-28);
-            }
-        }
-    }
-
-    fn side(slaves: Vec<usize>, faces: Vec<Face>) -> ContactPair {
-        ContactPair {
+    fn side(slaves: Vec<usize>, faces: Vec<Face>) -> crate::model::ContactPair {
+        crate::model::ContactPair {
             name: "p".into(),
             sides: vec![crate::model::ContactSide {
                 slaves,
-                master: Master::Faces(faces),
+                master: crate::model::Master::Faces(faces),
                 mortar: Vec::new(),
                 faces: Vec::new(),
                 master_boundary: Vec::new(),
@@ -725,7 +771,7 @@ mod tests {
         ];
         let mut out = Vec::new();
         let x = geometry(0.2);
-        detect(&[side(vec![6], faces.clone())], |n| x[n], &mut out);
+        detect(&[side(vec![6], faces.clone())], &x, &mut out);
         assert_eq!(out.len(), 2, "{out:?}");
         for c in &out {
             // Each along its own face's normal (leaning away from the other face).
@@ -734,12 +780,12 @@ mod tests {
         assert!(out[0].normal[0] * out[1].normal[0] < 0.0);
         // A ridge: one row along the ridge's mean normal (straight up).
         let x = geometry(-0.2);
-        detect(&[side(vec![6], faces.clone())], |n| x[n], &mut out);
+        detect(&[side(vec![6], faces.clone())], &x, &mut out);
         assert_eq!(out.len(), 1, "{out:?}");
         assert!(out[0].normal[0].abs() < 1e-12 && (out[0].normal[1] - 1.0).abs() < 1e-12);
         // A nearly flat valley (below VALLEY_SINE): one row, continuous normal.
         let x = geometry(1e-4);
-        detect(&[side(vec![6], faces)], |n| x[n], &mut out);
+        detect(&[side(vec![6], faces)], &x, &mut out);
         assert_eq!(out.len(), 1, "{out:?}");
         assert!(out[0].normal[0].abs() < 1e-12);
     }
