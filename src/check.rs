@@ -385,7 +385,8 @@ impl fmt::Display for Report {
 
 /// Writes the matrices of the model's first step in Matrix Market format (through
 /// nalgebra-sparse's I/O) into `dir`, for study in SciPy or MATLAB:
-/// `K.mtx` and `M.mtx` (all dofs, dof `2n + c` for node `n`, component `c`),
+/// `K.mtx` and `M.mtx` (all dofs, dof `d n + c` for node `n`, component `c`, `d`
+/// the mesh dimension),
 /// `K_eff.mtx` (the effective matrix of the first step on the free dofs, both
 /// triangles), `free_dofs.txt` (the dof of each free equation), and `G.mtx` (the
 /// linearised gap rows of every contact candidate at the initial geometry, all dofs)

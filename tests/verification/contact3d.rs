@@ -843,3 +843,34 @@ fn a_solid_crossing_a_face_or_a_plane_within_one_step_is_caught() {
         assert!(touched, "rigid {rigid}: the striker was stopped by contact");
     }
 }
+
+#[test]
+fn check_writes_a_solids_gap_rows() {
+    // The cube of examples/solid/incline.toml rests on its rigid plane y = 0: the
+    // 4 x 4 nodes of its bottom face are candidates, each row one unit entry on the
+    // node's y dof (the plane's normal; the row keeps the zero x and z entries),
+    // three dofs per node.
+    use nalgebra_sparse::io::load_coo_from_matrix_market_file;
+    let dir = tempfile::tempdir().unwrap();
+    let sc = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/solid/incline.toml");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_rothe"))
+        .args(["check", sc.to_str().unwrap(), "--matrices"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let g = load_coo_from_matrix_market_file::<f64, _>(dir.path().join("G.mtx")).unwrap();
+    let model = rothe::config::load(&sc).unwrap();
+    assert_eq!((g.nrows(), g.ncols()), (16, model.mesh.n_dofs()));
+    let mut rows = vec![0; 16];
+    for (i, j, v) in g.triplet_iter().filter(|e| *e.2 != 0.0) {
+        assert_eq!((j % 3, *v), (1, 1.0), "row {i}: dof {j}");
+        assert!(model.mesh.coords[j / 3][1].abs() < 1e-15);
+        rows[i] += 1;
+    }
+    assert!(rows.iter().all(|&k| k == 1), "{rows:?}");
+}
