@@ -20,17 +20,18 @@
 //! complementarity (no force across an open gap) and the active set all settle
 //! (`theory/contact.md`).
 
+mod parts;
 mod paths;
 
-use std::collections::BTreeMap;
+use parts::{ActiveSet, RowSelection, Setup, StepStart, Workspace};
+
 use std::time::Instant;
 
-use super::compliance::Compliance;
-use super::master::{rigid, Positions};
-use super::qp::DualQp;
+use super::master::rigid;
+use super::master::Positions;
 use super::rows::Candidate;
 use crate::error::Result;
-use crate::model::{ContactPair, ContactQp, Model};
+use crate::model::{ContactQp, Model};
 use crate::nonlinear::{ConstraintStatus, Corrected, Correction};
 use crate::system::EffectiveSystem;
 
@@ -99,82 +100,16 @@ pub struct ContactStats {
     pub cone_programs: usize,
 }
 
-/// The constrained correction for the contact pairs of a model.
+/// The constrained correction for the contact pairs of a model: its setup, where the
+/// step started, the active set, the rows of the QP at hand, the workspace and the
+/// record of what it cost.
 pub struct ContactCorrection<'m> {
-    model: &'m Model,
-    pairs: &'m [ContactPair],
-    tol: f64,
-    /// The gap the coordinates resolve (m): [`GAP_ROUNDOFF`] ulps of the largest.
-    gap_floor: f64,
-    qp: ContactQp,
-    /// Tributary area (length × thickness) of each node as a slave, for pressures.
-    area: Vec<f64>,
-    /// The free-dof numbering (the system's).
-    dofs: crate::system::DofMap,
-    /// Candidates at the current iterate.
-    cands: Vec<Candidate>,
-    /// Current multipliers by key (positive ones only).
-    lambda: BTreeMap<Key, f64>,
-    /// Current tangential multipliers by key (frictional rows), along the row's
-    /// tangents (one in the plane, the second zero).
-    lambda_t: BTreeMap<Key, [f64; 2]>,
-    /// The spatial dimension (dofs per node).
-    dim: usize,
-    /// Whether any pair has friction.
-    frictional: bool,
-    /// The friction part of `f_c`.
-    f_t: Vec<f64>,
-    /// Displacements at the start of the step (slips are measured from them).
-    u0: Vec<f64>,
-    /// Normal rows of the last QP (the tangential ones follow them), and each
-    /// tangential row's normal row and `μ`.
-    normal_rows: usize,
-    cones: Vec<(usize, f64)>,
-    /// The guess of a frictional QP: the normal rows pressed at the last QP and how
-    /// each frictional node ended there.
-    pressed: Vec<bool>,
-    guess_t: Vec<super::coulomb::Guess>,
-    /// Active constraints (multipliers above the threshold) of the previous QP (or of
-    /// the last step) and of the last one, sorted. The active set has settled when
-    /// the same slaves are held (a slave in a notch may share its force between
-    /// two segments differently from one QP to the next).
-    previous: Vec<Key>,
-    current: Vec<Key>,
-    /// Contact forces `Gᵀλ` at the current iterate (all dofs), and whether the loop's
-    /// residual includes them.
-    f_c: Vec<f64>,
-    added: bool,
-    // Workspace.
-    x: Vec<f64>,
-    /// Node positions at the start of the step (`x` above is the current one).
-    x0: Vec<f64>,
-    delta0: Vec<f64>,
-    /// `δ₀` kept for a second round of the QP, and the candidates a round forced in.
-    delta_start: Vec<f64>,
-    forced: Vec<usize>,
-    rows: Vec<usize>,
-    y: Vec<f64>,
-    w: Vec<f64>,
-    c: Vec<f64>,
-    lambda_rows: Vec<f64>,
-    needed: Vec<usize>,
-    push: Vec<f64>,
-    /// The step's lead `h v` on the free dofs and on all dofs, and `u + h v`.
-    lead: Vec<f64>,
-    lead_all: Vec<f64>,
-    x_lead: Vec<f64>,
-    /// The gap of each candidate at the iterate (shifted back by the lead).
-    gaps: Vec<f64>,
-    guess: Vec<usize>,
-    guess_work: Vec<f64>,
-    moved: Vec<(Key, f64)>,
-    /// The compliance of the contact dofs, and the factorisation of the last QP.
-    compliance: Compliance,
-    qp_generation: usize,
-    dual: DualQp,
-    stats: ContactStats,
-    rigid: rigid::RigidHistory,
-    push_entries: Vec<(usize, f64)>,
+    setup: Setup<'m>,
+    start: StepStart,
+    active: ActiveSet,
+    sel: RowSelection,
+    work: Workspace,
+    record: ContactStats,
 }
 
 impl<'m> ContactCorrection<'m> {
@@ -182,75 +117,49 @@ impl<'m> ContactCorrection<'m> {
     pub fn new(model: &'m Model) -> Self {
         let mesh = &model.mesh;
         let n = mesh.n_dofs();
-        let area = super::tributary_areas(model);
+        let largest = mesh
+            .coords
+            .iter()
+            .flat_map(|c| c.iter())
+            .fold(0.0f64, |a, x| a.max(x.abs()));
         ContactCorrection {
-            model,
-            pairs: &model.contacts,
-            tol: model.analysis.contact.tolerance,
-            gap_floor: GAP_ROUNDOFF
-                * f64::EPSILON
-                * model
-                    .mesh
-                    .coords
-                    .iter()
-                    .flat_map(|c| c.iter())
-                    .fold(0.0f64, |a, x| a.max(x.abs())),
-            qp: model.analysis.contact.qp,
-            area,
-            dofs: crate::system::DofMap::new(n, model.constraints.iter().map(|c| c.dof)),
-            cands: Vec::new(),
-            lambda: BTreeMap::new(),
-            lambda_t: BTreeMap::new(),
-            dim: mesh.dim,
-            frictional: model.contacts.iter().any(|p| p.mu > 0.0),
-            f_t: vec![0.0; n],
-            u0: Vec::new(),
-            normal_rows: 0,
-            cones: Vec::new(),
-            pressed: Vec::new(),
-            guess_t: Vec::new(),
-            previous: Vec::new(),
-            current: Vec::new(),
-            f_c: vec![0.0; n],
-            added: false,
-            x: vec![0.0; n],
-            x0: Vec::new(),
-            delta0: Vec::new(),
-            delta_start: Vec::new(),
-            forced: Vec::new(),
-            rows: Vec::new(),
-            y: Vec::new(),
-            w: Vec::new(),
-            c: Vec::new(),
-            lambda_rows: Vec::new(),
-            needed: Vec::new(),
-            push: Vec::new(),
-            lead: Vec::new(),
-            lead_all: Vec::new(),
-            x_lead: Vec::new(),
-            gaps: Vec::new(),
-            guess: Vec::new(),
-            guess_work: Vec::new(),
-            moved: Vec::new(),
-            compliance: Compliance::default(),
-            qp_generation: usize::MAX,
-            dual: DualQp::default(),
-            stats: ContactStats::default(),
-            rigid: Default::default(),
-            push_entries: Vec::new(),
+            setup: Setup {
+                model,
+                pairs: &model.contacts,
+                tol: model.analysis.contact.tolerance,
+                gap_floor: GAP_ROUNDOFF * f64::EPSILON * largest,
+                qp: model.analysis.contact.qp,
+                area: super::tributary_areas(model),
+                dofs: crate::system::DofMap::new(n, model.constraints.iter().map(|c| c.dof)),
+                dim: mesh.dim,
+                frictional: model.contacts.iter().any(|p| p.mu > 0.0),
+            },
+            start: StepStart::default(),
+            active: ActiveSet {
+                f_c: vec![0.0; n],
+                f_t: vec![0.0; n],
+                ..Default::default()
+            },
+            sel: RowSelection::default(),
+            work: Workspace {
+                x: vec![0.0; n],
+                qp_generation: usize::MAX,
+                ..Default::default()
+            },
+            record: ContactStats::default(),
         }
     }
 
     /// The same correction without friction: impenetrability only (the contact
     /// predictor's projection).
     pub fn frictionless(mut self) -> Self {
-        self.frictional = false;
+        self.setup.frictional = false;
         self
     }
 
     /// Whether any constraint carries a force at the last iterate.
     pub fn has_forces(&self) -> bool {
-        !self.lambda.is_empty()
+        !self.active.lambda.is_empty()
     }
 
     /// Starts a step from the contact state of the last one: its multipliers are the
@@ -258,77 +167,80 @@ impl<'m> ContactCorrection<'m> {
     pub fn begin_step(&mut self, committed: &ContactState, u: &[f64], lead: Option<(f64, &[f64])>) {
         // Slaves that came around the end of a rigid line are not its candidates;
         // those it holds stay on it a little beyond its ends.
-        let coords = &self.model.mesh.coords;
+        let coords = &self.setup.model.mesh.coords;
         // The geometry at the start of the step: a slave's motion from it is swept
         // for crossings ([`super::detect::crossed`]).
-        let dim = self.dim;
-        self.x0.clear();
-        self.x0.extend(
+        let dim = self.setup.dim;
+        self.start.x0.clear();
+        self.start.x0.extend(
             coords
                 .iter()
                 .enumerate()
                 .flat_map(|(n, c)| (0..dim).map(move |i| c[i] + u[dim * n + i])),
         );
         if dim == 2 {
-            self.rigid.beneath = rigid::beneath_rigid(
-                self.pairs,
+            self.start.rigid.beneath = rigid::beneath_rigid(
+                self.setup.pairs,
                 |n| [coords[n][0] + u[2 * n], coords[n][1] + u[2 * n + 1]],
-                rigid::RIGID_DEPTH_TOLERANCES * self.tol,
-                &self.rigid.beneath,
+                rigid::RIGID_DEPTH_TOLERANCES * self.setup.tol,
+                &self.start.rigid.beneath,
             );
         }
         // The displacement h v the step is expected to make, by which the first
         // correction is linearised ahead (zero on the constrained dofs).
-        self.lead.clear();
-        self.lead_all.clear();
+        self.start.lead.clear();
+        self.start.lead_all.clear();
         if let Some((h, v)) = lead {
-            self.lead_all.extend(v.iter().map(|x| h * x));
-            for (d, &e) in self.dofs.eq.iter().enumerate() {
+            self.start.lead_all.extend(v.iter().map(|x| h * x));
+            for (d, &e) in self.setup.dofs.eq.iter().enumerate() {
                 if e == crate::system::CONSTRAINED {
-                    self.lead_all[d] = 0.0;
+                    self.start.lead_all[d] = 0.0;
                 }
             }
-            self.lead
-                .extend(self.dofs.free.iter().map(|&d| self.lead_all[d]));
+            self.start
+                .lead
+                .extend(self.setup.dofs.free.iter().map(|&d| self.start.lead_all[d]));
         }
-        self.lambda = committed.active.iter().copied().collect();
-        self.lambda_t = committed.tangential.iter().copied().collect();
+        self.active.lambda = committed.active.iter().copied().collect();
+        self.active.lambda_t = committed.tangential.iter().copied().collect();
         // Slips are measured from the start of the step (friction only).
-        self.u0.clear();
-        if self.frictional {
-            self.u0.extend_from_slice(u);
+        self.start.u0.clear();
+        if self.setup.frictional {
+            self.start.u0.extend_from_slice(u);
         }
         let values: Vec<f64> = committed.active.iter().map(|(_, l)| *l).collect();
         let threshold = self.active_threshold(&values);
-        self.current = committed
+        self.active.current = committed
             .active
             .iter()
             .filter(|(_, l)| *l > threshold)
             .map(|(k, _)| *k)
             .collect();
-        self.previous = self.current.clone();
-        self.added = false;
-        self.rigid.held = self
+        self.active.previous = self.active.current.clone();
+        self.active.added = false;
+        self.start.rigid.held = self
+            .active
             .current
             .iter()
             .filter(|k| k.target == Target::Rigid)
             .map(|k| k.slave)
             .collect();
-        self.rigid.held.sort_unstable();
-        self.rigid.held.dedup();
+        self.start.rigid.held.sort_unstable();
+        self.start.rigid.held.dedup();
     }
 
     /// Ends an accepted step with increment `du`: writes the contact state and returns
     /// the work `Δu·f` of the normal and of the tangential contact forces of the step
     /// (the ledger books their negatives as `D_contact` and `D_friction`).
     pub fn finish(&mut self, du: &[f64], out: &mut ContactState) -> (f64, f64) {
-        let work: f64 = du.iter().zip(&self.f_c).map(|(d, f)| d * f).sum();
-        let friction: f64 = du.iter().zip(&self.f_t).map(|(d, f)| d * f).sum();
-        out.active = self.lambda.iter().map(|(k, l)| (*k, *l)).collect();
-        out.tangential = self.lambda_t.iter().map(|(k, l)| (*k, *l)).collect();
+        let work: f64 = du.iter().zip(&self.active.f_c).map(|(d, f)| d * f).sum();
+        let friction: f64 = du.iter().zip(&self.active.f_t).map(|(d, f)| d * f).sum();
+        out.active = self.active.lambda.iter().map(|(k, l)| (*k, *l)).collect();
+        out.tangential = self.active.lambda_t.iter().map(|(k, l)| (*k, *l)).collect();
         out.pairs.clear();
-        out.pairs.resize(self.pairs.len(), PairRecord::default());
-        let n_nodes = self.model.mesh.n_nodes();
+        out.pairs
+            .resize(self.setup.pairs.len(), PairRecord::default());
+        let n_nodes = self.setup.model.mesh.n_nodes();
         out.gap.clear();
         out.gap.resize(n_nodes, f64::NAN);
         out.pressure.clear();
@@ -336,26 +248,31 @@ impl<'m> ContactCorrection<'m> {
         out.traction.clear();
         out.traction.resize(n_nodes, 0.0);
         out.slip.resize(n_nodes, 0.0);
-        let largest = self.lambda.values().fold(0.0f64, |a, x| a.max(*x));
+        let largest = self.active.lambda.values().fold(0.0f64, |a, x| a.max(*x));
         let threshold = self.active_threshold(&[largest]);
-        for c in &self.cands {
+        for c in &self.sel.cands {
             let rec = &mut out.pairs[c.pair];
             rec.penetration = rec.penetration.max(-c.gap);
             let g = &mut out.gap[c.slave];
             *g = if g.is_nan() { c.gap } else { g.min(c.gap) };
             let area = self.area_of(c);
-            if let Some(&l) = self.lambda.get(&c.key()) {
+            if let Some(&l) = self.active.lambda.get(&c.key()) {
                 rec.force += l;
                 if area > 0.0 {
                     out.pressure[c.slave] += l / area;
                 }
-                let mu = self.pairs[c.pair].mu;
+                let mu = self.setup.pairs[c.pair].mu;
                 if mu > 0.0 && l > threshold {
-                    let lt = self.lambda_t.get(&c.key()).copied().unwrap_or([0.0; 2]);
+                    let lt = self
+                        .active
+                        .lambda_t
+                        .get(&c.key())
+                        .copied()
+                        .unwrap_or([0.0; 2]);
                     // In the plane the signed force along the tangent; in a solid,
                     // whose rows' tangents differ, its magnitude.
                     let size = lt[0].hypot(lt[1]);
-                    let signed = if self.dim == 2 { lt[0] } else { size };
+                    let signed = if self.setup.dim == 2 { lt[0] } else { size };
                     rec.tangential_force += signed;
                     rec.tangential_magnitude += size;
                     if area > 0.0 {
@@ -366,14 +283,14 @@ impl<'m> ContactCorrection<'m> {
                     } else {
                         rec.slipping += 1;
                     }
-                    let dim = self.dim;
+                    let dim = self.setup.dim;
                     let d = c.tangential(|n, i| du[dim * n + i]);
                     out.slip[c.slave] += d[0].hypot(d[1]);
                     rec.max_slip = rec.max_slip.max(out.slip[c.slave]);
                 }
             }
         }
-        for s in slaves(&self.current) {
+        for s in slaves(&self.active.current) {
             out.pairs[s.pair].active += 1;
         }
         (work - friction, friction)
@@ -383,57 +300,63 @@ impl<'m> ContactCorrection<'m> {
     /// times the slave body's thickness, else the node's tributary area.
     fn area_of(&self, c: &Candidate) -> f64 {
         if c.length > 0.0 {
-            let mesh = &self.model.mesh;
-            c.length * self.model.bodies[mesh.node_body[c.slave]].thickness
+            let mesh = &self.setup.model.mesh;
+            c.length * self.setup.model.bodies[mesh.node_body[c.slave]].thickness
         } else {
-            self.area[c.slave]
+            self.setup.area[c.slave]
         }
     }
 
     /// Time and counts so far.
     pub fn stats(&self) -> ContactStats {
-        self.stats
+        self.record
     }
 
-    /// Candidates at `u` into `self.cands`.
+    /// Candidates at `u` into `self.sel.cands`.
     fn detect_at(&mut self, u: &[f64]) {
         let t = Instant::now();
-        let coords = &self.model.mesh.coords;
-        let dim = self.dim;
+        let coords = &self.setup.model.mesh.coords;
+        let dim = self.setup.dim;
         for (n, c) in coords.iter().enumerate() {
             for i in 0..dim {
-                self.x[dim * n + i] = c[i] + u[dim * n + i];
+                self.work.x[dim * n + i] = c[i] + u[dim * n + i];
             }
         }
-        let x = Positions::new(&self.x, dim);
-        super::detect::detect(self.pairs, x, &self.rigid, &mut self.cands);
-        if !self.x0.is_empty() {
-            let x0 = Positions::new(&self.x0, dim);
-            super::detect::crossed(self.pairs, x0, x, &self.rigid, &mut self.cands);
+        let x = Positions::new(&self.work.x, dim);
+        super::detect::detect(self.setup.pairs, x, &self.start.rigid, &mut self.sel.cands);
+        if !self.start.x0.is_empty() {
+            let x0 = Positions::new(&self.start.x0, dim);
+            super::detect::crossed(
+                self.setup.pairs,
+                x0,
+                x,
+                &self.start.rigid,
+                &mut self.sel.cands,
+            );
         }
-        self.stats.detect_s += t.elapsed().as_secs_f64();
+        self.record.detect_s += t.elapsed().as_secs_f64();
     }
 
     /// `Gᵀλ` of the current multipliers at the current candidates, into `f_c` (the
     /// tangential ones' part also into `f_t`).
     fn forces(&mut self) {
-        self.f_c.fill(0.0);
-        self.f_t.fill(0.0);
-        for c in &self.cands {
-            if let Some(&l) = self.lambda.get(&c.key()) {
+        self.active.f_c.fill(0.0);
+        self.active.f_t.fill(0.0);
+        for c in &self.sel.cands {
+            if let Some(&l) = self.active.lambda.get(&c.key()) {
                 for (d, v) in c.row() {
-                    self.f_c[d] += l * v;
+                    self.active.f_c[d] += l * v;
                 }
             }
-            if let Some(&l) = self.lambda_t.get(&c.key()) {
+            if let Some(&l) = self.active.lambda_t.get(&c.key()) {
                 for (j, lj) in l.iter().enumerate().take(c.n_tangents()) {
                     for (d, v) in c.tangent_row(j) {
-                        self.f_t[d] += lj * v;
+                        self.active.f_t[d] += lj * v;
                     }
                 }
             }
         }
-        for (c, t) in self.f_c.iter_mut().zip(&self.f_t) {
+        for (c, t) in self.active.f_c.iter_mut().zip(&self.active.f_t) {
             *c += t;
         }
     }
@@ -441,8 +364,8 @@ impl<'m> ContactCorrection<'m> {
     /// The relative tangential displacement of a row since the start of the step at
     /// displacements `u`: `t_j · Σ w_k (u_k − u0_k)` along each tangent.
     fn slip(&self, c: &Candidate, u: &[f64]) -> [f64; 2] {
-        let dim = self.dim;
-        c.tangential(|n, i| u[dim * n + i] - self.u0[dim * n + i])
+        let dim = self.setup.dim;
+        c.tangential(|n, i| u[dim * n + i] - self.start.u0[dim * n + i])
     }
 
     /// The rows of the QP at an iterate: the candidates predicted (by `δ₀`) to close
@@ -450,61 +373,64 @@ impl<'m> ContactCorrection<'m> {
     /// earlier round of the same correction; then the tangential rows of the
     /// frictional ones. `leading`: the candidates were detected at `u + h v`.
     fn select_rows(&mut self, g: &nalgebra_sparse::CsrMatrix<f64>, u: &[f64], leading: bool) {
-        let n_cands = self.cands.len();
-        let tdim = self.dim - 1;
-        self.rows.clear();
-        self.cones.clear();
-        self.c.clear();
-        self.gaps.clear();
-        for (i, c) in self.cands.iter().enumerate() {
+        let n_cands = self.sel.cands.len();
+        let tdim = self.setup.dim - 1;
+        self.sel.rows.clear();
+        self.sel.cones.clear();
+        self.sel.c.clear();
+        self.sel.gaps.clear();
+        for (i, c) in self.sel.cands.iter().enumerate() {
             let row = g.row(i);
             let dot = |x: &[f64]| row_dot(&row, x);
             // The gap at u: at u + hv less its linearised change over hv.
             let gap = if leading {
-                c.gap - dot(&self.lead)
+                c.gap - dot(&self.start.lead)
             } else {
                 c.gap
             };
-            self.gaps.push(gap);
+            self.sel.gaps.push(gap);
             if row.nnz() == 0 {
                 continue;
             }
-            let predicted = gap + dot(&self.delta0);
-            if predicted < self.tol
-                || self.previous.contains(&c.key())
-                || self.forced.binary_search(&i).is_ok()
+            let predicted = gap + dot(&self.work.delta0);
+            if predicted < self.setup.tol
+                || self.active.previous.contains(&c.key())
+                || self.sel.forced.binary_search(&i).is_ok()
             {
-                self.rows.push(i);
-                self.c.push(predicted);
+                self.sel.rows.push(i);
+                self.sel.c.push(predicted);
             }
         }
         // The tangential rows of the frictional pairs' rows, after the normal ones
         // (one per tangent, `dim − 1`): the slip since the start of the step,
         // predicted.
-        self.normal_rows = self.rows.len();
-        self.pressed.clear();
-        self.guess_t.clear();
-        if self.frictional {
-            for &i in &self.rows {
-                let key = self.cands[i].key();
-                self.pressed.push(self.previous.binary_search(&key).is_ok());
+        self.sel.normal_rows = self.sel.rows.len();
+        self.sel.pressed.clear();
+        self.sel.guess_t.clear();
+        if self.setup.frictional {
+            for &i in &self.sel.rows {
+                let key = self.sel.cands[i].key();
+                self.sel
+                    .pressed
+                    .push(self.active.previous.binary_search(&key).is_ok());
             }
-            for j in 0..self.normal_rows {
-                let i = self.rows[j];
-                let c = &self.cands[i];
-                let mu = self.pairs[c.pair].mu;
+            for j in 0..self.sel.normal_rows {
+                let i = self.sel.rows[j];
+                let c = &self.sel.cands[i];
+                let mu = self.setup.pairs[c.pair].mu;
                 if mu > 0.0 {
                     let slip = self.slip(c, u);
                     for (t, s) in slip.iter().enumerate().take(tdim) {
-                        let moved = row_dot(&g.row(n_cands + tdim * i + t), &self.delta0);
-                        self.rows.push(n_cands + tdim * i + t);
-                        self.c.push(s + moved);
+                        let moved = row_dot(&g.row(n_cands + tdim * i + t), &self.work.delta0);
+                        self.sel.rows.push(n_cands + tdim * i + t);
+                        self.sel.c.push(s + moved);
                     }
-                    self.cones.push((j, mu));
+                    self.sel.cones.push((j, mu));
                     let key = c.key();
-                    let ln = self.lambda.get(&key).copied().unwrap_or(0.0);
-                    let lt = self.lambda_t.get(&key).copied().unwrap_or([0.0; 2]);
-                    self.guess_t
+                    let ln = self.active.lambda.get(&key).copied().unwrap_or(0.0);
+                    let lt = self.active.lambda_t.get(&key).copied().unwrap_or([0.0; 2]);
+                    self.sel
+                        .guess_t
                         .push(if lt[0].hypot(lt[1]) < (1.0 - STICK_MARGIN) * mu * ln {
                             super::coulomb::Guess::Stick
                         } else {
@@ -519,20 +445,20 @@ impl<'m> ContactCorrection<'m> {
     /// QP penetrate (beyond the QP's own accuracy); those that do are added to
     /// `forced` for the next round.
     fn left_out_penetrate(&mut self, g: &nalgebra_sparse::CsrMatrix<f64>) -> bool {
-        let inside = &self.rows[..self.normal_rows];
-        let floor = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let before = self.forced.len();
-        for i in 0..self.cands.len() {
+        let inside = &self.sel.rows[..self.sel.normal_rows];
+        let floor = GUESS_GAP_TOLERANCE * self.sel.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let before = self.sel.forced.len();
+        for i in 0..self.sel.cands.len() {
             let row = g.row(i);
             if row.nnz() == 0 || inside.binary_search(&i).is_ok() {
                 continue;
             }
-            if self.gaps[i] + row_dot(&row, &self.delta0) < -floor {
-                self.forced.push(i);
+            if self.sel.gaps[i] + row_dot(&row, &self.work.delta0) < -floor {
+                self.sel.forced.push(i);
             }
         }
-        self.forced.sort_unstable();
-        self.forced.len() > before
+        self.sel.forced.sort_unstable();
+        self.sel.forced.len() > before
     }
 
     /// The threshold below which a multiplier counts as zero: a millionth of the
@@ -554,11 +480,11 @@ impl Correction for ContactCorrection<'_> {
         // row left for the slave (it left the master), it is dropped, and that is
         // an active-set change.
         let mut dropped = false;
-        self.moved.clear();
-        let cands = &self.cands;
+        self.active.moved.clear();
+        let cands = &self.sel.cands;
         let found = |k: &Key| cands.binary_search_by_key(k, Candidate::key).is_ok();
-        let moved = &mut self.moved;
-        self.lambda.retain(|k, l| {
+        let moved = &mut self.active.moved;
+        self.active.lambda.retain(|k, l| {
             let keep = found(k);
             if !keep {
                 moved.push((*k, *l));
@@ -567,7 +493,7 @@ impl Correction for ContactCorrection<'_> {
         });
         // A tangential force follows its normal one to the slave's remaining row.
         let mut moved_t = Vec::new();
-        self.lambda_t.retain(|k, l| {
+        self.active.lambda_t.retain(|k, l| {
             let keep = found(k);
             if !keep {
                 moved_t.push((*k, *l));
@@ -576,23 +502,23 @@ impl Correction for ContactCorrection<'_> {
         });
         for (k, l) in moved_t {
             let slave = k.slave;
-            let at = self.cands.partition_point(|c| c.slave_key() < slave);
-            if let Some(c) = self.cands.get(at).filter(|c| c.slave_key() == slave) {
-                let e = self.lambda_t.entry(c.key()).or_insert([0.0; 2]);
+            let at = self.sel.cands.partition_point(|c| c.slave_key() < slave);
+            if let Some(c) = self.sel.cands.get(at).filter(|c| c.slave_key() == slave) {
+                let e = self.active.lambda_t.entry(c.key()).or_insert([0.0; 2]);
                 e[0] += l[0];
                 e[1] += l[1];
             }
         }
-        for &(k, l) in &self.moved {
+        for &(k, l) in &self.active.moved {
             let slave = k.slave;
-            let at = self.cands.partition_point(|c| c.slave_key() < slave);
-            match self.cands.get(at).filter(|c| c.slave_key() == slave) {
+            let at = self.sel.cands.partition_point(|c| c.slave_key() < slave);
+            match self.sel.cands.get(at).filter(|c| c.slave_key() == slave) {
                 Some(c) => {
-                    *self.lambda.entry(c.key()).or_insert(0.0) += l;
-                    if let Ok(p) = self.current.binary_search(&k) {
-                        self.current.remove(p);
-                        if let Err(q) = self.current.binary_search(&c.key()) {
-                            self.current.insert(q, c.key());
+                    *self.active.lambda.entry(c.key()).or_insert(0.0) += l;
+                    if let Ok(p) = self.active.current.binary_search(&k) {
+                        self.active.current.remove(p);
+                        if let Err(q) = self.active.current.binary_search(&c.key()) {
+                            self.active.current.insert(q, c.key());
                         }
                     }
                 }
@@ -600,22 +526,23 @@ impl Correction for ContactCorrection<'_> {
             }
         }
         self.forces();
-        for (ri, f) in r.iter_mut().zip(&self.f_c) {
+        for (ri, f) in r.iter_mut().zip(&self.active.f_c) {
             *ri -= f;
         }
-        self.added = true;
+        self.active.added = true;
         let mut penetration: f64 = 0.0;
         let mut open_under_force: f64 = 0.0;
-        for c in &self.cands {
+        for c in &self.sel.cands {
             penetration = penetration.max(-c.gap);
-            if self.current.binary_search(&c.key()).is_ok() {
+            if self.active.current.binary_search(&c.key()).is_ok() {
                 open_under_force = open_under_force.max(c.gap);
             }
         }
         ConstraintStatus {
             penetration,
             complementarity: open_under_force,
-            active_set_changed: !slaves(&self.previous).eq(slaves(&self.current)) || dropped,
+            active_set_changed: !slaves(&self.active.previous).eq(slaves(&self.active.current))
+                || dropped,
         }
     }
 
@@ -625,58 +552,62 @@ impl Correction for ContactCorrection<'_> {
         u: &[f64],
         rhs: &mut [f64],
     ) -> Result<Corrected> {
-        if !self.added {
+        if !self.active.added {
             // A predicted start: no evaluation, no forces in the right-hand side yet.
             // Linearised about the predicted geometry u + h v (theory/contact.md).
-            if self.lead.is_empty() {
+            if self.start.lead.is_empty() {
                 self.detect_at(u);
             } else {
-                self.x_lead.clear();
-                self.x_lead
-                    .extend(u.iter().zip(&self.lead_all).map(|(a, b)| a + b));
-                let x_lead = std::mem::take(&mut self.x_lead);
+                self.work.x_lead.clear();
+                self.work
+                    .x_lead
+                    .extend(u.iter().zip(&self.start.lead_all).map(|(a, b)| a + b));
+                let x_lead = std::mem::take(&mut self.work.x_lead);
                 self.detect_at(&x_lead);
-                self.x_lead = x_lead;
+                self.work.x_lead = x_lead;
             }
-            self.f_c.fill(0.0);
+            self.active.f_c.fill(0.0);
         }
-        let leading = !self.added && !self.lead.is_empty();
-        self.added = false;
-        let (free, eq) = (&self.dofs.free, &self.dofs.eq);
+        let leading = !self.active.added && !self.start.lead.is_empty();
+        self.active.added = false;
+        let (free, eq) = (&self.setup.dofs.free, &self.setup.dofs.eq);
         debug_assert_eq!(free.len(), sys.dofs().n_free());
         // −r = rhs − f_c on the free dofs; δ₀ = A⁻¹(−r).
-        self.delta0.clear();
-        self.delta0
-            .extend(free.iter().zip(rhs.iter()).map(|(&d, &b)| b - self.f_c[d]));
-        sys.solve(&mut self.delta0)?;
+        self.work.delta0.clear();
+        self.work.delta0.extend(
+            free.iter()
+                .zip(rhs.iter())
+                .map(|(&d, &b)| b - self.active.f_c[d]),
+        );
+        sys.solve(&mut self.work.delta0)?;
         // G over the free dofs (nalgebra-sparse CSR).
-        let n_cands = self.cands.len();
-        let g = if self.frictional {
-            super::rows::gap_and_tangent_matrix(&self.cands, eq, free.len())
+        let n_cands = self.sel.cands.len();
+        let g = if self.setup.frictional {
+            super::rows::gap_and_tangent_matrix(&self.sel.cands, eq, free.len())
         } else {
-            super::rows::gap_matrix(&self.cands, eq, free.len())
+            super::rows::gap_matrix(&self.sel.cands, eq, free.len())
         };
-        let tdim = self.dim - 1;
-        self.previous = std::mem::take(&mut self.current);
-        self.lambda.clear();
-        self.lambda_t.clear();
+        let tdim = self.setup.dim - 1;
+        self.active.previous = std::mem::take(&mut self.active.current);
+        self.active.lambda.clear();
+        self.active.lambda_t.clear();
         // The QP on the rows predicted to close; a row left out that the QP's
         // correction would make penetrate joins them and the QP is solved again, so
         // no slave is let into its master for want of a row (theory/contact.md,
         // "rows left out").
-        self.delta_start.clone_from(&self.delta0);
-        self.forced.clear();
+        self.sel.delta_start.clone_from(&self.work.delta0);
+        self.sel.forced.clear();
         let mut rounds = 0;
         let status = loop {
             self.select_rows(&g, u, leading);
-            let m = self.rows.len();
+            let m = self.sel.rows.len();
             if m == 0 {
-                rhs.copy_from_slice(&self.delta0);
+                rhs.copy_from_slice(&self.work.delta0);
                 return Ok(Corrected::Ok);
             }
-            self.stats.qps += 1;
-            self.stats.rows += m;
-            let status = match self.qp {
+            self.record.qps += 1;
+            self.record.rows += m;
+            let status = match self.setup.qp {
                 ContactQp::Condensed => self.condensed(sys, &g, m)?,
                 ContactQp::Full => self.full(sys, &g, rhs)?,
             };
@@ -684,11 +615,12 @@ impl Correction for ContactCorrection<'_> {
             if status.is_err() || rounds > MAX_ROW_ROUNDS || !self.left_out_penetrate(&g) {
                 break status;
             }
-            self.delta0.clone_from(&self.delta_start);
+            self.work.delta0.clone_from(&self.sel.delta_start);
         };
 
         if let Err(status) = status {
             let worst = self
+                .sel
                 .cands
                 .iter()
                 .min_by(|a, b| a.gap.total_cmp(&b.gap))
@@ -696,23 +628,26 @@ impl Correction for ContactCorrection<'_> {
                     format!(
                         "; worst gap {:.3e} m at {} of pair `{}`",
                         c.gap,
-                        self.model.describe_node(c.slave),
-                        self.pairs[c.pair].name
+                        self.setup.model.describe_node(c.slave),
+                        self.setup.pairs[c.pair].name
                     )
                 })
                 .unwrap_or_default();
             let pairs: Vec<&str> = {
                 let mut p: Vec<usize> = self
+                    .sel
                     .rows
                     .iter()
                     .map(|&i| {
                         let c = if i < n_cands { i } else { (i - n_cands) / tdim };
-                        self.cands[c].pair
+                        self.sel.cands[c].pair
                     })
                     .collect();
                 p.sort_unstable();
                 p.dedup();
-                p.iter().map(|&i| self.pairs[i].name.as_str()).collect()
+                p.iter()
+                    .map(|&i| self.setup.pairs[i].name.as_str())
+                    .collect()
             };
             return Ok(Corrected::Failed(format!(
                 "contact QP of pair(s) {}: {status}{worst}",
@@ -722,34 +657,36 @@ impl Correction for ContactCorrection<'_> {
         // Every positive multiplier acts as a force (dropping small ones would leave
         // their force out of the balance); the active set, for the test that it has
         // settled and for complementarity, holds the significant ones.
-        let nr = self.normal_rows;
+        let nr = self.sel.normal_rows;
         // A multiplier whose own closure `λ W_jj` is below what the coordinates
         // resolve holds a gap of round-off, not a contact: left out of the active
         // set (its force still acts), or a slave resting or grazing at a gap of
         // exactly zero flips in and out of the set on round-off forces.
-        let threshold = self.active_threshold(&self.lambda_rows[..nr]);
-        let m = self.rows.len();
-        let condensed = self.w.len() == m * m;
-        for (j, &i) in self.rows[..nr].iter().enumerate() {
-            let l = self.lambda_rows[j];
-            let key = self.cands[i].key();
+        let threshold = self.active_threshold(&self.work.lambda_rows[..nr]);
+        let m = self.sel.rows.len();
+        let condensed = self.work.w.len() == m * m;
+        for (j, &i) in self.sel.rows[..nr].iter().enumerate() {
+            let l = self.work.lambda_rows[j];
+            let key = self.sel.cands[i].key();
             if l > 0.0 {
-                self.lambda.insert(key, l);
+                self.active.lambda.insert(key, l);
             }
-            let resolved = !condensed || l * self.w[j + j * m] > self.gap_floor;
+            let resolved = !condensed || l * self.work.w[j + j * m] > self.setup.gap_floor;
             if l > threshold && resolved {
-                self.current.push(key);
+                self.active.current.push(key);
             }
         }
-        for (k, &(j, _)) in self.cones.iter().enumerate() {
+        for (k, &(j, _)) in self.sel.cones.iter().enumerate() {
             let mut l = [0.0; 2];
-            l[..tdim].copy_from_slice(&self.lambda_rows[nr + tdim * k..nr + tdim * (k + 1)]);
-            if l != [0.0; 2] && self.lambda_rows[j] > 0.0 {
-                self.lambda_t.insert(self.cands[self.rows[j]].key(), l);
+            l[..tdim].copy_from_slice(&self.work.lambda_rows[nr + tdim * k..nr + tdim * (k + 1)]);
+            if l != [0.0; 2] && self.work.lambda_rows[j] > 0.0 {
+                self.active
+                    .lambda_t
+                    .insert(self.sel.cands[self.sel.rows[j]].key(), l);
             }
         }
-        self.current.sort_unstable();
-        rhs.copy_from_slice(&self.delta0);
+        self.active.current.sort_unstable();
+        rhs.copy_from_slice(&self.work.delta0);
         Ok(Corrected::Ok)
     }
 }

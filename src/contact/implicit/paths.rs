@@ -21,52 +21,53 @@ impl ContactCorrection<'_> {
         g: &nalgebra_sparse::CsrMatrix<f64>,
         m: usize,
     ) -> Result<std::result::Result<(), String>> {
-        let nf = self.dofs.free.len();
+        let nf = self.setup.dofs.free.len();
         let t = Instant::now();
         // S pays once the factor has outlived a QP (theory/contact.md).
         let generation = sys.factorizations();
-        let compliant = self.compliance.is_current(sys) || self.qp_generation == generation;
-        self.qp_generation = generation;
+        let compliant =
+            self.work.compliance.is_current(sys) || self.work.qp_generation == generation;
+        self.work.qp_generation = generation;
         if compliant {
-            self.needed.clear();
-            for &i in &self.rows {
-                self.needed.extend_from_slice(g.row(i).col_indices());
+            self.work.needed.clear();
+            for &i in &self.sel.rows {
+                self.work.needed.extend_from_slice(g.row(i).col_indices());
             }
-            self.compliance.cover(sys, &self.needed)?;
-            self.stats.compliant += 1;
-            self.w.clear();
-            self.w.resize(m * m, 0.0);
-            for (j, &ij) in self.rows.iter().enumerate() {
+            self.work.compliance.cover(sys, &self.work.needed)?;
+            self.record.compliant += 1;
+            self.work.w.clear();
+            self.work.w.resize(m * m, 0.0);
+            for (j, &ij) in self.sel.rows.iter().enumerate() {
                 let rj = g.row(ij);
-                for (k, &ik) in self.rows.iter().enumerate().skip(j) {
+                for (k, &ik) in self.sel.rows.iter().enumerate().skip(j) {
                     let rk = g.row(ik);
                     let mut w = 0.0;
                     for (&e, v) in rk.col_indices().iter().zip(rk.values()) {
                         for (&f, u) in rj.col_indices().iter().zip(rj.values()) {
-                            w += v * u * self.compliance.at(e, f);
+                            w += v * u * self.work.compliance.at(e, f);
                         }
                     }
-                    self.w[k + j * m] = w;
-                    self.w[j + k * m] = w;
+                    self.work.w[k + j * m] = w;
+                    self.work.w[j + k * m] = w;
                 }
             }
         } else {
-            self.y.clear();
-            self.y.resize(nf * m, 0.0);
-            for (j, &i) in self.rows.iter().enumerate() {
+            self.work.y.clear();
+            self.work.y.resize(nf * m, 0.0);
+            for (j, &i) in self.sel.rows.iter().enumerate() {
                 let row = g.row(i);
                 for (&e, v) in row.col_indices().iter().zip(row.values()) {
-                    self.y[j * nf + e] += v;
+                    self.work.y[j * nf + e] += v;
                 }
             }
-            sys.solve_block(&mut self.y, m)?;
-            self.w.clear();
-            self.w.resize(m * m, 0.0);
+            sys.solve_block(&mut self.work.y, m)?;
+            self.work.w.clear();
+            self.work.w.resize(m * m, 0.0);
             for j in 0..m {
-                let yj = &self.y[j * nf..(j + 1) * nf];
-                for (k, &i) in self.rows.iter().enumerate() {
+                let yj = &self.work.y[j * nf..(j + 1) * nf];
+                for (k, &i) in self.sel.rows.iter().enumerate() {
                     let row = g.row(i);
-                    self.w[k + j * m] = row
+                    self.work.w[k + j * m] = row
                         .col_indices()
                         .iter()
                         .zip(row.values())
@@ -75,72 +76,79 @@ impl ContactCorrection<'_> {
                 }
             }
         }
-        self.stats.w_s += t.elapsed().as_secs_f64();
+        self.record.w_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
         // The previous active set first: accepted only if it satisfies the
         // KKT conditions, so the QP's solution either way.
-        self.guess.clear();
-        for (j, &i) in self.rows[..self.normal_rows].iter().enumerate() {
-            if self.previous.binary_search(&self.cands[i].key()).is_ok() {
-                self.guess.push(j);
+        self.work.guess.clear();
+        for (j, &i) in self.sel.rows[..self.sel.normal_rows].iter().enumerate() {
+            if self
+                .active
+                .previous
+                .binary_search(&self.sel.cands[i].key())
+                .is_ok()
+            {
+                self.work.guess.push(j);
             }
         }
-        let gap_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let slip_tol = GUESS_GAP_TOLERANCE * self.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let gap_tol = GUESS_GAP_TOLERANCE * self.sel.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let slip_tol = GUESS_GAP_TOLERANCE * self.sel.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         // The guess of the statuses is written for the plane's one tangent.
-        let r = if !self.cones.is_empty()
-            && self.dim == 2
+        let r = if !self.sel.cones.is_empty()
+            && self.setup.dim == 2
             && crate::contact::coulomb::solve_by_guess(
-                &self.w,
-                &self.c,
-                self.normal_rows,
-                &self.cones,
-                &self.pressed,
-                &self.guess_t,
+                &self.work.w,
+                &self.sel.c,
+                self.sel.normal_rows,
+                &self.sel.cones,
+                &self.sel.pressed,
+                &self.sel.guess_t,
                 slip_tol,
-                &mut self.lambda_rows,
+                &mut self.work.lambda_rows,
             ) {
-            self.stats.guessed += 1;
-            self.stats.frictional += 1;
-            self.stats.friction_guessed += 1;
+            self.record.guessed += 1;
+            self.record.frictional += 1;
+            self.record.friction_guessed += 1;
             Ok(QpStats::default())
-        } else if !self.cones.is_empty() {
+        } else if !self.sel.cones.is_empty() {
             let r = crate::contact::coulomb::solve(
-                &self.w,
-                &self.c,
-                (self.normal_rows, self.dim - 1),
-                &self.cones,
-                &mut self.lambda_rows,
+                &self.work.w,
+                &self.sel.c,
+                (self.sel.normal_rows, self.setup.dim - 1),
+                &self.sel.cones,
+                &mut self.work.lambda_rows,
             );
             if let Ok(q) = &r {
-                self.stats.frictional += 1;
-                self.stats.cone_programs += q.programs as usize;
+                self.record.frictional += 1;
+                self.record.cone_programs += q.programs as usize;
             }
             r
-        } else if !self.guess.is_empty()
+        } else if !self.work.guess.is_empty()
             && solve_by_active_set(
-                &self.w,
-                &self.c,
-                &mut self.guess,
+                &self.work.w,
+                &self.sel.c,
+                &mut self.work.guess,
                 gap_tol,
-                &mut self.lambda_rows,
-                &mut self.guess_work,
+                &mut self.work.lambda_rows,
+                &mut self.work.guess_work,
             )
         {
-            self.stats.guessed += 1;
+            self.record.guessed += 1;
             Ok(QpStats::default())
         } else {
-            self.dual.solve(&self.w, &self.c, &mut self.lambda_rows)
+            self.work
+                .dual
+                .solve(&self.work.w, &self.sel.c, &mut self.work.lambda_rows)
         };
-        self.stats.qp_s += t.elapsed().as_secs_f64();
+        self.record.qp_s += t.elapsed().as_secs_f64();
         if r.is_ok() {
             if compliant {
                 self.push_forces(sys, g)?;
             } else {
-                for (j, &l) in self.lambda_rows.iter().enumerate() {
+                for (j, &l) in self.work.lambda_rows.iter().enumerate() {
                     if l != 0.0 {
-                        let yj = &self.y[j * nf..(j + 1) * nf];
-                        for (d, y) in self.delta0.iter_mut().zip(yj) {
+                        let yj = &self.work.y[j * nf..(j + 1) * nf];
+                        for (d, y) in self.work.delta0.iter_mut().zip(yj) {
                             *d += l * y;
                         }
                     }
@@ -157,17 +165,19 @@ impl ContactCorrection<'_> {
         sys: &mut EffectiveSystem,
         g: &nalgebra_sparse::CsrMatrix<f64>,
     ) -> Result<()> {
-        self.push_entries.clear();
-        for (j, &i) in self.rows.iter().enumerate() {
+        self.work.push_entries.clear();
+        for (j, &i) in self.sel.rows.iter().enumerate() {
             let row = g.row(i);
             for (&e, v) in row.col_indices().iter().zip(row.values()) {
-                self.push_entries.push((e, self.lambda_rows[j] * v));
+                self.work
+                    .push_entries
+                    .push((e, self.work.lambda_rows[j] * v));
             }
         }
-        self.push.clear();
-        self.push.resize(self.dofs.free.len(), 0.0);
-        sys.solve_sparse(&self.push_entries, &mut self.push)?;
-        for (d, p) in self.delta0.iter_mut().zip(&self.push) {
+        self.work.push.clear();
+        self.work.push.resize(self.setup.dofs.free.len(), 0.0);
+        sys.solve_sparse(&self.work.push_entries, &mut self.work.push)?;
+        for (d, p) in self.work.delta0.iter_mut().zip(&self.work.push) {
             *d += p;
         }
         Ok(())
@@ -185,16 +195,20 @@ impl ContactCorrection<'_> {
         g: &nalgebra_sparse::CsrMatrix<f64>,
         rhs: &[f64],
     ) -> Result<std::result::Result<(), String>> {
-        let free = &self.dofs.free;
-        debug_assert!(self.cones.is_empty(), "validation: friction is condensed");
+        let free = &self.setup.dofs.free;
+        debug_assert!(
+            self.sel.cones.is_empty(),
+            "validation: friction is condensed"
+        );
         let t = Instant::now();
         let r_free: Vec<f64> = free
             .iter()
             .zip(rhs.iter())
-            .map(|(&d, &b)| self.f_c[d] - b)
+            .map(|(&d, &b)| self.active.f_c[d] - b)
             .collect();
-        let gaps: Vec<f64> = self.rows.iter().map(|&i| self.gaps[i]).collect();
+        let gaps: Vec<f64> = self.sel.rows.iter().map(|&i| self.sel.gaps[i]).collect();
         let row_entries: Vec<Vec<(usize, f64)>> = self
+            .sel
             .rows
             .iter()
             .map(|&i| {
@@ -207,7 +221,11 @@ impl ContactCorrection<'_> {
             })
             .collect();
         let mut delta = Vec::new();
-        let sigma = self.delta0.iter().fold(self.tol, |a, x| a.max(x.abs()));
+        let sigma = self
+            .work
+            .delta0
+            .iter()
+            .fold(self.setup.tol, |a, x| a.max(x.abs()));
         let r = primal_qp(
             sys.matrix(),
             &r_free,
@@ -215,9 +233,9 @@ impl ContactCorrection<'_> {
             &row_entries,
             sigma,
             &mut delta,
-            &mut self.lambda_rows,
+            &mut self.work.lambda_rows,
         );
-        self.stats.qp_s += t.elapsed().as_secs_f64();
+        self.record.qp_s += t.elapsed().as_secs_f64();
         if r.is_ok() {
             self.push_forces(sys, g)?;
         }
