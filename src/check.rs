@@ -231,12 +231,12 @@ fn contact_line(p: &crate::model::ContactPair) -> String {
     let faces = p
         .sides
         .iter()
-        .any(|s| matches!(s.master, Master::Faces(_) | Master::Plane { .. }));
+        .any(|s| matches!(s.master, Master::Faces { .. } | Master::Plane { .. }));
     let master = match p.sides.first().map(|s| &s.master) {
         Some(Master::Rigid { .. }) => "a rigid line",
         Some(Master::Plane { .. }) => "a rigid plane",
-        Some(Master::Faces(_)) if p.sides.len() == 2 => "faces, both ways",
-        Some(Master::Faces(_)) => "faces",
+        Some(Master::Faces { .. }) if p.sides.len() == 2 => "faces, both ways",
+        Some(Master::Faces { .. }) => "faces",
         _ if p.sides.len() == 2 => "segments, both ways",
         _ => "segments",
     };

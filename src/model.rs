@@ -391,7 +391,14 @@ pub enum Master {
     },
     /// Faces of a solid (triangles or quadrilaterals), numbered counter-clockwise
     /// seen from outside, so their normal points out of the body.
-    Faces(Vec<Face>),
+    Faces {
+        /// The faces.
+        faces: Vec<Face>,
+        /// The set's boundary edges (sorted node pairs, each an edge of one face
+        /// only), where node to face ends: topology, so found once at validation
+        /// (`contact::master::faces::boundary_edges`).
+        boundary: Vec<[usize; 2]>,
+    },
     /// A rigid plane through `point` with unit normal `n` towards the slave body: a
     /// unilateral support of a solid, unbounded.
     Plane {
@@ -399,9 +406,19 @@ pub enum Master {
         point: [f64; 3],
         /// Unit normal pointing to the side the slave body lies on.
         n: [f64; 3],
-        /// Two unit tangents of the plane, orthonormal with `n` (friction's axes).
-        tangents: [[f64; 3]; 2],
     },
+}
+
+/// The slave side's surface: what the slaves are a part of.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SlaveSurface {
+    /// A node set: nodes only.
+    Nodes,
+    /// A plane body's edge set (oriented with its body on the left): a mortar
+    /// pair's weighted gaps integrate over it.
+    Segments(Vec<[usize; 2]>),
+    /// A solid's face set: its nodes' tributary areas for the contact pressure.
+    Faces(Vec<Face>),
 }
 
 /// One direction of a contact pair: slave nodes that may not cross the master.
@@ -409,18 +426,10 @@ pub enum Master {
 pub struct ContactSide {
     /// Slave nodes, sorted and distinct (detection looks them up by number).
     pub slaves: Vec<usize>,
+    /// The surface the slaves belong to.
+    pub surface: SlaveSurface,
     /// The master surface.
     pub master: Master,
-    /// The slave's segments (oriented with its body on their left) when the side is
-    /// enforced by mortar weighted gaps; empty for node-to-segment.
-    pub mortar: Vec<[usize; 2]>,
-    /// A solid's slave faces, when the slave is a face set: the tributary areas of
-    /// its nodes for the contact pressure; empty otherwise.
-    pub faces: Vec<Face>,
-    /// A master face set's boundary edges (sorted node pairs, each an edge of one
-    /// face only), where node to face ends: topology, so found once at validation
-    /// (`contact::master::faces::boundary_edges`); empty for other masters.
-    pub master_boundary: Vec<[usize; 2]>,
 }
 
 impl ContactSide {
@@ -429,7 +438,7 @@ impl ContactSide {
     pub fn master_nodes(&self) -> Vec<usize> {
         match &self.master {
             Master::Segments(segs) => segs.iter().flatten().copied().collect(),
-            Master::Faces(faces) => faces
+            Master::Faces { faces, .. } => faces
                 .iter()
                 .flat_map(|f| f.corners().iter().copied())
                 .collect(),

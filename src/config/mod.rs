@@ -113,16 +113,16 @@ pub struct ContactSpec {
     pub name: String,
     /// The slave side: a node set or an edge set (its nodes) of one body.
     pub slave: String,
-    /// The master side: an edge set of another body (a face set in a solid). Give
-    /// this, `rigid_line` (plane) or `rigid_plane` (solid).
-    #[serde(default)]
-    pub master: Option<String>,
+    /// The master side ([`MasterTable`]): the name of an edge set of another body (a
+    /// face set in a solid), short for `{ set = "..." }`, or a table naming a rigid
+    /// master. `rigid_line` and `rigid_plane` may be given beside `slave` instead.
+    #[serde(default, deserialize_with = "master_field")]
+    pub master: Option<MasterTable>,
     /// A rigid line `[[x0, y0], [x1, y1]]` the slave nodes may not cross (a unilateral
-    /// support). Its side is the one the slave body lies on.
+    /// support), short for `master = { rigid_line = ... }`.
     #[serde(default, deserialize_with = "exact::option_segment")]
     pub rigid_line: Option<[[f64; 2]; 2]>,
-    /// A solid's rigid plane the slave nodes may not cross (unbounded; its side is
-    /// the one the slave body lies on).
+    /// A solid's rigid plane, short for `master = { rigid_plane = ... }`.
     #[serde(default)]
     pub rigid_plane: Option<RigidPlaneSpec>,
     /// Also check the master's nodes against the slave's edges (the slave must be an
@@ -146,6 +146,119 @@ pub struct ContactSpec {
     /// or `node_to_segment`. Rigid lines and the explicit path are node to segment.
     #[serde(default)]
     pub formulation: Option<crate::model::Formulation>,
+}
+
+/// `contact.master`: what a pair's slaves may not cross, exactly one of its keys.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MasterTable {
+    /// An edge set (plane) or face set (solid) of another body.
+    #[serde(default)]
+    pub set: Option<String>,
+    /// A plane model's rigid line `[[x0, y0], [x1, y1]]`: a unilateral support of
+    /// finite length; its side is the one the slave body lies on.
+    #[serde(default, deserialize_with = "exact::option_segment")]
+    pub rigid_line: Option<[[f64; 2]; 2]>,
+    /// A solid's rigid plane (unbounded; its side is the one the slave body lies
+    /// on).
+    #[serde(default)]
+    pub rigid_plane: Option<RigidPlaneSpec>,
+}
+
+/// Reads `contact.master`: a set's name or a [`MasterTable`].
+fn master_field<'de, D>(d: D) -> std::result::Result<Option<MasterTable>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    struct Field;
+    impl<'de> serde::de::Visitor<'de> for Field {
+        type Value = MasterTable;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a set's name or a table with one of `set`, `rigid_line`, `rigid_plane`")
+        }
+        fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<MasterTable, E> {
+            Ok(MasterTable {
+                set: Some(v.to_string()),
+                ..Default::default()
+            })
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            map: A,
+        ) -> std::result::Result<MasterTable, A::Error> {
+            MasterTable::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+        }
+    }
+    d.deserialize_any(Field).map(Some)
+}
+
+/// What a pair's master is, from whichever keys the scenario gave.
+#[derive(Clone, Copy, Debug)]
+pub enum MasterSpec<'a> {
+    /// An edge set (plane) or face set (solid) of another body, by name.
+    Set(&'a str),
+    /// A rigid line.
+    RigidLine(&'a [[f64; 2]; 2]),
+    /// A rigid plane.
+    RigidPlane(&'a RigidPlaneSpec),
+}
+
+impl ContactSpec {
+    /// The pair's master and the field that gave it (`contact[i].master`,
+    /// `.master.rigid_line`, `.rigid_line`, ...): exactly one of `master` (a name, or
+    /// a table with one key), `rigid_line` and `rigid_plane`. `field` is the pair's
+    /// own (`contact[i]`).
+    pub fn master_spec(&self, field: &str) -> Result<(MasterSpec<'_>, String)> {
+        let mut given: Vec<(MasterSpec<'_>, String)> = Vec::new();
+        if let Some(m) = &self.master {
+            if let Some(set) = &m.set {
+                given.push((MasterSpec::Set(set), format!("{field}.master")));
+            }
+            if let Some(l) = &m.rigid_line {
+                given.push((
+                    MasterSpec::RigidLine(l),
+                    format!("{field}.master.rigid_line"),
+                ));
+            }
+            if let Some(p) = &m.rigid_plane {
+                given.push((
+                    MasterSpec::RigidPlane(p),
+                    format!("{field}.master.rigid_plane"),
+                ));
+            }
+            if given.is_empty() {
+                return Err(Error::config(
+                    format!("{field}.master"),
+                    "the table names no master: give one of `set`, `rigid_line`, `rigid_plane`",
+                ));
+            }
+        }
+        if let Some(l) = &self.rigid_line {
+            given.push((MasterSpec::RigidLine(l), format!("{field}.rigid_line")));
+        }
+        if let Some(p) = &self.rigid_plane {
+            given.push((MasterSpec::RigidPlane(p), format!("{field}.rigid_plane")));
+        }
+        match given.len() {
+            1 => Ok(given.pop().expect("one")),
+            0 => Err(Error::config(
+                field,
+                "no master: give `master` (an edge set, a face set in a solid), `rigid_line` \
+                 (plane) or `rigid_plane` (solid)",
+            )),
+            _ => Err(Error::config(
+                field,
+                format!(
+                    "give exactly one of `master`, `rigid_line` and `rigid_plane`; found {}",
+                    given
+                        .iter()
+                        .map(|(_, f)| format!("`{f}`"))
+                        .collect::<Vec<_>>()
+                        .join(" and ")
+                ),
+            )),
+        }
+    }
 }
 
 /// `contact.rigid_plane`: a point of the plane and its normal (either sense: the

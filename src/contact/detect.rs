@@ -12,7 +12,7 @@
 use super::master::{self, rigid::RigidHistory, Positions};
 use super::rows::Candidate;
 use super::state::Slave;
-use crate::model::{ContactPair, Master};
+use crate::model::{ContactPair, Formulation, Master, SlaveSurface};
 
 /// Candidates of every pair at the geometry `x`, appended to `out` (cleared first),
 /// ordered by pair, side and slave node (a slave in a notch or a valley gives one per
@@ -22,14 +22,17 @@ pub fn detect(pairs: &[ContactPair], x: Positions, rigid: &RigidHistory, out: &m
     out.clear();
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
-            if let (false, Master::Segments(segments)) = (side.mortar.is_empty(), &side.master) {
+            let mortar = pair.formulation == Formulation::Mortar;
+            if let (true, SlaveSurface::Segments(slave_segments), Master::Segments(segments)) =
+                (mortar, &side.surface, &side.master)
+            {
                 // Rows are sized for the initial geometry (validation); a mesh sliding
                 // far enough to bring more master nodes under one slave node keeps
                 // the first `ROW_NODES`.
                 super::mortar::rows(
                     (pi, si),
                     &side.slaves,
-                    &side.mortar,
+                    slave_segments,
                     segments,
                     pair.radius,
                     &|n| x.at::<2>(n),

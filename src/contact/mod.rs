@@ -69,7 +69,10 @@ pub fn tributary_areas(model: &crate::model::Model) -> Vec<f64> {
     let mut area = vec![0.0; mesh.n_nodes()];
     if mesh.dim == 3 {
         for side in model.contacts.iter().flat_map(|p| &p.sides) {
-            for f in &side.faces {
+            let crate::model::SlaveSurface::Faces(faces) = &side.surface else {
+                continue;
+            };
+            for f in faces {
                 let c = f.corners();
                 let x = |k: usize| mesh.coords[c[k % c.len()]];
                 // Half the cross product of the diagonals (of two edges for a

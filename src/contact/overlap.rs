@@ -60,7 +60,7 @@ pub fn deepest(mesh: &Mesh, pairs: &[ContactPair], tolerance: f64) -> Option<Ove
                             .fold(f64::INFINITY, f64::min)
                     })
                 }
-                Master::Faces(faces) => {
+                Master::Faces { faces, .. } => {
                     let body = mesh.node_body[faces[0][0]];
                     inside_body(mesh, body, &side.slaves, tolerance, |p| {
                         faces

@@ -784,3 +784,41 @@ fn two_bars_meeting_within_a_step_split_the_impact_as_the_note_derives() {
         assert!((d - d_ref).abs() < 1e-6 * d_ref, "{per_theta:?}");
     }
 }
+
+#[test]
+fn a_master_may_be_given_as_one_table() {
+    // `master = { set = ... }` and `master = { rigid_line = ... }` are the same pairs as
+    // the short keys; a table naming none, two, or an unknown key is refused naming it.
+    let base = drop_on("model = \"elastic\"");
+    let pair = "master = \"base.top\"";
+    let line = "rigid_line = [[0.0, 0.0], [1.2, 0.0]]";
+    let same = |a: &str, b: &str| {
+        let (ma, mb) = (model(&base.replace(pair, a)), model(&base.replace(pair, b)));
+        assert_eq!(ma.contacts, mb.contacts, "{a} against {b}");
+    };
+    same(pair, "master = { set = \"base.top\" }");
+    same(line, &format!("master = {{ {line} }}"));
+    let refused = |to: &str, words: &[&str]| {
+        let e = rothe::config::from_str(&base.replace(pair, to), Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert!(words.iter().all(|w| e.contains(w)), "{to}: {e}");
+    };
+    refused("master = {}", &["contact[0].master", "names no master"]);
+    refused(
+        &format!("master = {{ set = \"base.top\", {line} }}"),
+        &[
+            "contact[0]",
+            "exactly one",
+            "`contact[0].master.rigid_line`",
+        ],
+    );
+    refused(
+        "master = { rigid_lin = [[0.0, 0.0], [1.2, 0.0]] }",
+        &["rigid_lin"],
+    );
+    refused(
+        "master = { rigid_line = [[0.0, 0.0], [0.0, 0.0]] }",
+        &["contact[0].master.rigid_line", "zero length"],
+    );
+}

@@ -11,7 +11,6 @@ mod constraints;
 mod contacts;
 mod materials;
 mod meshes;
-mod solid_contacts;
 
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -736,10 +736,11 @@ mod tests {
             name: "p".into(),
             sides: vec![crate::model::ContactSide {
                 slaves,
-                master: crate::model::Master::Faces(faces),
-                mortar: Vec::new(),
-                faces: Vec::new(),
-                master_boundary: Vec::new(),
+                master: crate::model::Master::Faces {
+                    faces,
+                    boundary: Vec::new(),
+                },
+                surface: crate::model::SlaveSurface::Nodes,
             }],
             radius: 1.0,
             friction: 0.0,

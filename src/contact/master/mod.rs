@@ -115,8 +115,8 @@ pub fn surface<'a>(side: &'a ContactSide, x: Positions<'a>) -> Box<dyn MasterSur
     match &side.master {
         Master::Segments(segments) => Box::new(segments::SegmentChain::new(segments, x)),
         Master::Rigid { a, b, n } => Box::new(rigid::RigidLine::new(*a, *b, *n, x)),
-        Master::Faces(faces) => Box::new(faces::FaceSurface::new(faces, &side.master_boundary, x)),
-        Master::Plane { point, n, .. } => Box::new(rigid::RigidPlane::new(*point, *n, x)),
+        Master::Faces { faces, boundary } => Box::new(faces::FaceSurface::new(faces, boundary, x)),
+        Master::Plane { point, n } => Box::new(rigid::RigidPlane::new(*point, *n, x)),
     }
 }
 

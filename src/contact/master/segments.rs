@@ -389,9 +389,7 @@ mod tests {
             sides: vec![ContactSide {
                 slaves: vec![3, 4, 5],
                 master: Master::Segments(vec![[0, 1], [1, 2]]),
-                mortar: Vec::new(),
-                faces: Vec::new(),
-                master_boundary: Vec::new(),
+                surface: crate::model::SlaveSurface::Nodes,
             }],
             radius: 1.0,
             friction: 0.0,
@@ -447,9 +445,7 @@ mod tests {
             sides: vec![ContactSide {
                 slaves,
                 master: Master::Segments(segments),
-                mortar: Vec::new(),
-                faces: Vec::new(),
-                master_boundary: Vec::new(),
+                surface: crate::model::SlaveSurface::Nodes,
             }],
             radius: 1.0,
             friction: 0.0,
