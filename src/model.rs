@@ -272,6 +272,11 @@ pub struct ContactSettings {
     pub tolerance: f64,
     /// How the contact QP is solved.
     pub qp: ContactQp,
+    /// Whether a frictional QP first tries the statuses (and slip directions) its
+    /// predecessor ended in, one elimination accepted only if it satisfies the whole
+    /// law, before the cone programs (default true; false runs the cone programs
+    /// only, the reference the guess is checked against).
+    pub friction_guess: bool,
 }
 
 /// Output settings of the analysis.

@@ -189,7 +189,7 @@ fn by_statuses(
             if t.iter().map(|x| x * x).sum::<f64>().sqrt() < (1.0 - 1e-6) * mu * lambda[j] {
                 Guess::Stick
             } else {
-                Guess::Slip(t[0].signum())
+                Guess::slip_along(t)
             }
         })
         .collect();
@@ -288,7 +288,7 @@ mod tests {
             if lt.abs() < (1.0 - 1e-6) * mu * ln {
                 Guess::Stick
             } else {
-                Guess::Slip(lt.signum())
+                Guess::slip_along(&[lt])
             }
         };
         let guess = [status(0), status(1)];
@@ -327,25 +327,50 @@ mod tests {
     }
 }
 
-/// How a frictional node is guessed to end: inside the cone, or on it with the sign
-/// of its tangential force.
+/// How a frictional node is guessed to end: inside the cone, or on it along a
+/// direction of its tangential force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Guess {
     /// `|λ_T| < μ λ_N`, no slip.
     Stick,
-    /// `λ_T = sign μ λ_N`, the slip opposite to it.
-    Slip(f64),
+    /// `λ_T = μ λ_N d` along the unit direction `d` in the row's tangents (in the
+    /// plane `[±1, 0]`), the slip opposite to it.
+    Slip([f64; 2]),
+}
+
+impl Guess {
+    /// Whether it is [`Guess::Stick`].
+    pub(crate) fn is_stick(&self) -> bool {
+        matches!(self, Guess::Stick)
+    }
+
+    /// The slip of a node whose tangential force is `t` (`tdim` components): along
+    /// `t`'s direction (its sign in the plane); sticking when `t` is zero in a
+    /// solid, where it has no direction.
+    pub(crate) fn slip_along(t: &[f64]) -> Guess {
+        if t.len() == 1 {
+            return Guess::Slip([t[0].signum(), 0.0]);
+        }
+        let size = t[0].hypot(t[1]);
+        if size > 0.0 && size.is_finite() {
+            Guess::Slip([t[0] / size, t[1] / size])
+        } else {
+            Guess::Stick
+        }
+    }
 }
 
 /// Solves Coulomb's law for the rows of [`solve`] on a guess of how it ends: the
 /// normal rows `pressed` (the others open) and each frictional node's [`Guess`]. On
 /// the guess the law is linear: pressed gaps and sticking slips vanish, a slipping
-/// node's tangential force is `sign μ λ_N`; the unknowns solve that by dense
-/// elimination. True, with the forces in `lambda`, when the result satisfies the
-/// whole law (pressed forces non-negative, open gaps non-negative to `tol`, sticking
-/// forces inside the cone, slips opposite to their forces to `tol`): then it is the
-/// law's solution and no cone program is needed. In persistent contact the last
-/// iterate's statuses hold, and a step costs one small elimination.
+/// node's tangential force is `μ λ_N d` along its guessed direction `d` (`sign` in
+/// the plane); the unknowns solve that by dense elimination. True, with the forces
+/// in `lambda`, when the result satisfies the whole law (pressed forces
+/// non-negative, open gaps non-negative to `tol`, sticking forces inside the cone,
+/// slips opposite to their forces to `tol`, in a solid along the same line to `tol`):
+/// then it is the law's solution and no cone program is needed. In persistent
+/// contact the last iterate's statuses and directions hold, and a step costs one
+/// small elimination.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_by_guess(
     w: &[f64],
@@ -359,8 +384,39 @@ pub(crate) fn solve_by_guess(
 ) -> bool {
     let mut p = pressed.to_vec();
     let mut g = guess.to_vec();
-    law_on_guess(w, c, (n, cones), (&mut p, &mut g), tol, lambda) == Verdict::Holds
+    // In the plane one round; in a solid more while only slip directions turn.
+    let tdim = if cones.is_empty() {
+        1
+    } else {
+        (c.len() - n) / cones.len()
+    };
+    let rounds = if tdim == 1 { 1 } else { GUESS_ROUNDS };
+    for _ in 0..rounds {
+        let statuses = (p.clone(), g.iter().map(Guess::is_stick).collect::<Vec<_>>());
+        match law_on_guess(w, c, (n, cones), (&mut p, &mut g), tol, lambda) {
+            Verdict::Holds => return true,
+            Verdict::Singular => return false,
+            // A status the last QP got wrong (a node pressed or released, sticking
+            // or slipping): the contact is changing, the cone programs' case (taking
+            // the statuses the elimination asks for cut the first step of an impact
+            // in `solid_contact_friction`).
+            Verdict::Changed
+                if statuses != (p.clone(), g.iter().map(Guess::is_stick).collect()) =>
+            {
+                return false
+            }
+            Verdict::Changed => {}
+        }
+    }
+    false
 }
+
+/// Rounds a guess may take in a solid: a slip direction taken from the last QP is
+/// off by the change of the motion since (a millionth in a block accelerating down a
+/// slope), and each round turns it to the slip the last one gave (by a factor of
+/// about four a round) until the law holds to the QP's tolerance. Each round is one
+/// elimination of the pressed rows, far cheaper than a cone program.
+const GUESS_ROUNDS: usize = 16;
 
 /// What the law says of the forces a guess of statuses gives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -386,21 +442,13 @@ fn law_on_guess(
     lambda: &mut Vec<f64>,
 ) -> Verdict {
     let m = c.len();
-    // One tangential row per node in the plane, two in a solid, where a slip (its
-    // direction unknown) is not linear.
+    // One tangential row per node in the plane, two in a solid (a slip linear on
+    // its guessed direction).
     let tdim = if cones.is_empty() {
         1
     } else {
         (m - n) / cones.len()
     };
-    if tdim > 1
-        && cones
-            .iter()
-            .zip(guess.iter())
-            .any(|(&(j, _), g)| pressed[j] && *g != Guess::Stick)
-    {
-        return Verdict::Singular;
-    }
     // Unknowns: λ_N of the pressed rows, then λ_T of their sticking nodes.
     let mut rows = Vec::new();
     for j in (0..n).filter(|&j| pressed[j]) {
@@ -415,11 +463,12 @@ fn law_on_guess(
     if q == 0 {
         return Verdict::Singular;
     }
-    // dΛ/dx: a pressed row's λ_N also drives its slipping node's λ_T.
-    let mut slip_of = vec![None; n];
+    // dΛ/dx: a pressed row's λ_N also drives its slipping node's λ_T, `μ d_i` per
+    // tangential row `t + i`.
+    let mut slip_of: Vec<Option<(usize, [f64; 2])>> = vec![None; n];
     for (k, &(j, mu)) in cones.iter().enumerate() {
-        if let Guess::Slip(sign) = guess[k] {
-            slip_of[j] = Some((n + k, sign * mu));
+        if let Guess::Slip(d) = guess[k] {
+            slip_of[j] = Some((n + tdim * k, [mu * d[0], mu * d[1]]));
         }
     }
     let mut b = vec![0.0; q * q];
@@ -429,7 +478,9 @@ fn law_on_guess(
         for (v, &i) in rows.iter().enumerate() {
             let mut x = w[r + i * m];
             if let Some(Some((t, f))) = slip_of.get(i) {
-                x += f * w[r + t * m];
+                for (a, fa) in f.iter().enumerate().take(tdim) {
+                    x += fa * w[r + (t + a) * m];
+                }
             }
             b[e + v * q] = x;
         }
@@ -442,7 +493,9 @@ fn law_on_guess(
     for (v, &i) in rows.iter().enumerate() {
         lambda[i] = rhs[v];
         if let Some(Some((t, f))) = slip_of.get(i) {
-            lambda[*t] = f * rhs[v];
+            for (a, fa) in f.iter().enumerate().take(tdim) {
+                lambda[t + a] = fa * rhs[v];
+            }
         }
     }
     // The whole law.
@@ -472,12 +525,34 @@ fn law_on_guess(
             .sqrt();
         match guess[k] {
             Guess::Stick if lt > mu * ln * (1.0 + 1e-12) + 1e-12 * scale => {
-                guess[k] = Guess::Slip(lambda[n + tdim * k].signum());
+                guess[k] = Guess::slip_along(&lambda[n + tdim * k..n + tdim * (k + 1)]);
                 changed = true;
             }
-            Guess::Slip(sign) if sign * y(n + k, lambda) > tol => {
-                guess[k] = Guess::Stick;
-                changed = true;
+            Guess::Slip(d) => {
+                // The slip `s` must be opposite to the force: `s · d ≤ 0`, and in a
+                // solid along the same line.
+                let mut s = [0.0; 2];
+                for (i, si) in s.iter_mut().enumerate().take(tdim) {
+                    *si = y(n + tdim * k + i, lambda);
+                }
+                let along = if tdim == 1 {
+                    d[0] * s[0]
+                } else {
+                    d[0] * s[0] + d[1] * s[1]
+                };
+                if along > tol {
+                    guess[k] = Guess::Stick;
+                    changed = true;
+                } else if tdim > 1 {
+                    // Across the direction the cone programs' own accuracy: they
+                    // settle the shift `μ |s|` to `SHIFT_TOLERANCE` = 1e-8 of the
+                    // largest predicted gap or slip, ten times `tol`.
+                    let across = (s[0] - along * d[0]).hypot(s[1] - along * d[1]);
+                    if across > tol {
+                        guess[k] = Guess::slip_along(&[-s[0], -s[1]]);
+                        changed = true;
+                    }
+                }
             }
             _ => {}
         }

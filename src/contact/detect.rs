@@ -9,19 +9,67 @@
 //! master farther than that search reaches (theory/contact.md, "Nothing crosses
 //! unseen"; theory/contact3d.md).
 
-use super::master::{self, rigid::RigidHistory, Positions};
+use super::master::faces::{FaceSurface, KeptFaces};
+use super::master::{self, rigid::RigidHistory, MasterSurface, Positions};
 use super::rows::Candidate;
 use super::state::Slave;
 use crate::model::{ContactPair, Formulation, Master, SlaveSurface};
 
+/// How far (in units of a pair's search radius) a face master's nodes may move
+/// before the tree detection keeps of it is built again ([`KeptFaces`]): a tenth.
+/// The boxes grow by as much, so a query meets a few more faces; in persistent
+/// contact the tree then lasts the run.
+pub const KEPT_MARGIN: f64 = 0.1;
+
+/// What detection keeps from one evaluation to the next: the tree and topology of
+/// every side with a face master ([`KeptFaces`]), by side in pair order.
+#[derive(Default)]
+pub struct Kept {
+    sides: Vec<Option<KeptFaces>>,
+}
+
+impl Kept {
+    /// Trees built so far over all sides.
+    pub fn builds(&self) -> usize {
+        self.sides.iter().flatten().map(KeptFaces::builds).sum()
+    }
+}
+
 /// Candidates of every pair at the geometry `x`, appended to `out` (cleared first),
 /// ordered by pair, side and slave node (a slave in a notch or a valley gives one per
 /// facet holding it, by facet). `rigid`: what the committed state knows of the rigid
-/// lines' slaves.
-pub fn detect(pairs: &[ContactPair], x: Positions, rigid: &RigidHistory, out: &mut Vec<Candidate>) {
+/// lines' slaves; `kept`: what detection keeps across evaluations, if anything (the
+/// same candidates either way).
+pub fn detect(
+    pairs: &[ContactPair],
+    x: Positions,
+    rigid: &RigidHistory,
+    mut kept: Option<&mut Kept>,
+    out: &mut Vec<Candidate>,
+) {
     out.clear();
+    let mut side_index = 0;
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
+            side_index += 1;
+            if let (Some(k), Master::Faces { faces, boundary }) =
+                (kept.as_deref_mut(), &side.master)
+            {
+                if k.sides.len() < side_index {
+                    k.sides.resize_with(side_index, || None);
+                }
+                let slot = &mut k.sides[side_index - 1];
+                match slot {
+                    Some(t) => t.refresh(faces, x),
+                    None => *slot = Some(KeptFaces::new(faces, x, KEPT_MARGIN * pair.radius)),
+                }
+                let surface = FaceSurface::new(faces, boundary, x)
+                    .kept(slot.as_ref().expect("set just above"));
+                for &s in &side.slaves {
+                    surface.detect(Slave::new(pi, si, s), pair.radius, rigid, out);
+                }
+                continue;
+            }
             let mortar = pair.formulation == Formulation::Mortar;
             if let (true, SlaveSurface::Segments(slave_segments), Master::Segments(segments)) =
                 (mortar, &side.surface, &side.master)

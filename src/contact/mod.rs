@@ -54,6 +54,7 @@ pub fn candidates(model: &crate::model::Model, u: &[f64], out: &mut Vec<Candidat
         &model.contacts,
         Positions::new(&x, model.mesh.dim),
         &Default::default(),
+        None,
         out,
     );
 }

@@ -61,6 +61,7 @@ pub fn model_of(
             contact: rothe::model::ContactSettings {
                 tolerance: 1e-6,
                 qp: rothe::model::ContactQp::Condensed,
+                friction_guess: true,
             },
             output: rothe::model::OutputSettings { vtk_every: 0 },
         },

@@ -874,3 +874,65 @@ fn check_writes_a_solids_gap_rows() {
     }
     assert!(rows.iter().all(|&k| k == 1), "{rows:?}");
 }
+
+/// Runs `m` with the friction guess on or off: the final state, the history of the
+/// pair's normal and tangential forces, and the QPs with friction and those the guess
+/// solved.
+fn with_guess(mut m: Model, guess: bool) -> (State, Vec<[f64; 2]>, (usize, usize)) {
+    m.analysis.contact.friction_guess = guess;
+    let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+    let mut s = be.initial_state();
+    let mut forces = Vec::new();
+    for _ in 0..m.analysis.n_steps() {
+        be.step_accepted(&mut s).unwrap();
+        let rec = s.contact.pairs[0];
+        forces.push([rec.force, rec.tangential_magnitude]);
+    }
+    let st = be.contact_stats().unwrap();
+    (s, forces, (st.frictional, st.friction_guessed))
+}
+
+#[test]
+fn the_friction_guess_gives_the_cone_programs_results_in_a_solid() {
+    // The block sliding down the incline off the axes (every node slipping along a
+    // direction no axis gives), and the steel block thrown obliquely onto the base
+    // (impact, sticking and slipping nodes, release): with the guess of the last QP's
+    // statuses and slip directions and without it, the same motion and forces to the
+    // QP's tolerance.
+    let (theta, phi) = (30f64.to_radians(), 35f64.to_radians());
+    let oblique = drop_on("model = \"elastic\"")
+        .replace("velocity = [0.0, -2.0, 0.0]", "velocity = [1.5, -2.0, 0.8]")
+        .replace("master = \"base.top\"", "master = \"base.top\"\nmu = 0.3");
+    for (name, text) in [
+        ("incline", incline(theta, phi, 0.3)),
+        ("oblique impact", oblique),
+    ] {
+        let m = model(&text);
+        let (on, f_on, (qps, hits)) = with_guess(m.clone(), true);
+        let (off, f_off, (qps_off, hits_off)) = with_guess(m, false);
+        let rate = hits as f64 / qps.max(1) as f64;
+        eprintln!(
+            "{name}: {hits} of {qps} frictional QPs solved by the guess ({:.0} %); \
+             without it {hits_off} of {qps_off}",
+            100.0 * rate
+        );
+        assert_eq!(hits_off, 0);
+        assert!(hits > 0, "{name}: the guess never held");
+        let scale = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let (du, dv) = (scale(&on.u), scale(&on.v));
+        for (a, b, s) in [(&on.u, &off.u, du), (&on.v, &off.v, dv)] {
+            let diff = a
+                .iter()
+                .zip(b.iter())
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(diff <= 1e-6 * s, "{name}: {diff:e} of {s:e}");
+        }
+        let fmax = f_off.iter().fold(0.0f64, |a, f| a.max(f[0]));
+        for (k, (a, b)) in f_on.iter().zip(&f_off).enumerate() {
+            assert!(
+                (a[0] - b[0]).abs() <= 1e-6 * fmax && (a[1] - b[1]).abs() <= 1e-6 * fmax,
+                "{name}, step {k}: {a:?} against {b:?}"
+            );
+        }
+    }
+}

@@ -239,6 +239,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             contact: ContactSettings {
                 tolerance: contact_tolerance,
                 qp: a.contact_qp.unwrap_or_default(),
+                friction_guess: true,
             },
             output: OutputSettings {
                 vtk_every: a.vtk_every,

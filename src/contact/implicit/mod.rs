@@ -133,6 +133,7 @@ impl<'m> ContactCorrection<'m> {
                 dofs: crate::system::DofMap::new(n, model.constraints.iter().map(|c| c.dof)),
                 dim: mesh.dim,
                 frictional: model.contacts.iter().any(|p| p.mu > 0.0),
+                friction_guess: model.analysis.contact.friction_guess,
             },
             start: StepStart::default(),
             active: ActiveSet {
@@ -323,7 +324,13 @@ impl<'m> ContactCorrection<'m> {
             }
         }
         let x = Positions::new(&self.work.x, dim);
-        super::detect::detect(self.setup.pairs, x, &self.start.rigid, &mut self.sel.cands);
+        super::detect::detect(
+            self.setup.pairs,
+            x,
+            &self.start.rigid,
+            Some(&mut self.work.kept),
+            &mut self.sel.cands,
+        );
         if !self.start.x0.is_empty() {
             let x0 = Positions::new(&self.start.x0, dim);
             super::detect::crossed(
@@ -427,14 +434,19 @@ impl<'m> ContactCorrection<'m> {
                     }
                     self.sel.cones.push((j, mu));
                     let key = c.key();
-                    let ln = self.active.lambda.get(&key).copied().unwrap_or(0.0);
-                    let lt = self.active.lambda_t.get(&key).copied().unwrap_or([0.0; 2]);
+                    let ln = self.sel.last_lambda.get(&key).copied().unwrap_or(0.0);
+                    let lt = self
+                        .sel
+                        .last_lambda_t
+                        .get(&key)
+                        .copied()
+                        .unwrap_or([0.0; 2]);
                     self.sel
                         .guess_t
                         .push(if lt[0].hypot(lt[1]) < (1.0 - STICK_MARGIN) * mu * ln {
                             super::coulomb::Guess::Stick
                         } else {
-                            super::coulomb::Guess::Slip(lt[0].signum())
+                            super::coulomb::Guess::slip_along(&lt[..tdim])
                         });
                 }
             }
@@ -589,6 +601,10 @@ impl Correction for ContactCorrection<'_> {
         };
         let tdim = self.setup.dim - 1;
         self.active.previous = std::mem::take(&mut self.active.current);
+        // The last multipliers, which the guess of a frictional QP reads, make way
+        // for the new ones.
+        std::mem::swap(&mut self.active.lambda, &mut self.sel.last_lambda);
+        std::mem::swap(&mut self.active.lambda_t, &mut self.sel.last_lambda_t);
         self.active.lambda.clear();
         self.active.lambda_t.clear();
         // The QP on the rows predicted to close; a row left out that the QP's

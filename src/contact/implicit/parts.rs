@@ -28,6 +28,8 @@ pub(super) struct Setup<'m> {
     pub(super) dim: usize,
     /// Whether any pair has friction.
     pub(super) frictional: bool,
+    /// Whether a frictional QP tries the statuses of the last one first.
+    pub(super) friction_guess: bool,
 }
 
 /// Where the step started.
@@ -88,6 +90,10 @@ pub(super) struct RowSelection {
     /// each frictional node ended there.
     pub(super) pressed: Vec<bool>,
     pub(super) guess_t: Vec<crate::contact::coulomb::Guess>,
+    /// The multipliers the last QP (or the last step) ended with, which the guess
+    /// reads.
+    pub(super) last_lambda: BTreeMap<Key, f64>,
+    pub(super) last_lambda_t: BTreeMap<Key, [f64; 2]>,
     /// `δ₀` kept for a second round of the QP, and the candidates a round forced in.
     pub(super) delta_start: Vec<f64>,
     pub(super) forced: Vec<usize>,
@@ -112,4 +118,6 @@ pub(super) struct Workspace {
     pub(super) compliance: Compliance,
     pub(super) qp_generation: usize,
     pub(super) dual: DualQp,
+    /// What detection keeps across evaluations (a face master's tree).
+    pub(super) kept: crate::contact::detect::Kept,
 }

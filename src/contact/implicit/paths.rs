@@ -93,9 +93,10 @@ impl ContactCorrection<'_> {
         }
         let gap_tol = GUESS_GAP_TOLERANCE * self.sel.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let slip_tol = GUESS_GAP_TOLERANCE * self.sel.c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        // The guess of the statuses is written for the plane's one tangent.
+        // The guess of the statuses (and in a solid the slip directions) the last QP
+        // ended in, accepted only if its result satisfies the whole law.
         let r = if !self.sel.cones.is_empty()
-            && self.setup.dim == 2
+            && self.setup.friction_guess
             && crate::contact::coulomb::solve_by_guess(
                 &self.work.w,
                 &self.sel.c,

@@ -563,6 +563,7 @@ impl<'m> KinematicContact<'m> {
             &self.model.contacts,
             Positions::new(&self.x, dim),
             &self.rigid,
+            None,
             &mut self.cands,
         );
     }

@@ -300,14 +300,48 @@ pub fn project<X: Fn(usize) -> V3>(p: V3, face: &Face, x: &X) -> Option<Projecti
 /// at each node the normalised sum of the unit normals of the faces meeting there.
 struct Surface {
     normal: Vec<V3>,
-    at_node: HashMap<usize, V3>,
+    /// By the set's node numbering ([`Topology`]).
+    at_node: Vec<V3>,
+}
+
+/// A face set's corners numbered over its distinct nodes: topology, found once for a
+/// set and kept ([`KeptFaces`]), so the nodal normals of a geometry are sums into a
+/// vector, not a map.
+#[derive(Clone, Debug)]
+pub struct Topology {
+    /// Each face's corners by their number in `nodes`.
+    corners: Vec<[usize; 4]>,
+    /// The distinct nodes, in the order the faces first name them.
+    nodes: Vec<usize>,
+}
+
+impl Topology {
+    /// The topology of `faces`.
+    pub fn new(faces: &[Face]) -> Topology {
+        let mut number: HashMap<usize, usize> = HashMap::with_capacity(faces.len());
+        let mut nodes = Vec::new();
+        let corners = faces
+            .iter()
+            .map(|f| {
+                let mut c = [0; 4];
+                for (k, &v) in f.corners().iter().enumerate() {
+                    c[k] = *number.entry(v).or_insert_with(|| {
+                        nodes.push(v);
+                        nodes.len() - 1
+                    });
+                }
+                c
+            })
+            .collect();
+        Topology { corners, nodes }
+    }
 }
 
 impl Surface {
-    fn new<X: Fn(usize) -> V3>(faces: &[Face], x: &X) -> Surface {
+    fn new<X: Fn(usize) -> V3>(faces: &[Face], topology: &Topology, x: &X) -> Surface {
         let mut normal = Vec::with_capacity(faces.len());
-        let mut at_node: HashMap<usize, V3> = HashMap::with_capacity(faces.len());
-        for f in faces {
+        let mut at_node = vec![[0.0; 3]; topology.nodes.len()];
+        for (f, local) in faces.iter().zip(&topology.corners) {
             let c = f.corners();
             let n = if c.len() == 3 {
                 cross(sub(x(c[1]), x(c[0])), sub(x(c[2]), x(c[0])))
@@ -316,14 +350,14 @@ impl Surface {
             };
             let n = unit(n).unwrap_or([0.0; 3]);
             normal.push(n);
-            for &v in c {
-                let e = at_node.entry(v).or_insert([0.0; 3]);
+            for &v in &local[..c.len()] {
+                let e = &mut at_node[v];
                 for i in 0..3 {
                     e[i] += n[i];
                 }
             }
         }
-        for v in at_node.values_mut() {
+        for v in &mut at_node {
             *v = unit(*v).unwrap_or([0.0; 3]);
         }
         Surface { normal, at_node }
@@ -337,13 +371,12 @@ impl Surface {
     /// faces' own from one iteration to the next; on a flat surface it is the
     /// surface's normal. Over a convex ridge or corner it is the ridge's or corner's
     /// mean normal.
-    fn normal(&self, face: &Face, pr: &Projection) -> V3 {
+    fn normal(&self, local: &[usize], pr: &Projection) -> V3 {
         let mut n = [0.0; 3];
-        for (k, &v) in face.corners().iter().enumerate() {
-            if let Some(m) = self.at_node.get(&v) {
-                for i in 0..3 {
-                    n[i] += pr.weights[k] * m[i];
-                }
+        for (k, &v) in local.iter().enumerate() {
+            let m = self.at_node[v];
+            for i in 0..3 {
+                n[i] += pr.weights[k] * m[i];
             }
         }
         unit(n).unwrap_or(pr.normal)
@@ -408,6 +441,63 @@ fn beyond_boundary<X: Fn(usize) -> V3>(
     t2 > RIGID_END_MARGIN.powi(2) * longest
 }
 
+/// What detection keeps of a face set from one evaluation to the next: its
+/// [`Topology`] and an R-tree of its faces' boxes grown by a margin, with the node
+/// positions the tree was built at. While no node has moved farther than the margin
+/// from there, every face within a slave's reach now lies in the tree's boxes (its
+/// box now lies within its grown one), so the query finds a superset of what a tree
+/// of the current geometry finds, and the exact projection decides as before: the
+/// same rows, bit for bit (the nearest face is chosen by distance and index, not
+/// by the tree's order). Past the margin the tree is built again.
+pub struct KeptFaces {
+    topology: Topology,
+    tree: FaceTree,
+    /// The positions of `topology.nodes` the tree was built at.
+    base: Vec<V3>,
+    margin: f64,
+    /// Trees built, for the record.
+    builds: usize,
+}
+
+impl KeptFaces {
+    /// The tree of `faces` at `x`, grown by `margin`.
+    pub fn new(faces: &[Face], x: Positions, margin: f64) -> KeptFaces {
+        let topology = Topology::new(faces);
+        let base = topology.nodes.iter().map(|&n| x.at::<3>(n)).collect();
+        let tree = face_tree(faces, |n| std::iter::once(x.at::<3>(n)), margin);
+        KeptFaces {
+            topology,
+            tree,
+            base,
+            margin,
+            builds: 1,
+        }
+    }
+
+    /// Builds the tree again at `x` if a node moved farther than the margin since
+    /// it was built.
+    pub fn refresh(&mut self, faces: &[Face], x: Positions) {
+        let moved = self
+            .topology
+            .nodes
+            .iter()
+            .zip(&self.base)
+            .any(|(&n, b)| crate::geometry::distance(x.at::<3>(n), *b) > self.margin);
+        if moved {
+            for (b, &n) in self.base.iter_mut().zip(&self.topology.nodes) {
+                *b = x.at::<3>(n);
+            }
+            self.tree = face_tree(faces, |n| std::iter::once(x.at::<3>(n)), self.margin);
+            self.builds += 1;
+        }
+    }
+
+    /// How many times the tree was built.
+    pub fn builds(&self) -> usize {
+        self.builds
+    }
+}
+
 /// A set of faces at a geometry.
 pub struct FaceSurface<'a> {
     faces: &'a [Face],
@@ -415,6 +505,9 @@ pub struct FaceSurface<'a> {
     edges: &'a [[usize; 2]],
     rim: Vec<usize>,
     x: Positions<'a>,
+    /// What detection keeps across evaluations, if it keeps anything.
+    kept: Option<&'a KeptFaces>,
+    topology: OnceCell<Topology>,
     surface: OnceCell<Surface>,
     tree: OnceCell<FaceTree>,
     swept: OnceCell<FaceTree>,
@@ -433,6 +526,8 @@ impl<'a> FaceSurface<'a> {
             edges,
             rim,
             x,
+            kept: None,
+            topology: OnceCell::new(),
             surface: OnceCell::new(),
             tree: OnceCell::new(),
             swept: OnceCell::new(),
@@ -440,14 +535,34 @@ impl<'a> FaceSurface<'a> {
         }
     }
 
+    /// The same, its topology and detection's tree taken from `kept` (built for
+    /// these faces and refreshed for `x`).
+    pub fn kept(mut self, kept: &'a KeptFaces) -> Self {
+        self.kept = Some(kept);
+        self
+    }
+
     fn x(&self, n: usize) -> V3 {
         self.x.at::<3>(n)
+    }
+
+    fn topology(&self) -> &Topology {
+        match self.kept {
+            Some(k) => &k.topology,
+            None => self.topology.get_or_init(|| Topology::new(self.faces)),
+        }
     }
 
     /// The faces' and the nodes' normals at the surface's geometry.
     fn surface(&self) -> &Surface {
         self.surface
-            .get_or_init(|| Surface::new(self.faces, &|n| self.x(n)))
+            .get_or_init(|| Surface::new(self.faces, self.topology(), &|n| self.x(n)))
+    }
+
+    /// The smoothed normal at a projection `pr` on face `k`.
+    fn smooth_normal(&self, k: usize, pr: &Projection) -> V3 {
+        let local = &self.topology().corners[k][..self.faces[k].corners().len()];
+        self.surface().normal(local, pr)
     }
 
     /// The row of `slave` against face `index` at its projection `pr`, along
@@ -486,9 +601,12 @@ impl MasterSurface for FaceSurface<'_> {
     fn detect(&self, slave: Slave, r: f64, _: &RigidHistory, out: &mut Vec<Candidate>) {
         let faces = self.faces;
         let x = |n: usize| self.x(n);
-        let tree = self
-            .tree
-            .get_or_init(|| face_tree(faces, |n| std::iter::once(x(n)), 0.0));
+        let tree = match self.kept {
+            Some(k) => &k.tree,
+            None => self
+                .tree
+                .get_or_init(|| face_tree(faces, |n| std::iter::once(x(n)), 0.0)),
+        };
         let s = slave.node;
         let p = x(s);
         let reach = AABB::from_corners(
@@ -568,7 +686,7 @@ impl MasterSurface for FaceSurface<'_> {
             }
         }
         if held.is_empty() {
-            let normal = self.surface().normal(&faces[k], &pr);
+            let normal = self.smooth_normal(k, &pr);
             out.push(self.candidate(slave, k, &pr, normal));
         } else {
             held.push(k);
@@ -621,7 +739,7 @@ impl MasterSurface for FaceSurface<'_> {
         }
         let (_, k) = first?;
         let pr = project(p1, &faces[k], &x1)?;
-        let normal = self.surface().normal(&faces[k], &pr);
+        let normal = self.smooth_normal(k, &pr);
         Some(self.candidate(slave, k, &pr, normal))
     }
 

@@ -137,7 +137,7 @@ pub(crate) mod tests {
         out: &mut Vec<Candidate>,
     ) {
         let x: Vec<f64> = coords.iter().flatten().copied().collect();
-        crate::contact::detect::detect(pairs, Positions::new(&x, D), rigid, out);
+        crate::contact::detect::detect(pairs, Positions::new(&x, D), rigid, None, out);
     }
 
     /// [`detect_with`] with no history.
