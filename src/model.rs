@@ -273,9 +273,10 @@ pub struct ContactSettings {
     /// How the contact QP is solved.
     pub qp: ContactQp,
     /// Whether a frictional QP first tries the statuses (and slip directions) its
-    /// predecessor ended in, one elimination accepted only if it satisfies the whole
-    /// law, before the cone programs (default true; false runs the cone programs
-    /// only, the reference the guess is checked against).
+    /// predecessor ended in, eliminations accepted only if they satisfy the whole
+    /// law, before the cone programs (`analysis.friction_guess`: default true in the
+    /// plane, false in a solid; false runs the cone programs only, the reference the
+    /// guess is checked against).
     pub friction_guess: bool,
 }
 

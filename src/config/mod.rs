@@ -376,6 +376,11 @@ pub struct AnalysisSpec {
     /// free dofs, the reference).
     #[serde(default)]
     pub contact_qp: Option<crate::model::ContactQp>,
+    /// Whether a frictional contact QP first tries the statuses (and in a solid the
+    /// slip directions) the last one ended in, before the cone programs. Default
+    /// true in the plane, false in a solid (theory/friction.md says why).
+    #[serde(default)]
+    pub friction_guess: Option<bool>,
     /// Where the implicit schemes keep the state of linear viscoelastic materials:
     /// `nodal` (default: nodal fields, a step of matrix-vector products) or `points`
     /// (the Gauss points, with each point's cumulative dissipation density in the

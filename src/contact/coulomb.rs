@@ -544,9 +544,7 @@ fn law_on_guess(
                     guess[k] = Guess::Stick;
                     changed = true;
                 } else if tdim > 1 {
-                    // Across the direction the cone programs' own accuracy: they
-                    // settle the shift `μ |s|` to `SHIFT_TOLERANCE` = 1e-8 of the
-                    // largest predicted gap or slip, ten times `tol`.
+                    // Across the direction the same tolerance as along it.
                     let across = (s[0] - along * d[0]).hypot(s[1] - along * d[1]);
                     if across > tol {
                         guess[k] = Guess::slip_along(&[-s[0], -s[1]]);

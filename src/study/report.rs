@@ -31,14 +31,15 @@ pub const DAMAGE_MODELS: [&str; 2] = ["mazars", "mazars_local"];
 /// The concrete models of benchmark 1 run as solids too
 /// (`two_blocks_solid.toml`, at the comparison mesh), against plane stress.
 pub const SOLID_MODELS: [&str; 3] = ["elastic", "mazars", "rankine_hill"];
-/// The concrete models of benchmark 2.
+/// The concrete models of benchmark 2, run as solids too
+/// (`rc_beam_punch_solid.toml`).
 pub const BENCHMARK2_MODELS: [&str; 4] = ["mazars", "mazars_local", "rankine_hill", "kelvin_voigt"];
 
 /// What the report runs.
 #[derive(Clone, Debug)]
 pub struct ReportOptions {
-    /// Directory holding `two_blocks.toml`, `two_blocks_solid.toml` and
-    /// `rc_beam_punch.toml`.
+    /// Directory holding `two_blocks.toml`, `two_blocks_solid.toml`,
+    /// `rc_beam_punch.toml` and `rc_beam_punch_solid.toml`.
     pub benchmarks: PathBuf,
     /// Benchmark 1's meshes.
     pub meshes: Vec<f64>,
@@ -83,7 +84,8 @@ pub fn plan(o: &ReportOptions) -> Result<Plan> {
     let b1 = o.benchmarks.join("two_blocks.toml");
     let b2 = o.benchmarks.join("rc_beam_punch.toml");
     let b1_solid = o.benchmarks.join("two_blocks_solid.toml");
-    for f in [&b1, &b2, &b1_solid] {
+    let b2_solid = o.benchmarks.join("rc_beam_punch_solid.toml");
+    for f in [&b1, &b2, &b1_solid, &b2_solid] {
         if !f.is_file() {
             return Err(Error::config(
                 "--benchmarks",
@@ -161,6 +163,22 @@ pub fn plan(o: &ReportOptions) -> Result<Plan> {
         runs.push(PlannedRun {
             label: format!("{m}, explicit"),
             ..both[1].clone()
+        });
+    }
+    // Benchmark 2 as solids, the same models (theory/benchmarks.md).
+    let abs2_solid = super::plan::absolute(&b2_solid)?;
+    for m in BENCHMARK2_MODELS {
+        let mut base = o.base.then(&variant(m));
+        if let Some(s) = o.beam_size {
+            base = base.then(&size(s));
+        }
+        runs.push(PlannedRun {
+            id: format!("b2solid_{m}"),
+            scenario: abs2_solid.clone(),
+            overrides: base,
+            param: o.beam_size.unwrap_or(f64::NAN),
+            label: format!("{m}, solid"),
+            record_fields: false,
         });
     }
     if !o.meshes.contains(&o.compare_mesh) {
@@ -357,6 +375,75 @@ fn solid_against_plane(runs: &[RunData], plots: &Path) -> Result<String> {
          The force from the second step in contact on (the first step's is the table's \
          peak).\n",
     );
+    Ok(md)
+}
+
+/// Benchmark 2 as solids against plane stress: mid-span deflection, lift-off,
+/// dissipation by mechanism, and the deflection histories.
+fn beam_solid_against_plane(runs: &[RunData], plots: &Path) -> Result<String> {
+    let pairs: Vec<(&str, &RunData, &RunData)> = BENCHMARK2_MODELS
+        .iter()
+        .filter_map(|m| {
+            let solid = find(runs, &format!("b2solid_{m}"))?;
+            let plane = find(runs, &format!("b2_{m}_implicit"))?;
+            Some((*m, plane, solid))
+        })
+        .collect();
+    if pairs.is_empty() {
+        return Ok(String::new());
+    }
+    let mut md = String::from(
+        "\n## Benchmark 2 as solids against plane stress\n\nThe beam, the punch and the \
+         supports as boxes with the plane model's thicknesses as depths, the rebars as \
+         bars through the beam (`rc_beam_punch_solid.toml`; the supports are steel boxes \
+         where the plane has rigid lines); its own mesh unless `--beam-size` sets both \
+         (theory/benchmarks.md).\n\n",
+    );
+    let mut t = Table::new(&{
+        let mut h = vec![
+            "model".to_string(),
+            "run".into(),
+            "peak deflection [mm]".into(),
+            "max upward [mm]".into(),
+            "lifts off".into(),
+        ];
+        h.extend(dissipation_header());
+        h
+    });
+    for (m, plane, solid) in &pairs {
+        for (what, r) in [("plane stress", plane), ("solid", solid)] {
+            let mut row = vec![
+                m.to_string(),
+                what.to_string(),
+                num(Some(-1e3 * r.probe_min("midspan"))),
+                num(r.number("/probes/midspan/max_uy").map(|v| 1e3 * v)),
+                (run_lifts_off(r, "left_support") || run_lifts_off(r, "right_support")).to_string(),
+            ];
+            row.extend(dissipation_cells(r));
+            t.push(row);
+        }
+    }
+    md.push_str(&t.markdown());
+    let mut fig = Figure::new(
+        "Benchmark 2: mid-span deflection, plane stress and solid",
+        "t [ms]",
+        "u_y [mm]",
+    );
+    for (m, plane, solid) in &pairs {
+        fig = fig
+            .with(Series::new(
+                format!("{m}, plane"),
+                plane.series("midspan_uy", 1e3),
+                Style::Line,
+            ))
+            .with(Series::new(
+                format!("{m}, solid"),
+                solid.series("midspan_uy", 1e3),
+                Style::Line,
+            ));
+    }
+    draw(&fig, &plots.join("b2_solid_probe"))?;
+    md.push_str("\n![benchmark 2 deflection, plane and solid](plots/b2_solid_probe.png)\n");
     Ok(md)
 }
 
@@ -559,6 +646,7 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
     }
 
     md.push_str(&solid_against_plane(runs, &plots)?);
+    md.push_str(&beam_solid_against_plane(runs, &plots)?);
 
     md.push_str(&schemes_side_by_side(runs));
 

@@ -903,6 +903,15 @@ fn the_friction_guess_gives_the_cone_programs_results_in_a_solid() {
     let oblique = drop_on("model = \"elastic\"")
         .replace("velocity = [0.0, -2.0, 0.0]", "velocity = [1.5, -2.0, 0.8]")
         .replace("master = \"base.top\"", "master = \"base.top\"\nmu = 0.3");
+    // Off by default in a solid, on when the scenario asks.
+    let asked = incline(theta, phi, 0.3).replace("[analysis]", "[analysis]\nfriction_guess = true");
+    assert!(
+        !model(&incline(theta, phi, 0.3))
+            .analysis
+            .contact
+            .friction_guess
+    );
+    assert!(model(&asked).analysis.contact.friction_guess);
     for (name, text) in [
         ("incline", incline(theta, phi, 0.3)),
         ("oblique impact", oblique),
@@ -935,4 +944,73 @@ fn the_friction_guess_gives_the_cone_programs_results_in_a_solid() {
             );
         }
     }
+}
+
+#[test]
+fn benchmark_2_as_a_solid_is_the_planes_data_in_boxes() {
+    // The punch's kinetic energy, the beam's and the punch's masses are the plane
+    // file's (thicknesses as depths), the supports hold the beam both ways, the
+    // rebars run through the beam.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/benchmarks");
+    let solid = rothe::config::load(&dir.join("rc_beam_punch_solid.toml")).unwrap();
+    let plane = rothe::config::load(&dir.join("rc_beam_punch.toml")).unwrap();
+    let kinetic = |m: &Model| {
+        let be = BackwardEuler::new(m, Backend::Faer).unwrap();
+        be.initial_state().ledger.kinetic()
+    };
+    let (ks, kp) = (kinetic(&solid), kinetic(&plane));
+    assert!((ks - kp).abs() <= 1e-12 * kp, "{ks} against {kp}");
+    for p in solid
+        .contacts
+        .iter()
+        .filter(|p| p.name.ends_with("support"))
+    {
+        assert_eq!(p.sides.len(), 2, "{}: both ways", p.name);
+    }
+    let bars = solid
+        .mesh
+        .blocks
+        .iter()
+        .filter(|b| b.elements.kind == rothe::mesh::ElementKind::Bar2)
+        .map(|b| b.elements.len())
+        .sum::<usize>();
+    assert!(bars > 0);
+}
+
+/// Benchmark 2 as solids, elastic to 10 ms (about a minute): the mid-span peak
+/// deflection within 2 % of the plane's and its contact line never falling by more
+/// than a thousandth of the punch's kinetic energy in a step (one-way node to face
+/// at the supports' edges let the beam's nodes sink beside them and be flung out,
+/// `D_contact` −16 `E_kin⁰`; theory/benchmarks.md).
+#[test]
+#[ignore]
+fn benchmark_2_as_a_solid_deflects_as_the_plane_and_its_contact_does_no_work() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/benchmarks");
+    let peak = |file: &str| {
+        let m = rothe::config::load(&dir.join(file)).unwrap();
+        let mut be = BackwardEuler::new(&m, Backend::Faer).unwrap();
+        let mut s = be.initial_state();
+        let k0 = s.ledger.kinetic();
+        let probe = m.probes[0].node;
+        let d = m.mesh.dim;
+        let (mut low, mut contact) = (0.0f64, 0.0);
+        while s.t < m.analysis.time.t_end * (1.0 - 1e-9) {
+            be.step_accepted(&mut s).unwrap();
+            low = low.min(s.u[d * probe + 1]);
+            let now = s.ledger.dissipated().contact;
+            assert!(
+                now - contact >= -1e-3 * k0,
+                "{file}: D_contact fell by {}",
+                contact - now
+            );
+            contact = now;
+        }
+        low
+    };
+    let (solid, plane) = (peak("rc_beam_punch_solid.toml"), peak("rc_beam_punch.toml"));
+    eprintln!("peak deflection: solid {solid:e} m, plane {plane:e} m");
+    assert!(
+        (solid - plane).abs() <= 0.02 * plane.abs(),
+        "{solid} against {plane}"
+    );
 }

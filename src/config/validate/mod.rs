@@ -239,7 +239,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             contact: ContactSettings {
                 tolerance: contact_tolerance,
                 qp: a.contact_qp.unwrap_or_default(),
-                friction_guess: true,
+                friction_guess: a.friction_guess.unwrap_or(!solid),
             },
             output: OutputSettings {
                 vtk_every: a.vtk_every,
@@ -468,6 +468,7 @@ fn unread_keys(a: &super::AnalysisSpec) -> Vec<String> {
     if explicit {
         let implicit_only = [
             ("analysis.contact_qp", a.contact_qp.is_some()),
+            ("analysis.friction_guess", a.friction_guess.is_some()),
             ("analysis.iteration", a.iteration.is_some()),
             ("analysis.keep_factor", a.keep_factor.is_some()),
             ("analysis.refactor_rate", a.refactor_rate.is_some()),
