@@ -28,13 +28,6 @@ pub struct Kept {
     sides: Vec<Option<KeptFaces>>,
 }
 
-impl Kept {
-    /// Trees built so far over all sides.
-    pub fn builds(&self) -> usize {
-        self.sides.iter().flatten().map(KeptFaces::builds).sum()
-    }
-}
-
 /// Candidates of every pair at the geometry `x`, appended to `out` (cleared first),
 /// ordered by pair, side and slave node (a slave in a notch or a valley gives one per
 /// facet holding it, by facet). `rigid`: what the committed state knows of the rigid
@@ -52,24 +45,6 @@ pub fn detect(
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
             side_index += 1;
-            if let (Some(k), Master::Faces { faces, boundary }) =
-                (kept.as_deref_mut(), &side.master)
-            {
-                if k.sides.len() < side_index {
-                    k.sides.resize_with(side_index, || None);
-                }
-                let slot = &mut k.sides[side_index - 1];
-                match slot {
-                    Some(t) => t.refresh(faces, x),
-                    None => *slot = Some(KeptFaces::new(faces, x, KEPT_MARGIN * pair.radius)),
-                }
-                let surface = FaceSurface::new(faces, boundary, x)
-                    .kept(slot.as_ref().expect("set just above"));
-                for &s in &side.slaves {
-                    surface.detect(Slave::new(pi, si, s), pair.radius, rigid, out);
-                }
-                continue;
-            }
             let mortar = pair.formulation == Formulation::Mortar;
             if let (true, SlaveSurface::Segments(slave_segments), Master::Segments(segments)) =
                 (mortar, &side.surface, &side.master)
@@ -88,7 +63,21 @@ pub fn detect(
                 );
                 continue;
             }
-            let surface = master::surface(side, x);
+            let surface: Box<dyn MasterSurface + '_> = match (kept.as_deref_mut(), &side.master) {
+                (Some(k), Master::Faces { faces, boundary }) => {
+                    if k.sides.len() < side_index {
+                        k.sides.resize_with(side_index, || None);
+                    }
+                    let slot = &mut k.sides[side_index - 1];
+                    match slot {
+                        Some(t) => t.refresh(faces, x),
+                        None => *slot = Some(KeptFaces::new(faces, x, KEPT_MARGIN * pair.radius)),
+                    }
+                    let kept = slot.as_ref().expect("set just above");
+                    Box::new(FaceSurface::new(faces, boundary, x).kept(kept))
+                }
+                _ => master::surface(side, x),
+            };
             for &s in &side.slaves {
                 surface.detect(Slave::new(pi, si, s), pair.radius, rigid, out);
             }

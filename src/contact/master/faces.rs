@@ -455,8 +455,6 @@ pub struct KeptFaces {
     /// The positions of `topology.nodes` the tree was built at.
     base: Vec<V3>,
     margin: f64,
-    /// Trees built, for the record.
-    builds: usize,
 }
 
 impl KeptFaces {
@@ -470,7 +468,6 @@ impl KeptFaces {
             tree,
             base,
             margin,
-            builds: 1,
         }
     }
 
@@ -488,13 +485,7 @@ impl KeptFaces {
                 *b = x.at::<3>(n);
             }
             self.tree = face_tree(faces, |n| std::iter::once(x.at::<3>(n)), self.margin);
-            self.builds += 1;
         }
-    }
-
-    /// How many times the tree was built.
-    pub fn builds(&self) -> usize {
-        self.builds
     }
 }
 
