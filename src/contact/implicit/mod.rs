@@ -186,6 +186,14 @@ impl<'m> ContactCorrection<'m> {
                 rigid::RIGID_DEPTH_TOLERANCES * self.setup.tol,
                 &self.start.rigid.beneath,
             );
+        } else {
+            // A solid's face masters: slaves that came around a master's edge.
+            self.start.rigid.beneath = super::master::faces::beneath_faces(
+                self.setup.pairs,
+                Positions::new(&self.start.x0, dim),
+                rigid::RIGID_DEPTH_TOLERANCES * self.setup.tol,
+                &self.start.rigid.beneath,
+            );
         }
         // The displacement h v the step is expected to make, by which the first
         // correction is linearised ahead (zero on the constrained dofs).

@@ -212,6 +212,15 @@ impl<'m> KinematicContact<'m> {
                 rigid::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
                 &previous,
             );
+        } else {
+            // Slaves that came around a face master's edge pass beside it.
+            self.x = super::positions(self.model, u);
+            self.rigid.beneath = super::master::faces::beneath_faces(
+                &self.model.contacts,
+                Positions::new(&self.x, 3),
+                rigid::RIGID_DEPTH_TOLERANCES * self.model.analysis.contact.tolerance,
+                &self.rigid.beneath,
+            );
         }
         self.collisions(u, v, h);
         if !self.rows.is_empty() {

@@ -533,6 +533,71 @@ impl<'a> FaceSurface<'a> {
         self
     }
 
+    /// The faces within `r` of slave `s` with their projections, and the nearest
+    /// (interior over boundary on a tie, then by index, so the choice does not depend
+    /// on the tree's order).
+    #[allow(clippy::type_complexity)]
+    fn nearest(&self, s: usize, r: f64) -> (Vec<(usize, Projection)>, Option<(usize, Projection)>) {
+        let faces = self.faces;
+        let x = |n: usize| self.x(n);
+        let tree = match self.kept {
+            Some(k) => &k.tree,
+            None => self
+                .tree
+                .get_or_init(|| face_tree(faces, |n| std::iter::once(x(n)), 0.0)),
+        };
+        let p = x(s);
+        let reach = AABB::from_corners(
+            [p[0] - r, p[1] - r, p[2] - r],
+            [p[0] + r, p[1] + r, p[2] + r],
+        );
+        let mut near: Vec<(usize, Projection)> = Vec::new();
+        for hit in tree.locate_in_envelope_intersecting(reach) {
+            let f = &faces[hit.data];
+            if f.corners().contains(&s) {
+                continue;
+            }
+            if let Some(pr) = project(p, f, &x) {
+                if pr.d2 <= r * r {
+                    near.push((hit.data, pr));
+                }
+            }
+        }
+        let rank = |(k, pr): &(usize, Projection)| {
+            (pr.d2, !matches!(pr.region, Region::Interior { .. }), *k)
+        };
+        let best = near
+            .iter()
+            .min_by(|a, b| {
+                let (ra, rb) = (rank(a), rank(b));
+                if ra.0 < rb.0 * (1.0 - 1e-12) {
+                    std::cmp::Ordering::Less
+                } else if rb.0 < ra.0 * (1.0 - 1e-12) {
+                    std::cmp::Ordering::Greater
+                } else {
+                    (ra.1, ra.2).cmp(&(rb.1, rb.2))
+                }
+            })
+            .copied();
+        (near, best)
+    }
+
+    /// Whether slave `s` lies below the surface's level by more than `depth` (along
+    /// its nearest face's normal, within `r`) and either beyond the set's boundary or
+    /// passed over already (`before`): a node that came around the master's edge,
+    /// beside its end face, which a row would fling up onto the surface in one step
+    /// (the face set's form of the rigid line's rule, [`super::rigid::beneath_rigid`]).
+    pub fn passed_over(&self, s: usize, r: f64, depth: f64, before: bool) -> bool {
+        let x = |n: usize| self.x(n);
+        let Some((k, pr)) = self.nearest(s, r).1 else {
+            return false;
+        };
+        let p = x(s);
+        let gap = dot(sub(p, pr.point), pr.normal);
+        gap < -depth
+            && (before || beyond_boundary((self.edges, &self.rim), p, &self.faces[k], &pr, &x))
+    }
+
     fn x(&self, n: usize) -> V3 {
         self.x.at::<3>(n)
     }
@@ -589,52 +654,16 @@ fn triangles(face: &Face) -> &'static [[usize; 3]] {
 }
 
 impl MasterSurface for FaceSurface<'_> {
-    fn detect(&self, slave: Slave, r: f64, _: &RigidHistory, out: &mut Vec<Candidate>) {
+    fn detect(&self, slave: Slave, r: f64, rigid: &RigidHistory, out: &mut Vec<Candidate>) {
+        if rigid.is_beneath(slave) {
+            return;
+        }
         let faces = self.faces;
         let x = |n: usize| self.x(n);
-        let tree = match self.kept {
-            Some(k) => &k.tree,
-            None => self
-                .tree
-                .get_or_init(|| face_tree(faces, |n| std::iter::once(x(n)), 0.0)),
-        };
         let s = slave.node;
         let p = x(s);
-        let reach = AABB::from_corners(
-            [p[0] - r, p[1] - r, p[2] - r],
-            [p[0] + r, p[1] + r, p[2] + r],
-        );
-        let mut near: Vec<(usize, Projection)> = Vec::new();
-        for hit in tree.locate_in_envelope_intersecting(reach) {
-            let f = &faces[hit.data];
-            if f.corners().contains(&s) {
-                continue;
-            }
-            if let Some(pr) = project(p, f, &x) {
-                if pr.d2 <= r * r {
-                    near.push((hit.data, pr));
-                }
-            }
-        }
-        // The nearest face (interior over boundary on a tie, then by index, so the
-        // choice does not depend on the tree's order).
-        let rank = |(k, pr): &(usize, Projection)| {
-            (pr.d2, !matches!(pr.region, Region::Interior { .. }), *k)
-        };
-        let Some(best) = near
-            .iter()
-            .min_by(|a, b| {
-                let (ra, rb) = (rank(a), rank(b));
-                if ra.0 < rb.0 * (1.0 - 1e-12) {
-                    std::cmp::Ordering::Less
-                } else if rb.0 < ra.0 * (1.0 - 1e-12) {
-                    std::cmp::Ordering::Greater
-                } else {
-                    (ra.1, ra.2).cmp(&(rb.1, rb.2))
-                }
-            })
-            .copied()
-        else {
+        let (near, best) = self.nearest(s, r);
+        let Some(best) = best else {
             return;
         };
         let (k, pr) = best;
@@ -700,7 +729,10 @@ impl MasterSurface for FaceSurface<'_> {
         )
     }
 
-    fn crossing(&self, slave: Slave, start: Positions, _: &RigidHistory) -> Option<Candidate> {
+    fn crossing(&self, slave: Slave, start: Positions, rigid: &RigidHistory) -> Option<Candidate> {
+        if rigid.is_beneath(slave) {
+            return None;
+        }
         let x0 = |n: usize| start.at::<3>(n);
         let x1 = |n: usize| self.x(n);
         let faces = self.faces;
@@ -740,8 +772,11 @@ impl MasterSurface for FaceSurface<'_> {
         v: Positions,
         h: f64,
         r: f64,
-        _: &RigidHistory,
+        rigid: &RigidHistory,
     ) -> Option<Impact> {
+        if rigid.is_beneath(slave) {
+            return None;
+        }
         let faces = self.faces;
         let at = |n: usize| self.x(n);
         let vel = |n: usize| v.at::<3>(n);
@@ -787,6 +822,39 @@ impl MasterSurface for FaceSurface<'_> {
         }
         best
     }
+}
+
+/// The slaves of face masters that came around a master's edge: at the geometry
+/// `x` (committed: the start of a step) they lie below the face set's level by more
+/// than `depth`, and either beyond its boundary or already so in `previous` (the last
+/// step's list), sorted. As a rigid line's ([`super::rigid::beneath_rigid`]): a
+/// slave past a master's edge is free and may sink beside the master's end face (a
+/// beam rotating over the edge of a support); a row would fling it up onto the
+/// surface in one step when it comes back over the edge (benchmark 2 as solids,
+/// one way: `D_contact` −16 `E_kin⁰`, theory/benchmarks.md). Such a slave stays
+/// passed over until it rises above the level again.
+pub fn beneath_faces(
+    pairs: &[crate::model::ContactPair],
+    x: Positions,
+    depth: f64,
+    previous: &[Slave],
+) -> Vec<Slave> {
+    let mut out = Vec::new();
+    for (pi, pair) in pairs.iter().enumerate() {
+        for (si, side) in pair.sides.iter().enumerate() {
+            if let crate::model::Master::Faces { faces, boundary } = &side.master {
+                let surface = FaceSurface::new(faces, boundary, x);
+                for &s in &side.slaves {
+                    let key = Slave::new(pi, si, s);
+                    let before = previous.binary_search(&key).is_ok();
+                    if surface.passed_over(s, pair.radius, depth, before) {
+                        out.push(key);
+                    }
+                }
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

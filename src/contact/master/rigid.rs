@@ -28,11 +28,12 @@ pub fn within_ends(xi: f64) -> bool {
     (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi)
 }
 
-/// What a step knows of its rigid lines' slaves from the committed state, as sorted
-/// lists.
+/// What a step knows of its rigid lines' slaves (and a solid's face masters',
+/// [`super::faces::beneath_faces`]) from the committed state, as sorted lists.
 #[derive(Clone, Debug, Default)]
 pub struct RigidHistory {
-    /// Slaves that came around a line's end ([`beneath_rigid`]): not candidates.
+    /// Slaves that came around a line's end ([`beneath_rigid`]) or a face set's edge
+    /// ([`super::faces::beneath_faces`]): not candidates.
     pub beneath: Vec<Slave>,
     /// Slaves the line held at the end of the last step: candidates even a little
     /// beyond the line's ends (within the pair's radius), so that a slave at the very
@@ -42,7 +43,8 @@ pub struct RigidHistory {
 }
 
 impl RigidHistory {
-    fn beneath(&self, s: Slave) -> bool {
+    /// Whether slave `s` is passed over ([`RigidHistory::beneath`]).
+    pub fn is_beneath(&self, s: Slave) -> bool {
         self.beneath.binary_search(&s).is_ok()
     }
 
@@ -170,7 +172,7 @@ impl<'a> RigidLine<'a> {
 
 impl MasterSurface for RigidLine<'_> {
     fn detect(&self, slave: Slave, reach: f64, rigid: &RigidHistory, out: &mut Vec<Candidate>) {
-        if rigid.beneath(slave) {
+        if rigid.is_beneath(slave) {
             return;
         }
         let (gap, xi) = self.gap_and_along(self.x.at::<2>(slave.node));
@@ -189,7 +191,7 @@ impl MasterSurface for RigidLine<'_> {
         let ((g0, _), (g1, along1)) = (self.gap_and_along(p0), self.gap_and_along(p1));
         // Moving into the line and behind it at the end (a slave resting on it
         // starts at a gap of round-off, of either sign).
-        if !(g1 < 0.0 && g1 < g0) || rigid.beneath(slave) {
+        if !(g1 < 0.0 && g1 < g0) || rigid.is_beneath(slave) {
             return None;
         }
         let c = if g0 > 0.0 { g0 / (g0 - g1) } else { 0.0 };
@@ -206,7 +208,7 @@ impl MasterSurface for RigidLine<'_> {
         reach: f64,
         rigid: &RigidHistory,
     ) -> Option<Impact> {
-        if rigid.beneath(slave) {
+        if rigid.is_beneath(slave) {
             return None;
         }
         let n = self.n;
