@@ -1012,7 +1012,8 @@ fn benchmark_2_as_a_solid_deflects_as_the_plane_and_its_contact_does_no_work() {
     };
     let same = |t: &str| t.to_string();
     let plane = peak("rc_beam_punch.toml", &same);
-    let edits: [(&str, &dyn Fn(&str) -> String); 2] = [("both ways", &same), ("one way", &one_way)];
+    type Edit<'a> = &'a dyn Fn(&str) -> String;
+    let edits: [(&str, Edit); 2] = [("both ways", &same), ("one way", &one_way)];
     for (what, edit) in edits {
         let solid = peak("rc_beam_punch_solid.toml", edit);
         eprintln!("peak deflection: solid ({what}) {solid:e} m, plane {plane:e} m");
