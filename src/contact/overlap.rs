@@ -66,7 +66,7 @@ pub fn deepest(mesh: &Mesh, pairs: &[ContactPair], tolerance: f64) -> Option<Ove
                         faces
                             .iter()
                             .filter_map(|f| {
-                                super::master::faces::project(p, f, &|n| mesh.coords[n])
+                                super::master::projection::project(p, f, &|n| mesh.coords[n])
                             })
                             .map(|pr| pr.d2)
                             .fold(f64::INFINITY, f64::min)
@@ -227,7 +227,7 @@ impl Facet {
                 .1
             }
             Facet::Face(f) => {
-                super::master::faces::project(p, f, &x).map_or(f64::INFINITY, |pr| pr.d2)
+                super::master::projection::project(p, f, &x).map_or(f64::INFINITY, |pr| pr.d2)
             }
         }
     }

@@ -16,6 +16,7 @@
 //! first asked for, so a surface asked for one thing pays for that one.
 
 pub mod faces;
+pub mod projection;
 pub mod rigid;
 pub mod segments;
 
