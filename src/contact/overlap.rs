@@ -1,6 +1,6 @@
 //! Initial overlaps at any depth, at the reference geometry.
 //!
-//! Detection ([`super::detect`], [`super::faces`]) looks for masters within a pair's
+//! Detection ([`super::detect`], [`super::master`]) looks for masters within a pair's
 //! search radius, about one element: a slave sunk deeper into its master's body has
 //! no candidate and would sit there with no force. This test needs no radius. A slave
 //! node of a deformable pair overlaps when it lies inside an element of the master's

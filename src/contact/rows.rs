@@ -2,8 +2,8 @@
 //! `g = n · Σ_k w_k x_k` over a few nodes `k` with weights `w_k` (slave weights
 //! summing to 1, master ones to −1) along a normal `n`, and its tangential twins
 //! along the tangents of the contact plane: in the plane the one `t = (n_y, −n_x)`,
-//! in a solid two orthonormal `t₁, t₂` ([`super::faces`]). Node to segment
-//! ([`super::detect`]), node to face ([`super::faces`]) and mortar
+//! in a solid two orthonormal `t₁, t₂` ([`crate::geometry::tangents`]). Node to segment
+//! ([`super::master::segments`]), node to face ([`super::master::faces`]) and mortar
 //! ([`super::mortar`]) build them, the implicit correction, friction and the ledger
 //! read them the same way. Here too the sparse gap matrices of a set of rows.
 
