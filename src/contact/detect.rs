@@ -10,7 +10,7 @@
 //! unseen"; theory/contact3d.md).
 
 use super::master::faces::{FaceSurface, KeptFaces};
-use super::master::{self, rigid::RigidHistory, MasterSurface, Positions};
+use super::master::{self, rigid::EdgeHistory, MasterSurface, Positions};
 use super::rows::Candidate;
 use super::state::Slave;
 use crate::model::{ContactPair, Formulation, Master, SlaveSurface};
@@ -36,7 +36,7 @@ pub struct Kept {
 pub fn detect(
     pairs: &[ContactPair],
     x: Positions,
-    rigid: &RigidHistory,
+    rigid: &EdgeHistory,
     mut kept: Option<&mut Kept>,
     out: &mut Vec<Candidate>,
 ) {
@@ -108,7 +108,7 @@ pub fn crossed(
     pairs: &[ContactPair],
     x0: Positions,
     x1: Positions,
-    rigid: &RigidHistory,
+    rigid: &EdgeHistory,
     out: &mut Vec<Candidate>,
 ) {
     let before = out.len();

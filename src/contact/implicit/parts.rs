@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 
 use crate::contact::compliance::Compliance;
-use crate::contact::master::rigid::RigidHistory;
+use crate::contact::master::rigid::EdgeHistory;
 use crate::contact::qp::DualQp;
 use crate::contact::rows::Candidate;
 use crate::contact::state::Key;
@@ -43,7 +43,7 @@ pub(super) struct StepStart {
     pub(super) lead: Vec<f64>,
     pub(super) lead_all: Vec<f64>,
     /// What the committed state knows of the rigid lines' slaves.
-    pub(super) rigid: RigidHistory,
+    pub(super) rigid: EdgeHistory,
 }
 
 /// The multipliers and the active set they make: what one QP hands to the next

@@ -140,7 +140,7 @@ pub struct KinematicContact<'m> {
     dual: DualQp,
     step: KinematicStats,
     total: KinematicStats,
-    rigid: rigid::RigidHistory,
+    rigid: rigid::EdgeHistory,
     /// Node positions (workspace).
     x: Vec<f64>,
 }

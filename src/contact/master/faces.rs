@@ -31,7 +31,7 @@ use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 
 pub use super::projection::{project, Projection, Region};
-use super::rigid::{RigidHistory, RIGID_END_MARGIN};
+use super::rigid::{EdgeHistory, RIGID_END_MARGIN};
 use super::{Impact, MasterSurface, Positions};
 use crate::contact::collision::node_triangle;
 use crate::contact::rows::{Candidate, Contactee};
@@ -451,7 +451,7 @@ fn triangles(face: &Face) -> &'static [[usize; 3]] {
 }
 
 impl MasterSurface for FaceSurface<'_> {
-    fn detect(&self, slave: Slave, r: f64, rigid: &RigidHistory, out: &mut Vec<Candidate>) {
+    fn detect(&self, slave: Slave, r: f64, rigid: &EdgeHistory, out: &mut Vec<Candidate>) {
         if rigid.is_beneath(slave) {
             return;
         }
@@ -526,7 +526,7 @@ impl MasterSurface for FaceSurface<'_> {
         )
     }
 
-    fn crossing(&self, slave: Slave, start: Positions, rigid: &RigidHistory) -> Option<Candidate> {
+    fn crossing(&self, slave: Slave, start: Positions, rigid: &EdgeHistory) -> Option<Candidate> {
         if rigid.is_beneath(slave) {
             return None;
         }
@@ -569,7 +569,7 @@ impl MasterSurface for FaceSurface<'_> {
         v: Positions,
         h: f64,
         r: f64,
-        rigid: &RigidHistory,
+        rigid: &EdgeHistory,
     ) -> Option<Impact> {
         if rigid.is_beneath(slave) {
             return None;
@@ -717,5 +717,74 @@ mod tests {
         detect(&[side(vec![6], faces)], &x, &mut out);
         assert_eq!(out.len(), 1, "{out:?}");
         assert!(out[0].normal[0].abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_kept_tree_gives_the_rows_of_a_fresh_one_as_the_geometry_moves() {
+        // The valley of two faces, its slave over the common edge, reshaped and carried
+        // step by step farther than the kept tree's margin: detection with the kept
+        // tree and topology gives the same rows, bit for bit, as detection without.
+        let faces = vec![
+            Face::quadrilateral([0, 1, 2, 3]),
+            Face::quadrilateral([1, 0, 4, 5]),
+        ];
+        let pairs = [side(vec![6], faces)];
+        let mut kept = crate::contact::detect::Kept::default();
+        let (mut with, mut without) = (Vec::new(), Vec::new());
+        for k in 0..40 {
+            let (rise, shift) = (0.2 - 0.01 * k as f64, 0.003 * k as f64);
+            let x: Vec<f64> = [
+                [0.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, rise, 1.0],
+                [1.0, rise, 0.0],
+                [-1.0, rise, 0.0],
+                [-1.0, rise, 1.0],
+                [shift, 1e-9 + 0.001 * k as f64, 0.5],
+            ]
+            .iter()
+            // The whole valley carried along x, past the tree's boxes.
+            .flat_map(|p| [p[0] + 0.5 * k as f64, p[1], p[2]])
+            .collect();
+            let x = Positions::new(&x, 3);
+            let none = EdgeHistory::default();
+            crate::contact::detect::detect(&pairs, x, &none, Some(&mut kept), &mut with);
+            crate::contact::detect::detect(&pairs, x, &none, None, &mut without);
+            assert!(!without.is_empty(), "step {k}");
+            assert_eq!(with, without, "step {k}");
+        }
+    }
+
+    #[test]
+    fn a_slave_that_came_around_a_face_sets_edge_is_passed_over() {
+        // One face y = 0 over 0 ≤ x, z ≤ 1 (normal +y); depth 1e-3.
+        let faces = [Face::quadrilateral([0, 1, 2, 3])];
+        let edges = boundary_edges(&faces);
+        let at = |slave: [f64; 3]| -> Vec<f64> {
+            [
+                [0.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 0.0, 1.0],
+                [1.0, 0.0, 0.0],
+                slave,
+            ]
+            .iter()
+            .flatten()
+            .copied()
+            .collect()
+        };
+        let passed = |slave: [f64; 3], before: bool| {
+            let x = at(slave);
+            FaceSurface::new(&faces, &edges, Positions::new(&x, 3))
+                .passed_over(4, 1.0, 1e-3, before)
+        };
+        // Beside the edge and below the level: passed over, whatever came before.
+        assert!(passed([1.01, -0.01, 0.5], false));
+        // Back over the face, still below: passed over only if it was.
+        assert!(passed([0.9, -0.01, 0.5], true));
+        assert!(!passed([0.9, -0.01, 0.5], false));
+        // Within the depth, or above the level: held again.
+        assert!(!passed([0.9, -0.5e-3, 0.5], true));
+        assert!(!passed([1.01, 0.01, 0.5], true));
     }
 }

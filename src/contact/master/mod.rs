@@ -23,7 +23,7 @@ pub mod segments;
 use super::rows::Candidate;
 use super::state::{Slave, Target};
 use crate::model::{ContactSide, Master};
-use rigid::RigidHistory;
+use rigid::EdgeHistory;
 
 /// Node positions of one geometry, `dim` coordinates per node, flat (the layout of
 /// the displacement vectors).
@@ -87,7 +87,7 @@ pub trait MasterSurface {
     /// Appends the candidates of `slave` at the surface's geometry within `reach`
     /// (detection's narrow phase): none when it is out of reach or beside the
     /// master, one for the nearest facet, two where a notch or valley holds it.
-    fn detect(&self, slave: Slave, reach: f64, rigid: &RigidHistory, out: &mut Vec<Candidate>);
+    fn detect(&self, slave: Slave, reach: f64, rigid: &EdgeHistory, out: &mut Vec<Candidate>);
 
     /// The nodes whose motion, with the slave's, decides whether a slave may have
     /// crossed the master unseen (a deformable master's); `None` for a rigid master,
@@ -96,7 +96,7 @@ pub trait MasterSurface {
 
     /// The candidate at the surface's geometry of a slave whose motion from `start`
     /// crossed the master within the step (the sweep), if it did.
-    fn crossing(&self, slave: Slave, start: Positions, rigid: &RigidHistory) -> Option<Candidate>;
+    fn crossing(&self, slave: Slave, start: Positions, rigid: &EdgeHistory) -> Option<Candidate>;
 
     /// The first impact of `slave` within a step of length `h` from the surface's
     /// geometry, every node moving at its velocity in `v` (the explicit path),
@@ -107,7 +107,7 @@ pub trait MasterSurface {
         v: Positions,
         h: f64,
         reach: f64,
-        rigid: &RigidHistory,
+        rigid: &EdgeHistory,
     ) -> Option<Impact>;
 }
 
@@ -126,7 +126,7 @@ pub(crate) mod tests {
     use crate::contact::rows::Candidate;
     use crate::model::ContactPair;
 
-    use super::rigid::RigidHistory;
+    use super::rigid::EdgeHistory;
     use super::Positions;
 
     /// [`crate::contact::detect::detect`] at the node positions `coords`, with the
@@ -134,7 +134,7 @@ pub(crate) mod tests {
     pub fn detect_with<const D: usize>(
         pairs: &[ContactPair],
         coords: &[[f64; D]],
-        rigid: &RigidHistory,
+        rigid: &EdgeHistory,
         out: &mut Vec<Candidate>,
     ) {
         let x: Vec<f64> = coords.iter().flatten().copied().collect();
@@ -147,6 +147,6 @@ pub(crate) mod tests {
         coords: &[[f64; D]],
         out: &mut Vec<Candidate>,
     ) {
-        detect_with(pairs, coords, &RigidHistory::default(), out);
+        detect_with(pairs, coords, &EdgeHistory::default(), out);
     }
 }

@@ -28,10 +28,11 @@ pub fn within_ends(xi: f64) -> bool {
     (-RIGID_END_MARGIN..=1.0 + RIGID_END_MARGIN).contains(&xi)
 }
 
-/// What a step knows of its rigid lines' slaves (and a solid's face masters',
-/// [`super::faces::beneath_faces`]) from the committed state, as sorted lists.
+/// What a step knows from the committed state of the slaves at its masters' edges:
+/// those that came around a rigid line's end or a face set's edge, and those a rigid
+/// line held, as sorted lists.
 #[derive(Clone, Debug, Default)]
-pub struct RigidHistory {
+pub struct EdgeHistory {
     /// Slaves that came around a line's end ([`beneath_rigid`]) or a face set's edge
     /// ([`super::faces::beneath_faces`]): not candidates.
     pub beneath: Vec<Slave>,
@@ -42,8 +43,8 @@ pub struct RigidHistory {
     pub held: Vec<Slave>,
 }
 
-impl RigidHistory {
-    /// Whether slave `s` is passed over ([`RigidHistory::beneath`]).
+impl EdgeHistory {
+    /// Whether slave `s` is passed over ([`EdgeHistory::beneath`]).
     pub fn is_beneath(&self, s: Slave) -> bool {
         self.beneath.binary_search(&s).is_ok()
     }
@@ -171,7 +172,7 @@ impl<'a> RigidLine<'a> {
 }
 
 impl MasterSurface for RigidLine<'_> {
-    fn detect(&self, slave: Slave, reach: f64, rigid: &RigidHistory, out: &mut Vec<Candidate>) {
+    fn detect(&self, slave: Slave, reach: f64, rigid: &EdgeHistory, out: &mut Vec<Candidate>) {
         if rigid.is_beneath(slave) {
             return;
         }
@@ -186,7 +187,7 @@ impl MasterSurface for RigidLine<'_> {
         None
     }
 
-    fn crossing(&self, slave: Slave, start: Positions, rigid: &RigidHistory) -> Option<Candidate> {
+    fn crossing(&self, slave: Slave, start: Positions, rigid: &EdgeHistory) -> Option<Candidate> {
         let (p0, p1) = (start.at::<2>(slave.node), self.x.at::<2>(slave.node));
         let ((g0, _), (g1, along1)) = (self.gap_and_along(p0), self.gap_and_along(p1));
         // Moving into the line and behind it at the end (a slave resting on it
@@ -206,7 +207,7 @@ impl MasterSurface for RigidLine<'_> {
         v: Positions,
         h: f64,
         reach: f64,
-        rigid: &RigidHistory,
+        rigid: &EdgeHistory,
     ) -> Option<Impact> {
         if rigid.is_beneath(slave) {
             return None;
@@ -262,7 +263,7 @@ impl<'a> RigidPlane<'a> {
 }
 
 impl MasterSurface for RigidPlane<'_> {
-    fn detect(&self, slave: Slave, reach: f64, _: &RigidHistory, out: &mut Vec<Candidate>) {
+    fn detect(&self, slave: Slave, reach: f64, _: &EdgeHistory, out: &mut Vec<Candidate>) {
         let gap = self.gap(self.x.at::<3>(slave.node));
         if gap * gap <= reach * reach {
             out.push(self.candidate(slave, gap));
@@ -273,7 +274,7 @@ impl MasterSurface for RigidPlane<'_> {
         None
     }
 
-    fn crossing(&self, slave: Slave, start: Positions, _: &RigidHistory) -> Option<Candidate> {
+    fn crossing(&self, slave: Slave, start: Positions, _: &EdgeHistory) -> Option<Candidate> {
         let (g0, g1) = (
             self.gap(start.at::<3>(slave.node)),
             self.gap(self.x.at::<3>(slave.node)),
@@ -287,7 +288,7 @@ impl MasterSurface for RigidPlane<'_> {
         v: Positions,
         h: f64,
         _: f64,
-        _: &RigidHistory,
+        _: &EdgeHistory,
     ) -> Option<Impact> {
         let (p, w) = (self.x.at::<3>(slave.node), v.at::<3>(slave.node));
         let g0 = self.gap(p);
@@ -348,7 +349,7 @@ mod tests {
             beneath_rigid(&pairs, |n| beyond[n], 5e-4, &[]),
             [Slave::new(0, 0, 1)]
         );
-        let mut rigid = RigidHistory {
+        let mut rigid = EdgeHistory {
             beneath,
             held: Vec::new(),
         };

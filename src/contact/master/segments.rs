@@ -27,7 +27,7 @@ use std::collections::HashMap;
 use rstar::primitives::{GeomWithData, Line, Rectangle};
 use rstar::{RTree, RTreeObject};
 
-use super::rigid::{within_ends, RigidHistory};
+use super::rigid::{within_ends, EdgeHistory};
 use super::{Impact, MasterSurface, Positions};
 use crate::contact::collision::node_segment;
 use crate::contact::rows::{Candidate, Contactee};
@@ -194,7 +194,7 @@ impl<'a> SegmentChain<'a> {
 }
 
 impl MasterSurface for SegmentChain<'_> {
-    fn detect(&self, slave: Slave, reach: f64, _: &RigidHistory, out: &mut Vec<Candidate>) {
+    fn detect(&self, slave: Slave, reach: f64, _: &EdgeHistory, out: &mut Vec<Candidate>) {
         let (segments, chain) = (self.segments, self.chain());
         let x = |n: usize| self.x(n);
         let s = slave.node;
@@ -271,7 +271,7 @@ impl MasterSurface for SegmentChain<'_> {
         Some(self.segments.iter().flatten().copied().collect())
     }
 
-    fn crossing(&self, slave: Slave, start: Positions, _: &RigidHistory) -> Option<Candidate> {
+    fn crossing(&self, slave: Slave, start: Positions, _: &EdgeHistory) -> Option<Candidate> {
         let x0 = |n: usize| start.at::<2>(n);
         let x1 = |n: usize| self.x(n);
         let tree = self.swept.get_or_init(|| {
@@ -318,7 +318,7 @@ impl MasterSurface for SegmentChain<'_> {
         v: Positions,
         h: f64,
         reach: f64,
-        _: &RigidHistory,
+        _: &EdgeHistory,
     ) -> Option<Impact> {
         let at = |n: usize| self.x(n);
         let vel = |n: usize| v.at::<2>(n);
