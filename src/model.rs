@@ -461,7 +461,9 @@ pub enum Formulation {
     /// shape function against the gap to the projected master.
     #[default]
     Mortar,
-    /// Each slave node against its closest master segment.
+    /// Each slave node against its closest master segment (in a solid, face;
+    /// `node_to_face` there reads the same).
+    #[serde(alias = "node_to_face")]
     NodeToSegment,
 }
 

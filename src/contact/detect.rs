@@ -13,6 +13,7 @@ use super::master::faces::{FaceSurface, KeptFaces};
 use super::master::{self, rigid::EdgeHistory, MasterSurface, Positions};
 use super::rows::Candidate;
 use super::state::Slave;
+use crate::mesh::Face;
 use crate::model::{ContactPair, Formulation, Master, SlaveSurface};
 
 /// How far (in units of a pair's search radius) a face master's nodes may move
@@ -26,6 +27,22 @@ pub const KEPT_MARGIN: f64 = 0.1;
 #[derive(Default)]
 pub struct Kept {
     sides: Vec<Option<KeptFaces>>,
+}
+
+impl Kept {
+    /// The kept tree of side `index` (pair order) with the master `faces`, made at
+    /// `x` (its margin a [`KEPT_MARGIN`] of `radius`) or refreshed for it.
+    fn refreshed(&mut self, index: usize, faces: &[Face], x: Positions, radius: f64) -> &KeptFaces {
+        if self.sides.len() <= index {
+            self.sides.resize_with(index + 1, || None);
+        }
+        let slot = &mut self.sides[index];
+        match slot {
+            Some(t) => t.refresh(faces, x),
+            None => *slot = Some(KeptFaces::new(faces, x, KEPT_MARGIN * radius)),
+        }
+        slot.as_ref().expect("set just above")
+    }
 }
 
 /// Candidates of every pair at the geometry `x`, appended to `out` (cleared first),
@@ -45,36 +62,56 @@ pub fn detect(
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
             side_index += 1;
-            let mortar = pair.formulation == Formulation::Mortar;
-            if let (true, SlaveSurface::Segments(slave_segments), Master::Segments(segments)) =
-                (mortar, &side.surface, &side.master)
-            {
+            let kept_faces = match (kept.as_deref_mut(), &side.master) {
+                (Some(k), Master::Faces { faces, .. }) => {
+                    Some(k.refreshed(side_index - 1, faces, x, pair.radius))
+                }
+                _ => None,
+            };
+            if pair.formulation == Formulation::Mortar {
                 // Rows are sized for the initial geometry (validation); a mesh sliding
                 // far enough to bring more master nodes under one slave node keeps
                 // the first `ROW_NODES`.
-                super::mortar::rows(
-                    (pi, si),
-                    &side.slaves,
-                    slave_segments,
-                    segments,
-                    pair.radius,
-                    &|n| x.at::<2>(n),
-                    out,
-                );
-                continue;
+                match (&side.surface, &side.master) {
+                    (SlaveSurface::Segments(slave_segments), Master::Segments(segments)) => {
+                        super::mortar::segment_rows(
+                            (pi, si),
+                            &side.slaves,
+                            slave_segments,
+                            segments,
+                            pair.radius,
+                            &|n| x.at::<2>(n),
+                            out,
+                        );
+                        continue;
+                    }
+                    (SlaveSurface::Faces(slave_faces), Master::Faces { faces, .. }) => {
+                        let fresh;
+                        let tree = match kept_faces {
+                            Some(t) => t,
+                            None => {
+                                fresh = KeptFaces::new(faces, x, KEPT_MARGIN * pair.radius);
+                                &fresh
+                            }
+                        };
+                        super::mortar::face_rows(
+                            (pi, si),
+                            &side.slaves,
+                            slave_faces,
+                            faces,
+                            tree,
+                            pair.radius,
+                            x,
+                            out,
+                        );
+                        continue;
+                    }
+                    _ => {}
+                }
             }
-            let surface: Box<dyn MasterSurface + '_> = match (kept.as_deref_mut(), &side.master) {
+            let surface: Box<dyn MasterSurface + '_> = match (kept_faces, &side.master) {
                 (Some(k), Master::Faces { faces, boundary }) => {
-                    if k.sides.len() < side_index {
-                        k.sides.resize_with(side_index, || None);
-                    }
-                    let slot = &mut k.sides[side_index - 1];
-                    match slot {
-                        Some(t) => t.refresh(faces, x),
-                        None => *slot = Some(KeptFaces::new(faces, x, KEPT_MARGIN * pair.radius)),
-                    }
-                    let kept = slot.as_ref().expect("set just above");
-                    Box::new(FaceSurface::new(faces, boundary, x).kept(kept))
+                    Box::new(FaceSurface::new(faces, boundary, x).kept(k))
                 }
                 _ => master::surface(side, x),
             };

@@ -36,7 +36,7 @@ use rothe::run::{run, run_kept, Hooks, RunOptions};
 /// the iterations themselves must not change. Runs whose contact forces come from
 /// Clarabel (the cone programs of friction, the explicit impacts)
 /// agree to its tolerance on the scaled data (1e-9), so to 1e-8 of a column.
-const CASES: [(&str, f64); 14] = [
+const CASES: [(&str, f64); 15] = [
     ("elastic_cantilever", 1e-10),
     ("damped_lumped_gravity", 1e-10),
     ("sls_wave_bar", 1e-10),
@@ -50,6 +50,7 @@ const CASES: [(&str, f64); 14] = [
     ("solid_elastic_cantilever", 1e-10),
     ("solid_rankine_hill_cantilever", 1e-9),
     ("solid_contact_friction", 1e-8),
+    ("solid_contact_mortar", 1e-8),
     ("solid_explicit_drop", 1e-8),
 ];
 

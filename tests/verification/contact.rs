@@ -486,7 +486,7 @@ fn friction_and_formulation_keys_are_validated() {
             "not a solver for runs",
         ),
         (
-            base.replace("divisions = [12, 6]", "divisions = [240, 6]"),
+            base.replace("divisions = [12, 6]", "divisions = [480, 6]"),
             "contact[0].formulation",
             "too fine for mortar",
         ),

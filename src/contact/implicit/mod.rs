@@ -306,7 +306,8 @@ impl<'m> ContactCorrection<'m> {
     }
 
     /// The area (m²) a row's force spreads over: the covered length of a mortar row
-    /// times the slave body's thickness, else the node's tributary area.
+    /// times the slave body's thickness (a solid's covered area: its thickness is
+    /// 1), else the node's tributary area.
     fn area_of(&self, c: &Candidate) -> f64 {
         if c.length > 0.0 {
             let mesh = &self.setup.model.mesh;

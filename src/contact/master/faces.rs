@@ -284,6 +284,16 @@ impl KeptFaces {
             self.tree = face_tree(faces, |n| std::iter::once(x.at::<3>(n)), self.margin);
         }
     }
+
+    /// The faces whose kept boxes meet the box from `lo` to `hi`, by index in
+    /// increasing order, into `out` (cleared first): every face that reaches into
+    /// the box now, and a few more (the mortar rows' broad phase).
+    pub fn within(&self, lo: V3, hi: V3, out: &mut Vec<usize>) {
+        out.clear();
+        let b = AABB::from_corners(lo, hi);
+        out.extend(self.tree.locate_in_envelope_intersecting(b).map(|h| h.data));
+        out.sort_unstable();
+    }
 }
 
 /// A set of faces at a geometry.

@@ -1,36 +1,17 @@
-//! Mortar (segment-to-segment) gap rows: one weighted gap per slave node.
-//!
-//! For slave node `j` with the linear shape function `N_j` of the slave surface,
-//! the weighted gap is
-//!
-//! `g̃_j = ∫ N_j n_j · (x_s(ξ) − x_m(η(ξ))) ds = n_j · (Σ_k D_jk x_k − Σ_l M_jl x_l)`,
-//!
-//! `D_jk = ∫ N_j N_k ds` over the slave nodes `k`, `M_jl = ∫ N_j N̂_l ds` over the
-//! master nodes `l` (their shape functions carried to the slave by the projection),
-//! both over the part of the slave surface that faces a master segment. Each row is
-//! divided by `W_j = Σ_l M_jl = Σ_k D_jk` (the covered integral of `N_j`), so its gap
-//! is in metres (a weighted average of the gap over the support of `N_j`), its
-//! slave weights sum to 1 and its master weights to −1, and its multiplier is the
-//! force the node's share of the interface carries (`λ_j / (W_j t)` is the
-//! pressure). A uniform pressure `p` then gives every slave node `p t ∫ N_k` and every
-//! master node `p t ∫ N̂_l`: the consistent loads of both sides, whatever the meshes
-//! (the contact patch test, `theory/contact.md`).
+//! Mortar in the plane: segment to segment ([`super`] has the weighted gap).
 //!
 //! Projection: per slave segment, along its own normal (the master's ends are
 //! projected orthogonally onto the slave segment's line, and between them the map
 //! from slave to master coordinate is affine), so the products `N_j N̂_l` are
 //! quadratic in the slave coordinate and two Gauss points integrate them exactly.
-//! The row's normal is the master's outward normal averaged with the row's own master
-//! weights (the normalised `Σ_l ∫ N_j n_m ds` over the master segments the node's
-//! support faces), so that, as for node-to-segment, it points from the
-//! master towards the slave, and a frictionless force slides along the master
-//! without working on it (the slave's nodal normal instead made a tilted master's
-//! sliding slave book `D_contact` falling by 2 mJ a step in benchmark 2).
+//! The row's normal is the master's (the slave's nodal normal instead made a tilted
+//! master's sliding slave book `D_contact` falling by 2 mJ a step in benchmark 2).
 
 use rstar::primitives::{GeomWithData, Line, Rectangle};
 use rstar::{RTree, RTreeObject};
 
-use super::rows::{Candidate, Contactee, Weights};
+use super::{finish, Gathered};
+use crate::contact::rows::Candidate;
 
 /// Outward unit normal of a segment with its body on the left, and its length (as
 /// `hypot`, whose last bits the mortar rows have always had; detection's
@@ -45,31 +26,11 @@ fn outward(a: [f64; 2], b: [f64; 2]) -> ([f64; 2], f64) {
     }
 }
 
-/// The least covered fraction of a slave node's shape-function integral for the node
-/// to get a row: below it the node sees the master over a sliver of its support
-/// only (a master edge ending just inside its segment), too little to weigh a gap
-/// on. A millionth: far below any fraction a real overlap leaves.
-pub const COVERED_FRACTION: f64 = 1e-6;
-
-/// What one slave node gathers over its segments.
-#[derive(Clone, Copy)]
-struct Gathered {
-    weights: Weights,
-    /// `W_j`, the covered integral of `N_j`.
-    covered: f64,
-    /// `∫ N_j ds` over the node's whole support.
-    total: f64,
-    /// The master's outward normals weighted as the row's master weights.
-    master_normal: [f64; 2],
-    /// Entries that did not fit the row ([`super::rows::ROW_NODES`]).
-    overflow: usize,
-}
-
 /// The mortar rows of one side (`key`: pair and side) against the master
 /// `segments` at the geometry `x`, appended to `out` in slave order. `slaves` are the
 /// side's slave nodes (sorted), `slave_segments` its slave surface; master segments
 /// farther than `radius` from a slave segment are not looked at. Returns the most
-/// nodes a row needed (more than [`super::rows::ROW_NODES`] means rows were cut:
+/// nodes a row needed (more than [`crate::contact::rows::ROW_NODES`] means rows were cut:
 /// validation refuses such a pair at the initial geometry).
 #[allow(clippy::too_many_arguments)]
 pub fn rows<X: Fn(usize) -> [f64; 2]>(
@@ -81,16 +42,7 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
     x: &X,
     out: &mut Vec<Candidate>,
 ) -> usize {
-    let mut gathered = vec![
-        Gathered {
-            weights: Weights::EMPTY,
-            covered: 0.0,
-            total: 0.0,
-            master_normal: [0.0, 0.0],
-            overflow: 0,
-        };
-        slaves.len()
-    ];
+    let mut gathered = Gathered::<2>::empty(slaves.len());
     let slot = |n: usize| slaves.binary_search(&n).ok();
     let tree = RTree::bulk_load(
         segments
@@ -172,31 +124,11 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
             }
         }
     }
-    let (pair, side) = key;
-    let needed = gathered
-        .iter()
-        .map(|g| g.weights.len() + g.overflow)
-        .max()
-        .unwrap_or(0);
-    for (j, gj) in gathered.iter_mut().enumerate() {
-        if gj.covered <= COVERED_FRACTION * gj.total || gj.total == 0.0 {
-            continue;
-        }
-        let l = gj.master_normal[0].hypot(gj.master_normal[1]);
-        if l == 0.0 {
-            continue;
-        }
-        let n = [gj.master_normal[0] / l, gj.master_normal[1] / l];
-        gj.weights.scale(1.0 / gj.covered);
-        let slave = super::state::Slave::new(pair, side, slaves[j]);
-        let mut c = Candidate::nodal::<2>(slave, Contactee::Mortar, &[], 0.0, 0.0, n);
-        c.weights = gj.weights;
-        c.length = gj.covered;
-        let p = c.combine(x);
-        c.gap = p[0] * n[0] + p[1] * n[1];
-        out.push(c);
-    }
-    needed
+    let unit = |m: [f64; 2]| {
+        let l = m[0].hypot(m[1]);
+        (l != 0.0).then(|| [m[0] / l, m[1] / l])
+    };
+    finish(key, slaves, &mut gathered, unit, x, out)
 }
 
 #[cfg(test)]
