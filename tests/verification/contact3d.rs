@@ -811,6 +811,15 @@ fn a_solid_contact_pair_is_validated() {
         "origin = [0.15, 0.3011, 0.1]",
         "origin = [0.15, 0.295, 0.1]",
     ));
+    assert!(e.contains("overlap") && e.contains("behind the master surface near its node"), "{e}");
+    // Node to face names the face.
+    let e = refusal(
+        &with(
+            "origin = [0.15, 0.3011, 0.1]",
+            "origin = [0.15, 0.295, 0.1]",
+        )
+        .replace(master, &format!("{master}\nformulation = \"node_to_face\"")),
+    );
     assert!(e.contains("overlap") && e.contains("master face"), "{e}");
     // In the plane a rigid plane is refused naming it.
     let plane = r#"

@@ -279,7 +279,16 @@ fn initial_overlap(model: &Model) -> Result<()> {
         crate::contact::rows::Contactee::Segment { nodes, .. } => {
             format!("the master segment of nodes {} and {}", nodes[0], nodes[1])
         }
-        crate::contact::rows::Contactee::Mortar => "the master surface (mortar)".to_string(),
+        crate::contact::rows::Contactee::Mortar => {
+            // The master node the weighted gap leans on most.
+            let near = c
+                .weights
+                .iter()
+                .filter(|&(_, w)| w < 0.0)
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or(String::new(), |(n, _)| format!(" near its node {n}"));
+            format!("the master surface{near} (mortar)")
+        }
         crate::contact::rows::Contactee::Face { nodes, .. } => format!(
             "the master face of nodes {}",
             nodes
