@@ -2,8 +2,9 @@
 //! (`examples/benchmarks/two_blocks_solid.toml`, both elastic, `h = 1e-7` s, the
 //! plane bench's step, `benches/contact.rs`) at
 //! the mesh sizes 0.1 m and 0.05 m: one backward-Euler step in persistent contact
-//! (node to face, condensed QP), the same with Coulomb friction (μ = 0.4, the
-//! steel's corner edges free), and the same step of the same state without contact.
+//! (node to face and mortar, condensed QP), node to face with Coulomb friction
+//! (μ = 0.4, the steel's corner edges free), and the same step of the same state
+//! without contact.
 //! The steel starts a micrometre above the concrete and is marched into contact
 //! (1000 steps) before the timed steps, each of which starts from that state.
 
@@ -16,15 +17,15 @@ use rothe::time::{Integrator, State};
 /// Steps marched before the timed ones: 0.1 ms, well into the contact.
 const WARM_UP: usize = 1000;
 
-/// `Some(μ)`: contact with Coulomb's `μ`; `None`: no contact.
-fn scenario(size: f64, contact: Option<f64>) -> Model {
+/// `Some((μ, formulation))`: contact with Coulomb's `μ`; `None`: no contact.
+fn scenario(size: f64, contact: Option<(f64, &str)>) -> Model {
     let pair = match contact {
-        Some(mu) => format!(
-            "[[contact]]\nname = \"impact\"\nslave = \"steel.bottom\"\nmaster = \"concrete.top\"\nmu = {mu:e}\n"
+        Some((mu, formulation)) => format!(
+            "[[contact]]\nname = \"impact\"\nslave = \"steel.bottom\"\nmaster = \"concrete.top\"\nmu = {mu:e}\nformulation = \"{formulation}\"\n"
         ),
         None => String::new(),
     };
-    let corners = if contact.is_some_and(|mu| mu > 0.0) {
+    let corners = if contact.is_some_and(|(mu, _)| mu > 0.0) {
         ""
     } else {
         r#"
@@ -94,12 +95,13 @@ fn steps(c: &mut Criterion) {
     for (size, label) in [(0.1, "0.1m"), (0.05, "0.05m")] {
         let mut state = None;
         for (name, enforced) in [
-            ("node_to_face", Some(0.0)),
+            ("node_to_face", Some((0.0, "node_to_face"))),
             ("without_contact", None),
-            ("node_to_face_friction", Some(0.4)),
+            ("mortar", Some((0.0, "mortar"))),
+            ("node_to_face_friction", Some((0.4, "node_to_face"))),
         ] {
             let model = scenario(size, enforced);
-            // The step without contact starts from the frictionless state.
+            // The step without contact starts from node to face's frictionless state.
             if enforced.is_some() {
                 state = Some(in_contact(&model));
             }
@@ -125,8 +127,15 @@ fn steps(c: &mut Criterion) {
 /// ms): forming `W`, the QP, detection, the solves, and the counts.
 fn split() {
     eprintln!("\nsolid contact step, per step (ms): W | QP | detection | solves | solves/step | QPs/step | rows/QP | cone programs/QP");
-    for (size, mu) in [(0.1, 0.0), (0.1, 0.4), (0.05, 0.0), (0.05, 0.4)] {
-        let model = scenario(size, Some(mu));
+    for (size, mu, formulation) in [
+        (0.1, 0.0, "node_to_face"),
+        (0.1, 0.0, "mortar"),
+        (0.1, 0.4, "node_to_face"),
+        (0.05, 0.0, "node_to_face"),
+        (0.05, 0.0, "mortar"),
+        (0.05, 0.4, "node_to_face"),
+    ] {
+        let model = scenario(size, Some((mu, formulation)));
         let mut be = BackwardEuler::new(&model, Backend::Faer).unwrap();
         let mut s = in_contact(&model);
         for _ in 0..5 {
@@ -141,7 +150,7 @@ fn split() {
         let per = |x: f64| 1e3 * x / n as f64;
         let qps = (c1.qps - c0.qps).max(1) as f64;
         eprintln!(
-            "{size} m, mu = {mu}: {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} | {:.2}",
+            "{size} m, {formulation}, mu = {mu}: {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} | {:.2}",
             per(c1.w_s - c0.w_s),
             per(c1.qp_s - c0.qp_s),
             per(c1.detect_s - c0.detect_s),

@@ -26,9 +26,13 @@ pub(crate) struct Compliance {
     slot: Vec<usize>,
     /// `S`, column-major `k x k`, `k = eqs.len()`.
     s: Vec<f64>,
-    // Workspace: new equations and their columns of `A⁻¹`.
+    // Workspace: new equations and their columns of `A⁻¹`; the slots a condensed
+    // operator's rows touch, their positions among them, and `S G_Uᵀ`.
     fresh: Vec<usize>,
     cols: Vec<f64>,
+    union: Vec<usize>,
+    position: Vec<usize>,
+    t: Vec<f64>,
 }
 
 impl Compliance {
@@ -95,9 +99,60 @@ impl Compliance {
         Ok(())
     }
 
-    /// `S` at the free equations `a`, `b` (both covered).
-    pub fn at(&self, a: usize, b: usize) -> f64 {
+    /// `W = G_R S G_Rᵀ` for the rows `rows` of `g` (their equations all covered),
+    /// column-major `m × m` into `w`: first `T = S G_Rᵀ` on the union `U` of the rows'
+    /// equations (`|U| · nnz(G_R)` products), then `W = G_R T` (`m · nnz(G_R)`, one
+    /// triangle mirrored), instead of `S` entry by entry for every pair of rows
+    /// (`nnz(G_j) · nnz(G_k)` each, which a mortar row of 54 entries makes 13 times
+    /// node to face's cost).
+    pub fn condense(
+        &mut self,
+        g: &nalgebra_sparse::CsrMatrix<f64>,
+        rows: &[usize],
+        w: &mut Vec<f64>,
+    ) {
         let k = self.eqs.len();
-        self.s[self.slot[a] + self.slot[b] * k]
+        let m = rows.len();
+        self.union.clear();
+        for &i in rows {
+            self.union
+                .extend(g.row(i).col_indices().iter().map(|&e| self.slot[e]));
+        }
+        self.union.sort_unstable();
+        self.union.dedup();
+        let nu = self.union.len();
+        self.position.resize(k, NONE);
+        for (a, &u) in self.union.iter().enumerate() {
+            self.position[u] = a;
+        }
+        self.t.clear();
+        self.t.resize(nu * m, 0.0);
+        for (j, &i) in rows.iter().enumerate() {
+            let r = g.row(i);
+            let tj = &mut self.t[j * nu..(j + 1) * nu];
+            for (&e, &v) in r.col_indices().iter().zip(r.values()) {
+                let c = self.slot[e];
+                let col = &self.s[c * k..(c + 1) * k];
+                for (ta, &ua) in tj.iter_mut().zip(&self.union) {
+                    *ta += v * col[ua];
+                }
+            }
+        }
+        w.clear();
+        w.resize(m * m, 0.0);
+        for j in 0..m {
+            let tj = &self.t[j * nu..(j + 1) * nu];
+            for (l, &il) in rows.iter().enumerate().skip(j) {
+                let r = g.row(il);
+                let v: f64 = r
+                    .col_indices()
+                    .iter()
+                    .zip(r.values())
+                    .map(|(&f, &u)| u * tj[self.position[self.slot[f]]])
+                    .sum();
+                w[l + j * m] = v;
+                w[j + l * m] = v;
+            }
+        }
     }
 }

@@ -35,7 +35,11 @@ use rothe::run::{run, run_kept, Hooks, RunOptions};
 /// iterate agree far below their equilibrium tolerance (1e-8 on the residual):
 /// the iterations themselves must not change. Runs whose contact forces come from
 /// Clarabel (the cone programs of friction, the explicit impacts)
-/// agree to its tolerance on the scaled data (1e-9), so to 1e-8 of a column.
+/// agree to its tolerance on the scaled data (1e-9), so to 1e-8 of a column; with
+/// mortar's rows (54 entries each in a solid) the cone programs pass on more of it:
+/// summing `W` in another order moved `D_contact` (2e-5 of the energy, a sum of
+/// small terms of both signs) by 9e-7 of itself and the other columns by at most
+/// 2e-8.
 const CASES: [(&str, f64); 15] = [
     ("elastic_cantilever", 1e-10),
     ("damped_lumped_gravity", 1e-10),
@@ -50,7 +54,7 @@ const CASES: [(&str, f64); 15] = [
     ("solid_elastic_cantilever", 1e-10),
     ("solid_rankine_hill_cantilever", 1e-9),
     ("solid_contact_friction", 1e-8),
-    ("solid_contact_mortar", 1e-8),
+    ("solid_contact_mortar", 1e-6),
     ("solid_explicit_drop", 1e-8),
 ];
 

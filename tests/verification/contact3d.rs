@@ -457,12 +457,20 @@ fn the_solid_patch_test_transmits_the_load_and_reports_the_pressure_error() {
     let load = 1.0e6 * 0.16;
     let spread = 2.0 * 0.3 * 1.0e6 / 210e9;
     let (f, worst) = patch_pressure([4, 4], [4, 4], "node_to_face");
-    eprintln!("node to face, matching: force {f:.9e} N (p A = {load:e}), pressure error {worst:.2e}");
+    eprintln!(
+        "node to face, matching: force {f:.9e} N (p A = {load:e}), pressure error {worst:.2e}"
+    );
     assert!((f - load).abs() < 1e-8 * load, "{f}");
     assert!(worst < 1e-6, "matching meshes: pressure error {worst}");
     let mortar_error = |worst: f64| (worst - spread).abs();
     let mut worst_nodal: f64 = 0.0;
-    for (upper, lower) in [([4, 4], [4, 4]), ([5, 3], [4, 4]), ([3, 3], [4, 4]), ([4, 4], [7, 5]), ([6, 6], [4, 4])] {
+    for (upper, lower) in [
+        ([4, 4], [4, 4]),
+        ([5, 3], [4, 4]),
+        ([3, 3], [4, 4]),
+        ([4, 4], [7, 5]),
+        ([6, 6], [4, 4]),
+    ] {
         let (f, worst) = patch_pressure(upper, lower, "node_to_face");
         eprintln!(
             "node to face, slave {upper:?} on master {lower:?}: force {f:.9e} N, pressure error {worst:.3}"
@@ -480,7 +488,10 @@ fn the_solid_patch_test_transmits_the_load_and_reports_the_pressure_error() {
         );
     }
     // Node to face's error on non-matching meshes: the test can tell the two apart.
-    assert!(worst_nodal > 1e-2, "node to face's pressure error {worst_nodal}");
+    assert!(
+        worst_nodal > 1e-2,
+        "node to face's pressure error {worst_nodal}"
+    );
 }
 
 /// The grid of a graded axis: `n0` equal cells of `h0` from 0, then cells growing
@@ -794,7 +805,6 @@ fn a_solid_contact_pair_is_validated() {
             format!("{master}\nboth_ways = true"),
             &["contact[0].both_ways", "one pass"],
         ),
-
         ("master = \"block.top\"".to_string(), &["self-contact"]),
     ] {
         let e = refusal(&with(master, &to));
@@ -802,16 +812,24 @@ fn a_solid_contact_pair_is_validated() {
     }
     // Mortar weighs with the slave faces' shape functions: a node-set slave has none.
     let e = refusal(
-        &with(master, &format!("{master}\nformulation = \"mortar\""))
-            .replace("slave = \"block.bottom\"", "slave = \"block.bottom_left_back\""),
+        &with(master, &format!("{master}\nformulation = \"mortar\"")).replace(
+            "slave = \"block.bottom\"",
+            "slave = \"block.bottom_left_back\"",
+        ),
     );
-    assert!(e.contains("contact[0].formulation") && e.contains("a face set"), "{e}");
+    assert!(
+        e.contains("contact[0].formulation") && e.contains("a face set"),
+        "{e}"
+    );
     // Overlapping at the start: the block sunk 5 mm into the base.
     let e = refusal(&with(
         "origin = [0.15, 0.3011, 0.1]",
         "origin = [0.15, 0.295, 0.1]",
     ));
-    assert!(e.contains("overlap") && e.contains("behind the master surface near its node"), "{e}");
+    assert!(
+        e.contains("overlap") && e.contains("behind the master surface near its node"),
+        "{e}"
+    );
     // Node to face names the face.
     let e = refusal(
         &with(

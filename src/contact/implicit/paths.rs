@@ -35,22 +35,9 @@ impl ContactCorrection<'_> {
             }
             self.work.compliance.cover(sys, &self.work.needed)?;
             self.record.compliant += 1;
-            self.work.w.clear();
-            self.work.w.resize(m * m, 0.0);
-            for (j, &ij) in self.sel.rows.iter().enumerate() {
-                let rj = g.row(ij);
-                for (k, &ik) in self.sel.rows.iter().enumerate().skip(j) {
-                    let rk = g.row(ik);
-                    let mut w = 0.0;
-                    for (&e, v) in rk.col_indices().iter().zip(rk.values()) {
-                        for (&f, u) in rj.col_indices().iter().zip(rj.values()) {
-                            w += v * u * self.work.compliance.at(e, f);
-                        }
-                    }
-                    self.work.w[k + j * m] = w;
-                    self.work.w[j + k * m] = w;
-                }
-            }
+            self.work
+                .compliance
+                .condense(g, &self.sel.rows, &mut self.work.w);
         } else {
             self.work.y.clear();
             self.work.y.resize(nf * m, 0.0);

@@ -639,7 +639,8 @@ impl MasterSurface for FaceSurface<'_> {
 /// beam rotating over the edge of a support); a row would fling it up onto the
 /// surface in one step when it comes back over the edge (benchmark 2 as solids,
 /// one way: `D_contact` −16 `E_kin⁰`, theory/benchmarks.md). Such a slave stays
-/// passed over until it rises above the level again.
+/// passed over until it rises above the level again. Node-to-face sides only: a
+/// mortar side's rows weigh only the part of a slave face that faces the master.
 pub fn beneath_faces(
     pairs: &[crate::model::ContactPair],
     x: Positions,
@@ -649,6 +650,11 @@ pub fn beneath_faces(
     let mut out = Vec::new();
     for (pi, pair) in pairs.iter().enumerate() {
         for (si, side) in pair.sides.iter().enumerate() {
+            // A mortar side integrates over what its slave faces see of the master:
+            // no node of it is held by this rule.
+            if pair.formulation == crate::model::Formulation::Mortar {
+                continue;
+            }
             if let crate::model::Master::Faces { faces, boundary } = &side.master {
                 let surface = FaceSurface::new(faces, boundary, x);
                 for &s in &side.slaves {

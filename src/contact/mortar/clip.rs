@@ -99,7 +99,8 @@ impl Polygon {
 /// `c` (counter-clockwise) at the point `p` (the fourth 0 on a triangle): a
 /// triangle's barycentric coordinates; a quadrilateral's `¼(1 ± ξ)(1 ± η)` at the
 /// `(ξ, η)` Newton's iteration finds from the centre (a few steps for a point
-/// inside a convex quadrilateral).
+/// inside a convex quadrilateral; one solve for a parallelogram, whose map is
+/// affine).
 pub fn shape_at(c: &[V2], p: V2) -> [f64; 4] {
     if c.len() == 3 {
         let (e1, e2) = (sub(c[1], c[0]), sub(c[2], c[0]));
@@ -108,6 +109,23 @@ pub fn shape_at(c: &[V2], p: V2) -> [f64; 4] {
         let a = (d[0] * e2[1] - d[1] * e2[0]) / det;
         let b = (e1[0] * d[1] - e1[1] * d[0]) / det;
         return [1.0 - a - b, a, b, 0.0];
+    }
+    // A parallelogram's map is affine: one solve.
+    let (e1, e2) = (sub(c[1], c[0]), sub(c[3], c[0]));
+    let skew = sub(sub(c[2], c[1]), e2);
+    let size = e1[0]
+        .abs()
+        .max(e1[1].abs())
+        .max(e2[0].abs())
+        .max(e2[1].abs());
+    if skew[0].abs().max(skew[1].abs()) <= 1e-14 * size {
+        let det = e1[0] * e2[1] - e1[1] * e2[0];
+        if det != 0.0 {
+            let d = sub(p, c[0]);
+            let a = (d[0] * e2[1] - d[1] * e2[0]) / det;
+            let b = (e1[0] * d[1] - e1[1] * d[0]) / det;
+            return bilinear(2.0 * a - 1.0, 2.0 * b - 1.0);
+        }
     }
     let (mut xi, mut eta) = (0.0f64, 0.0f64);
     for _ in 0..25 {
@@ -192,23 +210,35 @@ mod tests {
         assert!((o.area() - (0.5 - 0.125)).abs() < 1e-15, "{}", o.area());
         // A square turned by 45° over the unit square: an octagon.
         let h = 0.75;
-        let d = Polygon::new(&[[0.5, 0.5 - h], [0.5 + h, 0.5], [0.5, 0.5 + h], [0.5 - h, 0.5]]);
+        let d = Polygon::new(&[
+            [0.5, 0.5 - h],
+            [0.5 + h, 0.5],
+            [0.5, 0.5 + h],
+            [0.5 - h, 0.5],
+        ]);
         let o = a.clipped_by(&d);
         assert_eq!(o.corners().len(), 8);
         let cut = 4.0 * 0.5 * (1.0f64 - h).powi(2);
-        assert!((o.area() - (1.0 - cut)).abs() < 1e-14, "{} {}", o.area(), 1.0 - cut);
+        assert!(
+            (o.area() - (1.0 - cut)).abs() < 1e-14,
+            "{} {}",
+            o.area(),
+            1.0 - cut
+        );
     }
 
     #[test]
     fn shape_functions_reproduce_the_point_in_a_skewed_quadrilateral_and_a_triangle() {
         let q = [[0.0, 0.0], [2.0, 0.3], [2.5, 1.7], [-0.2, 1.0]];
+        let g = [[0.0, 0.0], [2.0, 0.3], [1.8, 1.3], [-0.2, 1.0]];
         let t = [[0.0, 0.0], [2.0, 0.3], [-0.2, 1.0]];
-        for c in [&q[..], &t[..]] {
+        for c in [&q[..], &g[..], &t[..]] {
             for p in [[0.4, 0.3], [1.9, 1.2], [0.0, 0.0], [1.0, 0.5]] {
                 let n = shape_at(c, p);
-                let back = c.iter().zip(n).fold([0.0, 0.0], |s, (x, w)| {
-                    [s[0] + w * x[0], s[1] + w * x[1]]
-                });
+                let back = c
+                    .iter()
+                    .zip(n)
+                    .fold([0.0, 0.0], |s, (x, w)| [s[0] + w * x[0], s[1] + w * x[1]]);
                 assert!((n.iter().sum::<f64>() - 1.0).abs() < 1e-14);
                 assert!((back[0] - p[0]).abs() < 1e-13 && (back[1] - p[1]).abs() < 1e-13);
             }

@@ -291,13 +291,17 @@ mod tests {
                 // no tangential offset between the row's slave and master points.
                 let d = c.combine(pos);
                 assert!(d[0].abs() < 1e-14 && d[2].abs() < 1e-14, "{d:?}");
-                let (sum_s, sum_m) = c.weights.iter().fold((0.0, 0.0), |(s, m), (n, w)| {
-                    if n < ns {
-                        (s + w, m)
-                    } else {
-                        (s, m + w)
-                    }
-                });
+                let (sum_s, sum_m) =
+                    c.weights.iter().fold(
+                        (0.0, 0.0),
+                        |(s, m), (n, w)| {
+                            if n < ns {
+                                (s + w, m)
+                            } else {
+                                (s, m + w)
+                            }
+                        },
+                    );
                 assert!((sum_s - 1.0).abs() < 1e-14 && (sum_m + 1.0).abs() < 1e-14);
                 // A unit pressure: λ_j = W_j; the slave pushed up, the master down.
                 for (n, w) in c.weights.iter() {
@@ -388,6 +392,11 @@ mod tests {
             let f = |x: f64| 2.0 * x - 1.5 * x * x;
             f(b) - f(a)
         };
-        assert!((third.length - 0.5 * hat).abs() < 1e-14, "{} vs {}", third.length, 0.5 * hat);
+        assert!(
+            (third.length - 0.5 * hat).abs() < 1e-14,
+            "{} vs {}",
+            third.length,
+            0.5 * hat
+        );
     }
 }
