@@ -1129,3 +1129,29 @@ fn benchmark_2_as_a_solid_deflects_as_the_plane_and_its_contact_does_no_work() {
         );
     }
 }
+
+#[test]
+fn mortar_under_a_second_order_scheme_without_the_predictor_is_warned_of() {
+    // theory/contact3d.md: the chatter amplifies round-off with mortar rows.
+    let text = drop_on("model = \"elastic\"");
+    let warned = |extra: &str, pair: &str| {
+        let t = text
+            .replace("vtk_every = 0", &format!("vtk_every = 0\n{extra}"))
+            .replace(
+                "master = \"base.top\"",
+                &format!("master = \"base.top\"\n{pair}"),
+            );
+        model(&t).warnings.iter().any(|w| w.contains("chatters"))
+    };
+    assert!(warned("scheme = \"trapezoidal\"", ""));
+    assert!(warned("scheme = \"generalized_alpha\"", ""));
+    assert!(!warned("", ""));
+    assert!(!warned(
+        "scheme = \"trapezoidal\"\ncontact_predictor = \"stabilised\"",
+        ""
+    ));
+    assert!(!warned(
+        "scheme = \"trapezoidal\"",
+        "formulation = \"node_to_face\""
+    ));
+}

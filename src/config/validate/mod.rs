@@ -24,8 +24,8 @@ use crate::error::{Error, Result};
 use crate::fe::{Idealisation, StrainSpace};
 use crate::mesh::Mesh;
 use crate::model::{
-    Analysis, AnalysisKind, Body, ContactSettings, Damping, IterationSettings, Model,
-    OutputSettings, TimeScheme, TimeSettings,
+    Analysis, AnalysisKind, Body, ContactPredictor, ContactSettings, Damping, Formulation,
+    IterationSettings, Model, OutputSettings, TimeScheme, TimeSettings,
 };
 
 /// Builds the model of `s`; relative file names resolve against `dir`.
@@ -250,8 +250,37 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     if explicit {
         explicit_step(&mut model, a.dt, opts)?;
     }
+    chatter_warning(&mut model);
     initial_overlap(&model)?;
     Ok(model)
+}
+
+/// Warns of a solid's mortar pair under a second-order scheme without the contact
+/// predictor: its contact phase chatters and amplifies round-off (two backends'
+/// forces part by 1.7 % on benchmark 1 as solids, theory/contact3d.md).
+fn chatter_warning(model: &mut Model) {
+    let t = &model.analysis.time;
+    let second_order = matches!(
+        t.scheme,
+        TimeScheme::Trapezoidal | TimeScheme::GeneralizedAlpha
+    );
+    if model.mesh.dim != 3 || !second_order || t.contact_predictor != ContactPredictor::None {
+        return;
+    }
+    if let Some((i, p)) = model
+        .contacts
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.formulation == Formulation::Mortar)
+    {
+        model.warnings.push(format!(
+            "contact[{i}] (`{}`): mortar between solids under a second-order scheme chatters \
+             in contact and its results then depend on round-off (theory/contact3d.md); \
+             add `analysis.contact_predictor = \"stabilised\"` or give the pair \
+             `formulation = \"node_to_face\"`",
+            p.name
+        ));
+    }
 }
 
 /// Bodies (or a body and a rigid line) must not overlap at the start: a slave node
