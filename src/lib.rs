@@ -45,6 +45,7 @@ pub mod linsolve;
 pub mod material;
 pub mod memory;
 pub mod mesh;
+pub mod modal;
 pub mod model;
 pub mod nonlinear;
 pub mod output;

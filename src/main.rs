@@ -106,6 +106,24 @@ enum Command {
         #[arg(long, default_value = "out")]
         out: PathBuf,
     },
+    /// The lowest eigenfrequencies and mode shapes (shift-invert Lanczos on the run's
+    /// factor): modes.csv, modes.json and modes.pvd in the output directory.
+    Modes {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        /// Number of modes, the lowest.
+        #[arg(long, default_value_t = 10)]
+        count: usize,
+        /// The shift σ (rad²/s², zero or negative); default −1e-4 tr K / tr M.
+        #[arg(long, allow_hyphen_values = true)]
+        shift: Option<f64>,
+        /// Output directory.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Linear solver backend: faer or cholmod.
+        #[arg(long, default_value = "faer")]
+        backend: Backend,
+    },
     /// Validate a scenario and print its size, steps and output volume, the explicit
     /// CFL step and the memory it needs, without solving.
     Check {
@@ -329,9 +347,9 @@ fn main() -> ExitCode {
     // A panic is reported below as an internal error, not printed by the default hook.
     std::panic::set_hook(Box::new(|_| {}));
     let input = match &cli.command {
-        Command::Run { scenario, .. } | Command::Check { scenario, .. } => {
-            scenario.scenario.clone()
-        }
+        Command::Run { scenario, .. }
+        | Command::Check { scenario, .. }
+        | Command::Modes { scenario, .. } => scenario.scenario.clone(),
         Command::Material { file, .. } => file.clone(),
         Command::Compare { scenario, .. } => scenario.scenario.clone(),
         Command::Study { study } => match study {
@@ -403,6 +421,43 @@ fn main() -> ExitCode {
                 "{steps} steps; wrote {}",
                 out.join("material.csv").display()
             );
+        }),
+        Command::Modes {
+            scenario,
+            count,
+            shift,
+            out,
+            backend,
+        } => scenario.load().and_then(|model| {
+            let opts = rothe::modal::ModalOptions {
+                count,
+                shift,
+                backend,
+            };
+            let modes = rothe::modal::modes(&model, &opts)?;
+            println!(
+                "{} modes of {} free dofs in {} Lanczos steps (shift {:.4e} rad²/s²)",
+                modes.modes.len(),
+                modes.n_free,
+                modes.steps,
+                modes.shift
+            );
+            println!("mode  f (Hz)          omega (rad/s)   residual");
+            for (i, m) in modes.modes.iter().enumerate() {
+                let w = m.omega();
+                println!(
+                    "{:>4}  {:<14.6e}  {:<14.6e}  {:.1e}{}",
+                    i + 1,
+                    w / (2.0 * std::f64::consts::PI),
+                    w,
+                    m.residual,
+                    if m.rigid { "  rigid" } else { "" }
+                );
+            }
+            for f in rothe::modal::output::write(&model, &modes, &out)? {
+                println!("wrote {}", f.display());
+            }
+            Ok(())
         }),
         Command::Check { scenario, matrices } => {
             let limit = scenario.options().memory_limit;

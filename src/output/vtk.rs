@@ -14,6 +14,10 @@ use crate::mesh::{ElementKind, Mesh};
 /// Writes the VTK series of a run.
 pub struct VtkSeries {
     dir: PathBuf,
+    /// The collection's name (`result` for a run: `result.pvd`) and its files'
+    /// prefix (`step`: `vtk/step_0000010.vtu`).
+    collection: &'static str,
+    prefix: &'static str,
     /// Dofs per node of the mesh.
     dim: usize,
     entries: Vec<(f64, String)>,
@@ -26,6 +30,16 @@ pub struct VtkSeries {
 impl VtkSeries {
     /// Prepares `dir/vtk/` and the cell tables of `mesh`.
     pub fn new(dir: &Path, mesh: &Mesh) -> Result<Self> {
+        Self::named(dir, mesh, "result", "step")
+    }
+
+    /// The same, the collection `dir/<collection>.pvd` listing `vtk/<prefix>_*.vtu`.
+    pub fn named(
+        dir: &Path,
+        mesh: &Mesh,
+        collection: &'static str,
+        prefix: &'static str,
+    ) -> Result<Self> {
         let sub = dir.join("vtk");
         std::fs::create_dir_all(&sub).map_err(|e| Error::io(&sub, e))?;
         let mut connectivity = Vec::new();
@@ -49,6 +63,8 @@ impl VtkSeries {
         Ok(VtkSeries {
             dim: mesh.dim,
             dir: dir.into(),
+            collection,
+            prefix,
             entries: Vec::new(),
             connectivity,
             offsets,
@@ -139,7 +155,7 @@ impl VtkSeries {
                 .collect(),
             },
         };
-        let name = format!("step_{step:07}.vtu");
+        let name = format!("{}_{step:07}.vtu", self.prefix);
         let path = self.dir.join("vtk").join(&name);
         let vtk = Vtk {
             version: Version::new_xml(1, 0),
@@ -162,8 +178,8 @@ impl VtkSeries {
             ));
         }
         s.push_str("  </Collection>\n</VTKFile>\n");
-        let path = self.dir.join("result.pvd");
-        let tmp = self.dir.join("result.pvd.tmp");
+        let path = self.dir.join(format!("{}.pvd", self.collection));
+        let tmp = self.dir.join(format!("{}.pvd.tmp", self.collection));
         std::fs::write(&tmp, s).map_err(|e| Error::io(&tmp, e))?;
         std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, e))
     }
