@@ -198,7 +198,10 @@ mod tests {
         let r = lanczos(n, 5, 60, 1e-12, &[], op, mass).unwrap_or_else(|_| panic!("converges"));
         for (i, th) in r.theta.iter().enumerate() {
             let lambda = sigma + 1.0 / th;
-            assert!((lambda - (i + 1) as f64 / 2.0).abs() < 1e-10, "{i}: {lambda}");
+            assert!(
+                (lambda - (i + 1) as f64 / 2.0).abs() < 1e-10,
+                "{i}: {lambda}"
+            );
         }
         // M-orthonormal.
         let mut mx = vec![0.0; n];

@@ -99,7 +99,10 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
     if opts.count > n_free {
         return Err(Error::config(
             "--count",
-            format!("{} modes asked for, the model has {n_free} free dofs", opts.count),
+            format!(
+                "{} modes asked for, the model has {n_free} free dofs",
+                opts.count
+            ),
         ));
     }
     let free = dofs.free.clone();
@@ -226,7 +229,11 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
     let dim = mesh.dim;
     let mut total_mass = [0.0; 3];
     let iota: Vec<Vec<f64>> = (0..dim)
-        .map(|r| free.iter().map(|&d| f64::from(u8::from(d % dim == r))).collect())
+        .map(|r| {
+            free.iter()
+                .map(|&d| f64::from(u8::from(d % dim == r)))
+                .collect()
+        })
         .collect();
     let mut m_iota = vec![vec![0.0; n_free]; dim];
     for r in 0..dim {
@@ -246,11 +253,7 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
             .map(|(a, b)| (a - lambda * b).powi(2))
             .sum::<f64>()
             .sqrt();
-        let reference = if rigid {
-            norm(&mx) * scale
-        } else {
-            norm(&kx)
-        };
+        let reference = if rigid { norm(&mx) * scale } else { norm(&kx) };
         let mut participation = [0.0; 3];
         for r in 0..dim {
             participation[r] = dot(x, &m_iota[r]);

@@ -89,7 +89,8 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
             let frac = m.participation[r].powi(2) / modes.total_mass[r];
             sums[r] += frac;
             write!(csv, ",{frac:.9e},{:.9e}", sums[r]).expect("to a string");
-            fractions.push(serde_json::json!({"direction": axes[r], "fraction": frac, "sum": sums[r]}));
+            fractions
+                .push(serde_json::json!({"direction": axes[r], "fraction": frac, "sum": sums[r]}));
         }
         writeln!(
             csv,

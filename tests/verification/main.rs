@@ -13,6 +13,7 @@ mod contact3d;
 mod equilibrium;
 mod explicit;
 mod friction;
+mod modal;
 mod mortar;
 mod nonlinear_dynamics;
 mod nonlocal;

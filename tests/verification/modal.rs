@@ -1,0 +1,356 @@
+//! Modal analysis (`rothe modes`, `rothe::modal`): an axial bar against its closed
+//! form and its order, rigid modes of free bodies, a box against its plane-strain
+//! section, a dense generalised solve, the backends, and bad input.
+
+use rothe::linsolve::Backend;
+use rothe::modal::{modes, ModalOptions, Modes};
+use rothe::model::Model;
+
+use crate::common::model;
+
+fn options(count: usize) -> ModalOptions {
+    ModalOptions {
+        count,
+        shift: None,
+        backend: Backend::Faer,
+    }
+}
+
+/// A steel bar 1 m long (plane stress, ν = 0) of `n` elements along, fixed at its left
+/// end, its lateral motion suppressed: an axial bar, `c = √(E/ρ)`.
+fn bar(n: usize) -> String {
+    format!(
+        r#"
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-6
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.0
+rho = 7850.0
+[[bodies]]
+name = "bar"
+material = "steel"
+thickness = 0.05
+mesh = {{ kind = "rectangle", size = [1.0, 0.05], divisions = [{n}, 1] }}
+[[supports]]
+set = "bar.left"
+fix = ["x"]
+[[supports]]
+set = "bar.all"
+fix = ["y"]
+"#
+    )
+}
+
+fn hz(m: &Modes, i: usize) -> f64 {
+    m.modes[i].omega() / (2.0 * std::f64::consts::PI)
+}
+
+#[test]
+fn an_axial_bar_has_its_closed_form_frequencies_converging_from_above_at_order_two() {
+    // f_n = (2n − 1) c / (4L); consistent mass: the discrete frequencies lie above
+    // and their error falls as h².
+    let c = (210e9f64 / 7850.0).sqrt();
+    let exact = |k: usize| (2 * k - 1) as f64 * c / 4.0;
+    let meshes = [20, 40, 80];
+    let errors: Vec<Vec<f64>> = meshes
+        .iter()
+        .map(|&n| {
+            let m = modes(&model(&bar(n)), &options(3)).unwrap();
+            (0..3)
+                .map(|k| {
+                    let f = hz(&m, k);
+                    assert!(f > exact(k + 1), "{n} elements, mode {}: {f} below", k + 1);
+                    (f - exact(k + 1)) / exact(k + 1)
+                })
+                .collect()
+        })
+        .collect();
+    let by_mode: Vec<Vec<f64>> = (0..3)
+        .map(|k| errors.iter().map(|row| row[k]).collect())
+        .collect();
+    for (k, e) in by_mode.iter().enumerate() {
+        let orders: Vec<f64> = (0..2).map(|i| (e[i] / e[i + 1]).log2()).collect();
+        eprintln!(
+            "axial bar mode {}: errors {:.3e} {:.3e} {:.3e}, observed orders {:.3} {:.3}",
+            k + 1,
+            e[0],
+            e[1],
+            e[2],
+            orders[0],
+            orders[1]
+        );
+        for o in orders {
+            assert!((o - 2.0).abs() < 0.1, "mode {}: order {o}", k + 1);
+        }
+        assert!(e[2] < 2e-3);
+    }
+}
+
+/// The block `size` with `divisions`, free (no support).
+fn free_body(dim: usize) -> Model {
+    let mesh = if dim == 3 {
+        "mesh = { kind = \"box\", size = [0.4, 0.1, 0.15], divisions = [6, 2, 2] }"
+    } else {
+        "thickness = 0.1\nmesh = { kind = \"rectangle\", size = [0.4, 0.1], divisions = [8, 2] }"
+    };
+    model(&format!(
+        r#"
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-6
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "b"
+material = "steel"
+{mesh}
+"#
+    ))
+}
+
+#[test]
+fn a_free_body_has_three_rigid_modes_in_the_plane_and_six_in_space() {
+    for (dim, rigid) in [(2, 3), (3, 6)] {
+        let m = free_body(dim);
+        let found = modes(&m, &options(rigid + 3)).unwrap();
+        let flags: Vec<bool> = found.modes.iter().map(|x| x.rigid).collect();
+        assert_eq!(
+            flags.iter().filter(|&&r| r).count(),
+            rigid,
+            "{dim}D: {flags:?}"
+        );
+        assert!(flags[..rigid].iter().all(|&r| r) && !flags[rigid]);
+        let scale = found.modes[rigid].lambda;
+        for x in &found.modes[..rigid] {
+            assert!(x.lambda.abs() < 1e-9 * scale, "{dim}D rigid λ {}", x.lambda);
+            assert!(x.residual < 1e-10, "{}", x.residual);
+        }
+        // The rigid modes carry the whole mass along each axis.
+        for r in 0..dim {
+            let carried: f64 = found.modes[..rigid]
+                .iter()
+                .map(|x| x.participation[r].powi(2))
+                .sum();
+            assert!(
+                (carried / found.total_mass[r] - 1.0).abs() < 1e-10,
+                "{dim}D axis {r}: {carried} of {}",
+                found.total_mass[r]
+            );
+        }
+        orthonormal(&m, &found);
+    }
+}
+
+/// The modes are `M`-orthonormal to 1e-10.
+fn orthonormal(m: &Model, found: &Modes) {
+    let asm = rothe::assembly::Assembler::new(&m.mesh);
+    let mass = asm.mass(&m.mesh, &m.materials, m.analysis.time.lumped_mass);
+    let mut y = vec![0.0; m.mesh.n_dofs()];
+    for (i, a) in found.modes.iter().enumerate() {
+        mass.matvec(&asm.pattern, &a.shape, &mut y);
+        for (j, b) in found.modes.iter().enumerate() {
+            let d: f64 = b.shape.iter().zip(&y).map(|(p, q)| p * q).sum();
+            let want = if i == j { 1.0 } else { 0.0 };
+            assert!((d - want).abs() < 1e-10, "modes {i}, {j}: {d}");
+        }
+    }
+}
+
+#[test]
+fn a_dense_generalised_solve_and_both_backends_give_the_same_frequencies() {
+    // The clamped bar of 6 x 2 elements (lateral motion free): K and M as dense
+    // matrices on the free dofs, M = L Lᵀ, the eigenvalues of L⁻¹ K L⁻ᵀ.
+    let m = model(
+        &bar(6)
+            .replace("[[supports]]\nset = \"bar.all\"\nfix = [\"y\"]\n", "")
+            .replace("divisions = [6, 1]", "divisions = [6, 2]")
+            .replace("fix = [\"x\"]", "fix = [\"x\", \"y\"]"),
+    );
+    let asm = rothe::assembly::Assembler::new(&m.mesh);
+    let k = asm.stiffness(&m.mesh, &m.materials, m.idealisation);
+    let mass = asm.mass(&m.mesh, &m.materials, false);
+    let fixed: std::collections::BTreeSet<usize> = m.constraints.iter().map(|c| c.dof).collect();
+    let free: Vec<usize> = (0..m.mesh.n_dofs())
+        .filter(|d| !fixed.contains(d))
+        .collect();
+    let n = free.len();
+    let (mut kd, mut md) = (
+        nalgebra::DMatrix::<f64>::zeros(n, n),
+        nalgebra::DMatrix::<f64>::zeros(n, n),
+    );
+    let mut e = vec![0.0; m.mesh.n_dofs()];
+    let (mut ke, mut me) = (e.clone(), e.clone());
+    for (j, &dj) in free.iter().enumerate() {
+        e.fill(0.0);
+        e[dj] = 1.0;
+        asm.pattern.matvec(&k, &e, &mut ke);
+        mass.matvec(&asm.pattern, &e, &mut me);
+        for (i, &di) in free.iter().enumerate() {
+            kd[(i, j)] = ke[di];
+            md[(i, j)] = me[di];
+        }
+    }
+    let l = md.cholesky().expect("M positive").l();
+    let li = l.clone().try_inverse().unwrap();
+    let c = &li * kd * li.transpose();
+    let mut dense: Vec<f64> = c.symmetric_eigen().eigenvalues.iter().copied().collect();
+    dense.sort_by(f64::total_cmp);
+    let backends: &[Backend] = if cfg!(feature = "cholmod") {
+        &[Backend::Faer, Backend::Cholmod]
+    } else {
+        &[Backend::Faer]
+    };
+    for &backend in backends {
+        let found = modes(
+            &m,
+            &ModalOptions {
+                count: 8,
+                shift: None,
+                backend,
+            },
+        )
+        .unwrap();
+        for (i, x) in found.modes.iter().enumerate() {
+            assert!(
+                (x.lambda - dense[i]).abs() < 1e-9 * dense[i],
+                "{backend:?} mode {i}: {} against {}",
+                x.lambda,
+                dense[i]
+            );
+            assert!(x.residual < 1e-8, "{}", x.residual);
+        }
+        orthonormal(&m, &found);
+    }
+}
+
+#[test]
+fn a_thin_box_with_its_depth_fixed_has_its_plane_strain_sections_modes() {
+    // A box 1 x 0.1 x 0.01 m clamped at its left end, every z dof fixed: its lowest
+    // modes are those of the plane-strain section of depth 0.01 m (the through-depth
+    // ones lie far above).
+    let text = |solid: bool| {
+        let (mesh, extra, fix) = if solid {
+            (
+                "mesh = { kind = \"box\", size = [1.0, 0.1, 0.01], divisions = [20, 2, 1] }",
+                "[[supports]]\nset = \"b.all\"\nfix = [\"z\"]\n",
+                "fix = [\"x\", \"y\", \"z\"]",
+            )
+        } else {
+            (
+                "thickness = 0.01\nmesh = { kind = \"rectangle\", size = [1.0, 0.1], divisions = [20, 2] }",
+                "",
+                "fix = [\"x\", \"y\"]",
+            )
+        };
+        format!(
+            r#"
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-6
+plane = "strain"
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "b"
+material = "steel"
+{mesh}
+[[supports]]
+set = "b.left"
+{fix}
+{extra}"#
+        )
+    };
+    let plane = modes(&model(&text(false)), &options(4)).unwrap();
+    let solid_text = text(true).replace("plane = \"strain\"\n", "");
+    let solid = modes(&model(&solid_text), &options(4)).unwrap();
+    for i in 0..4 {
+        let (a, b) = (hz(&plane, i), hz(&solid, i));
+        assert!(
+            (a - b).abs() < 1e-9 * a,
+            "mode {}: plane strain {a} Hz, box {b} Hz",
+            i + 1
+        );
+    }
+}
+
+#[test]
+fn modes_refuses_bad_input_and_writes_its_tables_and_shapes() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = model(&bar(10));
+    for (count, shift, words) in [
+        (0, None, "--count"),
+        (1000, None, "free dofs"),
+        (3, Some(1.0e6), "--shift"),
+    ] {
+        let e = modes(
+            &m,
+            &ModalOptions {
+                count,
+                shift,
+                backend: Backend::Faer,
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains(words), "{e}");
+    }
+    let held = model(
+        &bar(4)
+            .replace("fix = [\"x\"]", "fix = [\"x\", \"y\"]")
+            .replace(
+                "set = \"bar.all\"\nfix = [\"y\"]",
+                "set = \"bar.all\"\nfix = [\"x\", \"y\"]",
+            ),
+    );
+    let e = modes(&held, &options(1)).unwrap_err().to_string();
+    assert!(e.contains("no free motion"), "{e}");
+    // The command: its tables and shapes.
+    let path = crate::common::scenario(dir.path(), "bar.toml", &bar(20));
+    let out = dir.path().join("modes");
+    let (ok, stdout, stderr) = crate::common::rothe(&[
+        "modes",
+        path.to_str().unwrap(),
+        "--count",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}{stderr}");
+    let csv = std::fs::read_to_string(out.join("modes.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    assert!(
+        header.starts_with("index,omega_rad_s,f_hz,period_s"),
+        "{header}"
+    );
+    assert_eq!(lines.count(), 3);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("modes.json")).unwrap()).unwrap();
+    assert_eq!(json["modes"].as_array().unwrap().len(), 3);
+    // The axial bar's first mode carries 8/π² of the bar's mass along x (the
+    // fractions are of the free dofs' mass, which lacks the fixed end's share).
+    let first = json["modes"][0]["effective_mass"][0]["fraction"]
+        .as_f64()
+        .unwrap();
+    let free_mass = json["total_mass_kg"][0].as_f64().unwrap();
+    let bar_mass = 7850.0 * 1.0 * 0.05 * 0.05;
+    let exact = 8.0 / std::f64::consts::PI.powi(2);
+    assert!(
+        (first * free_mass / bar_mass - exact).abs() < 2e-3,
+        "{first} of {free_mass} kg against {exact} of {bar_mass} kg"
+    );
+    let pvd = std::fs::read_to_string(out.join("modes.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 3);
+    assert!(out.join("vtk/mode_0000001.vtu").exists());
+    let (ok, _, stderr) = crate::common::rothe(&["modes", path.to_str().unwrap(), "--count", "0"]);
+    assert!(!ok && stderr.contains("--count"), "{stderr}");
+}
