@@ -69,6 +69,9 @@ pub struct Report {
     pub nonlocal: Option<(usize, usize, usize, f64, u64)>,
     /// One line per contact pair: name, master, formulation, friction.
     pub contacts: Vec<String>,
+    /// Rayleigh's pair set from modal targets, and the damping ratio it gives the
+    /// first modes (computed), when the scenario gave `analysis.damping`.
+    pub damping: Vec<String>,
 }
 
 /// The lines `check` and `material` print for a material: model, elastic constants,
@@ -214,6 +217,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         warnings,
         materials: model.materials.iter().map(material_lines).collect(),
         contacts: model.contacts.iter().map(contact_line).collect(),
+        damping: damping_lines(model)?,
         nonlocal: crate::assembly::nonlocal::NonlocalTable::build(mesh, &model.materials).map(
             |t| {
                 let (lo, hi) = t.neighbour_range();
@@ -329,6 +333,9 @@ impl fmt::Display for Report {
             };
             writeln!(f, "iteration   {method}; {factor}")?;
         }
+        for (i, l) in self.damping.iter().enumerate() {
+            writeln!(f, "{}{l}", if i == 0 { "damping     " } else { "  " })?;
+        }
         writeln!(f, "steps       {steps} of h = {dt:e} s to T = {t_end:e} s")?;
         writeln!(
             f,
@@ -381,6 +388,40 @@ impl fmt::Display for Report {
         }
         Ok(())
     }
+}
+
+/// The lines of Rayleigh's pair from modal targets: the pair, its targets, and the
+/// ratio at each of the first six modes (computed; rigid ones left out).
+fn damping_lines(model: &Model) -> Result<Vec<String>> {
+    let d = &model.analysis.damping;
+    let Some((xi, w)) = d.targets else {
+        return Ok(Vec::new());
+    };
+    let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
+    let mut lines = vec![format!(
+        "Rayleigh a_m = {:.6e} 1/s, a_k = {:.6e} s: ratio {xi} at {:.6e} and {:.6e} Hz",
+        d.rayleigh[0],
+        d.rayleigh[1],
+        hz(w[0]),
+        hz(w[1])
+    )];
+    let found = crate::modal::modes(
+        model,
+        &crate::modal::ModalOptions {
+            count: 6.min(model.mesh.n_dofs()),
+            shift: None,
+            backend: crate::linsolve::Backend::Faer,
+        },
+    )?;
+    for (i, m) in found.modes.iter().enumerate().filter(|(_, m)| !m.rigid) {
+        lines.push(format!(
+            "mode {:>2}  {:.6e} Hz  ratio {:.6}",
+            i + 1,
+            hz(m.omega()),
+            d.ratio_at(m.omega())
+        ));
+    }
+    Ok(lines)
 }
 
 /// Writes the matrices of the model's first step in Matrix Market format (through

@@ -241,6 +241,25 @@ pub struct Damping {
     pub zeta: f64,
     /// Rayleigh damping `C += a_m M + a_k K`.
     pub rayleigh: [f64; 2],
+    /// What the pair was set from, when it came from modal targets: the ratio and
+    /// the two circular frequencies (rad/s).
+    pub targets: Option<(f64, [f64; 2])>,
+}
+
+impl Damping {
+    /// Rayleigh's pair giving the ratio `xi` at the circular frequencies `w`:
+    /// `ξ(ω) = a_m/(2ω) + a_k ω/2` equal to `xi` at both, so
+    /// `a_m = 2ξ ω₁ω₂/(ω₁ + ω₂)`, `a_k = 2ξ/(ω₁ + ω₂)`.
+    pub fn rayleigh_for(xi: f64, w: [f64; 2]) -> [f64; 2] {
+        let s = w[0] + w[1];
+        [2.0 * xi * w[0] * w[1] / s, 2.0 * xi / s]
+    }
+
+    /// The damping ratio Rayleigh's pair (and `zeta`, a mass term) gives a mode of
+    /// circular frequency `w`.
+    pub fn ratio_at(&self, w: f64) -> f64 {
+        (self.zeta + self.rayleigh[0]) / (2.0 * w) + self.rayleigh[1] * w / 2.0
+    }
 }
 
 /// Equilibrium iterations, step cuts and the factorisations they use.

@@ -148,6 +148,20 @@ pub struct ContactSpec {
     pub formulation: Option<crate::model::Formulation>,
 }
 
+/// `analysis.damping`: Rayleigh's pair from a damping ratio at two frequencies.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DampingSpec {
+    /// The damping ratio `ξ` wanted at both frequencies (0.02: two percent).
+    pub ratio: f64,
+    /// The two frequencies (Hz).
+    #[serde(default)]
+    pub frequencies: Option<[f64; 2]>,
+    /// The two modes (numbers from 1, the lowest first), computed.
+    #[serde(default)]
+    pub modes: Option<[usize; 2]>,
+}
+
 /// `contact.master`: what a pair's slaves may not cross, exactly one of its keys.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -323,6 +337,11 @@ pub struct AnalysisSpec {
     #[serde(default)]
     #[serde(deserialize_with = "exact::array")]
     pub rayleigh: [f64; 2],
+    /// Rayleigh damping from modal targets instead of `rayleigh`: the damping ratio
+    /// `ratio` at two frequencies, given (`frequencies`, Hz) or computed
+    /// (`modes`, by number, 1 the lowest; `theory/modal.md`).
+    #[serde(default)]
+    pub damping: Option<DampingSpec>,
     /// Gravity acceleration vector (m/s²; two components, three in a solid), applied
     /// from `t = 0`. Default none.
     #[serde(default, deserialize_with = "exact::option_vector")]

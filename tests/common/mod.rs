@@ -47,6 +47,7 @@ pub fn model_of(
             damping: rothe::model::Damping {
                 zeta: 0.0,
                 rayleigh: [0.0, 0.0],
+                targets: None,
             },
             iteration: rothe::model::IterationSettings {
                 tolerance: 1e-8,

@@ -354,3 +354,94 @@ fn modes_refuses_bad_input_and_writes_its_tables_and_shapes() {
     let (ok, _, stderr) = crate::common::rothe(&["modes", path.to_str().unwrap(), "--count", "0"]);
     assert!(!ok && stderr.contains("--count"), "{stderr}");
 }
+
+#[test]
+fn rayleigh_damping_from_modal_targets_gives_the_ratio_at_both() {
+    let with =
+        |damping: &str| bar(40).replace("dt = 1.0e-6\n", &format!("dt = 1.0e-6\n{damping}\n"));
+    // Given frequencies: the ratio at both to 1e-12.
+    let m = model(&with(
+        "damping = { ratio = 0.02, frequencies = [100.0, 2500.0] }",
+    ));
+    let d = &m.analysis.damping;
+    for f in [100.0, 2500.0] {
+        let r = d.ratio_at(2.0 * std::f64::consts::PI * f);
+        assert!((r - 0.02).abs() < 1e-12, "{f} Hz: {r}");
+    }
+    // Computed modes: the pair gives the ratio at modes 1 and 3 as computed.
+    let m = model(&with("damping = { ratio = 0.05, modes = [1, 3] }"));
+    let found = modes(&m, &options(3)).unwrap();
+    let d = &m.analysis.damping;
+    for i in [0, 2] {
+        let r = d.ratio_at(found.modes[i].omega());
+        assert!((r - 0.05).abs() < 1e-12, "mode {}: {r}", i + 1);
+    }
+    // Between the targets less, outside more.
+    assert!(d.ratio_at(found.modes[1].omega()) < 0.05);
+    // `rothe check` prints the pair and the ratio at the first modes.
+    let dir = tempfile::tempdir().unwrap();
+    let path = crate::common::scenario(
+        dir.path(),
+        "bar.toml",
+        &with("damping = { ratio = 0.05, modes = [1, 3] }"),
+    );
+    let (ok, stdout, stderr) = crate::common::rothe(&["check", path.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("damping     Rayleigh a_m") && stdout.contains("mode  3"),
+        "{stdout}"
+    );
+    // Bad input, by name.
+    for (damping, field) in [
+        (
+            "rayleigh = [1.0, 0.0]\ndamping = { ratio = 0.02, frequencies = [1.0, 2.0] }",
+            "analysis.damping",
+        ),
+        ("damping = { ratio = 0.02 }", "analysis.damping"),
+        (
+            "damping = { ratio = 0.02, frequencies = [1.0, 2.0], modes = [1, 2] }",
+            "analysis.damping",
+        ),
+        (
+            "damping = { ratio = 1.5, frequencies = [1.0, 2.0] }",
+            "analysis.damping.ratio",
+        ),
+        (
+            "damping = { ratio = 0.02, frequencies = [0.0, 2.0] }",
+            "analysis.damping.frequencies[0]",
+        ),
+        (
+            "damping = { ratio = 0.02, modes = [0, 2] }",
+            "analysis.damping.modes",
+        ),
+    ] {
+        let e = rothe::config::from_str(&with(damping), std::path::Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field), "{damping}: {e}");
+    }
+    // A free body's rigid modes have no frequency to damp at.
+    let free = r#"
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-6
+damping = { ratio = 0.02, modes = [1, 4] }
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+[[bodies]]
+name = "b"
+material = "steel"
+thickness = 0.1
+mesh = { kind = "rectangle", size = [0.4, 0.1], divisions = [8, 2] }
+"#;
+    let e = rothe::config::from_str(free, std::path::Path::new("."))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("analysis.damping.modes[0]") && e.contains("rigid"),
+        "{e}"
+    );
+}
