@@ -241,10 +241,13 @@ pub struct Damping {
     pub zeta: f64,
     /// Rayleigh damping `C += a_m M + a_k K`.
     pub rayleigh: [f64; 2],
-    /// What the pair was set from, when it came from modal targets: the ratio and
-    /// the two circular frequencies (rad/s).
-    pub targets: Option<(f64, [f64; 2])>,
+    /// What the pair was set from, when it came from modal targets.
+    pub targets: Option<RayleighTargets>,
 }
+
+/// Modal targets of Rayleigh damping: the ratio and the two circular frequencies
+/// (rad/s) it holds at.
+pub type RayleighTargets = (f64, [f64; 2]);
 
 impl Damping {
     /// Rayleigh's pair giving the ratio `xi` at the circular frequencies `w`:

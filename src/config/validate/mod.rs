@@ -268,7 +268,9 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
 /// Rayleigh's pair: `analysis.rayleigh` as given, or from `analysis.damping`'s
 /// ratio at two frequencies (given; by modes, set once the model is built,
 /// [`modal_targets`]).
-fn damping_targets(a: &super::AnalysisSpec) -> Result<([f64; 2], Option<(f64, [f64; 2])>)> {
+fn damping_targets(
+    a: &super::AnalysisSpec,
+) -> Result<([f64; 2], Option<crate::model::RayleighTargets>)> {
     let Some(d) = &a.damping else {
         return Ok((a.rayleigh, None));
     };
