@@ -454,7 +454,7 @@ fn main() -> ExitCode {
                     if m.rigid { "  rigid" } else { "" }
                 );
             }
-            for f in rothe::modal::output::write(&model, &modes, &out)? {
+            for f in rothe::output::modes::write(&model, &modes, &out)? {
                 println!("wrote {}", f.display());
             }
             Ok(())

@@ -11,7 +11,7 @@
 //! motion fix their dofs, bars are in `K` and `M` like any element.
 
 pub mod lanczos;
-pub mod output;
+pub mod step;
 
 use crate::assembly::{Assembler, Mass};
 use crate::error::{Error, Result};
