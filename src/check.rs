@@ -41,6 +41,9 @@ pub struct Report {
     /// The stable step of central differences (element eigenvalue bound), its block
     /// and element.
     pub stable: Option<(f64, usize, usize)>,
+    /// Central differences: the exact undamped stable step `2/ω_max` of the whole
+    /// mesh (`λ_max` of `M_lumped⁻¹K` by Lanczos).
+    pub exact_step: Option<f64>,
     /// The time scheme (for a dynamic analysis).
     pub scheme: Option<crate::model::TimeScheme>,
     /// Generalized-α's spectral radius at infinity.
@@ -204,6 +207,11 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         vtk,
         cfl,
         stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
+        exact_step: if a.time.scheme == crate::model::TimeScheme::CentralDifference {
+            Some(2.0 / crate::modal::highest_frequency(model)?)
+        } else {
+            None
+        },
         scheme: (a.time.kind == crate::model::AnalysisKind::Dynamic).then_some(a.time.scheme),
         rho_inf: a.time.rho_inf,
         contact_predictor: a.time.contact_predictor,
@@ -356,6 +364,13 @@ impl fmt::Display for Report {
                 f,
                 "stable step {dt_s:.4e} s (central differences, 2/ω_max of the elements; block {block}, element {element}); h / stable = {:.3}",
                 self.steps.1 / dt_s
+            )?;
+        }
+        if let Some(dt_e) = self.exact_step {
+            writeln!(
+                f,
+                "exact step  {dt_e:.4e} s (2/ω_max of the whole mesh, M_lumped⁻¹K by Lanczos, undamped); h / exact = {:.3}",
+                self.steps.1 / dt_e
             )?;
         }
         writeln!(

@@ -37,9 +37,10 @@ pub enum Shortfall {
     Operator(crate::error::Error),
 }
 
-/// The `count` largest eigenpairs of the `M`-self-adjoint operator `op` (`y = S x`)
-/// on vectors of length `n` `M`-orthogonal to the `locked` ones (`M`-orthonormal
-/// eigenvectors found before), with `mass` applying `M`; at most `max_steps` steps,
+/// The `count` largest eigenpairs of an `M`-self-adjoint operator `S` on vectors of
+/// length `n` `M`-orthogonal to the `locked` ones (`M`-orthonormal eigenvectors found
+/// before). `op` is handed `z = M q` and writes `S q` (for shift and invert,
+/// `S q = (K − σM)⁻¹ z`: one solve); `mass` applies `M`; at most `max_steps` steps,
 /// converged to `tol`. The start vector is fixed (deterministic), so a run repeats.
 /// An invariant subspace found early (the whole space, when `n` is small) ends the
 /// iteration with exact pairs.

@@ -445,3 +445,30 @@ mesh = { kind = "rectangle", size = [0.4, 0.1], divisions = [8, 2] }
         "{e}"
     );
 }
+
+#[test]
+fn the_exact_critical_step_is_the_lumped_chains_and_above_the_element_bound() {
+    // The axial bar of 40 lumped elements is a spring-mass chain fixed at one end:
+    // ω_max = (2c/h) sin((2n − 1)π/(4n)).
+    let n = 40;
+    let m = model(&bar(n));
+    let w = rothe::modal::highest_frequency(&m).unwrap();
+    let c = (210e9f64 / 7850.0).sqrt();
+    let h = 1.0 / n as f64;
+    let chain = 2.0 * c / h * ((2 * n - 1) as f64 * std::f64::consts::PI / (4 * n) as f64).sin();
+    assert!((w / chain - 1.0).abs() < 1e-8, "{w} against {chain}");
+    // On any mesh the largest element frequency bounds the mesh's from above, so the
+    // exact step is at least the element bound `rothe check` prints.
+    let two_blocks = rothe::config::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/explicit/two_blocks_central_difference.toml"),
+    )
+    .unwrap();
+    let exact = 2.0 / rothe::modal::highest_frequency(&two_blocks).unwrap();
+    let bound = rothe::time::cfl::stable_step(&two_blocks).unwrap().dt;
+    eprintln!("two blocks: exact step {exact:.5e} s, element bound {bound:.5e} s");
+    assert!(
+        exact >= bound && exact < 1.5 * bound,
+        "{exact} against {bound}"
+    );
+}
