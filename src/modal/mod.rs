@@ -115,17 +115,16 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
             full[d] = v;
         }
     };
-    let gather = |full: &[f64], y: &mut [f64]| {
-        for (yi, &d) in y.iter_mut().zip(&free) {
-            *yi = full[d];
-        }
-    };
+    // `M` or `K` on a free-dof vector, through two all-dof buffers kept across the
+    // Lanczos steps.
+    let buffers = std::cell::RefCell::new((vec![0.0; n], vec![0.0; n]));
     let apply = |m: &dyn Fn(&[f64], &mut [f64]), x: &[f64], y: &mut [f64]| {
-        let mut full = Vec::new();
-        scatter(x, &mut full);
-        let mut out = vec![0.0; n];
-        m(&full, &mut out);
-        gather(&out, y);
+        let (full, out) = &mut *buffers.borrow_mut();
+        scatter(x, full);
+        m(full, out);
+        for (yi, &d) in y.iter_mut().zip(&free) {
+            *yi = out[d];
+        }
     };
     let m_full = |x: &[f64], y: &mut [f64]| mass.matvec(pattern, x, y);
     let k_full = |x: &[f64], y: &mut [f64]| pattern.matvec(&k, x, y);
