@@ -1,7 +1,7 @@
 //! What `rothe modes` writes: `modes.csv` and `modes.json` (frequencies, generalised
 //! and effective modal masses, what the scenario's step does to each mode), and the
 //! shapes for ParaView (`modes.pvd`, one `vtk/mode_*.vtu` per mode, its "time" the
-//! mode's number).
+//! mode's number), and two charts (`spectrum`, `step_effect`).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -98,5 +98,56 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
         vtk.write(i + 1, (i + 1) as f64, &shape, &zero, &[], &cells, &[])?;
     }
     written.push(dir.join("modes.pvd"));
+    written.extend(plots(modes, h, dir)?);
     Ok(written)
+}
+
+/// `spectrum.png/svg` (the frequencies by mode number) and `step_effect.png/svg`
+/// (backward Euler's damping ratio and both schemes' period errors at the
+/// scenario's step, against the frequency): which modes the step resolves.
+fn plots(modes: &Modes, h: f64, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
+    use crate::plot::{draw, Figure, Series, Style};
+    let elastic: Vec<(usize, f64)> = modes
+        .modes
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| !m.rigid)
+        .map(|(i, m)| (i + 1, m.omega()))
+        .collect();
+    let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
+    let spectrum = Figure::new("Eigenfrequencies", "mode", "f [Hz]").with(Series::new(
+        "elastic modes",
+        elastic.iter().map(|&(i, w)| (i as f64, hz(w))).collect(),
+        Style::LineWithMarkers,
+    ));
+    let f: Vec<f64> = elastic.iter().map(|&(_, w)| hz(w)).collect();
+    let be: Vec<_> = elastic.iter().map(|&(_, w)| backward_euler(w, h)).collect();
+    let tr: Vec<_> = elastic.iter().map(|&(_, w)| trapezoidal(w, h)).collect();
+    let effect = Figure::new(
+        format!("What the step h = {h:e} s does to each mode"),
+        "f [Hz]",
+        "ratio",
+    )
+    .with(Series::from_xy(
+        "backward Euler: damping ratio",
+        &f,
+        &be.iter().map(|e| e.damping).collect::<Vec<_>>(),
+        Style::LineWithMarkers,
+    ))
+    .with(Series::from_xy(
+        "backward Euler: period error T'/T - 1",
+        &f,
+        &be.iter().map(|e| e.period - 1.0).collect::<Vec<_>>(),
+        Style::LineWithMarkers,
+    ))
+    .with(Series::from_xy(
+        "trapezoidal: period error T'/T - 1",
+        &f,
+        &tr.iter().map(|e| e.period - 1.0).collect::<Vec<_>>(),
+        Style::LineWithMarkers,
+    ));
+    let mut out = Vec::new();
+    out.extend(draw(&spectrum, &dir.join("spectrum"))?);
+    out.extend(draw(&effect, &dir.join("step_effect"))?);
+    Ok(out)
 }

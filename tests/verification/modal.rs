@@ -351,6 +351,14 @@ fn modes_refuses_bad_input_and_writes_its_tables_and_shapes() {
     let pvd = std::fs::read_to_string(out.join("modes.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 3);
     assert!(out.join("vtk/mode_0000001.vtu").exists());
+    for chart in [
+        "spectrum.png",
+        "spectrum.svg",
+        "step_effect.png",
+        "step_effect.svg",
+    ] {
+        assert!(out.join(chart).exists(), "{chart}");
+    }
     let (ok, _, stderr) = crate::common::rothe(&["modes", path.to_str().unwrap(), "--count", "0"]);
     assert!(!ok && stderr.contains("--count"), "{stderr}");
 }
