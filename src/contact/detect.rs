@@ -9,7 +9,8 @@
 //! master farther than that search reaches (theory/contact.md, "Nothing crosses
 //! unseen"; theory/contact3d.md).
 
-use super::master::faces::{FaceSurface, KeptFaces};
+use super::master::face_tree::KeptFaces;
+use super::master::faces::FaceSurface;
 use super::master::{self, rigid::EdgeHistory, MasterSurface, Positions};
 use super::rows::Candidate;
 use super::state::Slave;

@@ -157,7 +157,7 @@ fn inside_body(
         }
         for e in 0..b.elements.len() {
             let pts = b.elements.element(e).iter().map(|&k| mesh.coords[k]);
-            let bb = super::master::faces::bounding_box(pts, 0.0);
+            let bb = super::master::face_tree::bounding_box(pts, 0.0);
             items.push(rstar::primitives::GeomWithData::new(
                 rstar::primitives::Rectangle::from_corners(bb.lower(), bb.upper()),
                 (bi, e),

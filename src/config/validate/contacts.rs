@@ -212,7 +212,7 @@ fn mortar_reach(
                 .flat_map(|c| [c[0], c[1], c[2]])
                 .collect();
             let x = crate::contact::master::Positions::new(&x, 3);
-            let kept = crate::contact::master::faces::KeptFaces::new(faces, x, 0.0);
+            let kept = crate::contact::master::face_tree::KeptFaces::new(faces, x, 0.0);
             crate::contact::mortar::face_rows((0, 0), slaves, s, faces, &kept, radius, x, &mut rows)
         }
         _ => 0,

@@ -15,6 +15,7 @@
 //! over a step, the facets grown by the reach of the explicit path) are built when
 //! first asked for, so a surface asked for one thing pays for that one.
 
+pub mod face_tree;
 pub mod faces;
 pub mod projection;
 pub mod rigid;

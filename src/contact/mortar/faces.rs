@@ -18,7 +18,7 @@
 
 use super::clip::{shape_at, triangle_rule, Polygon};
 use super::{finish, Gathered};
-use crate::contact::master::faces::KeptFaces;
+use crate::contact::master::face_tree::KeptFaces;
 use crate::contact::master::Positions;
 use crate::contact::rows::Candidate;
 use crate::geometry::{cross, dot, sub, tangents, unit};
@@ -246,22 +246,19 @@ mod tests {
         (x, faces)
     }
 
-    /// The rows of a slave grid `gap` above a master grid; the flat positions, the
-    /// slaves' count and the rows.
+    /// The rows of a slave grid `gap` above a master grid whose nodes `moved` places;
+    /// the flat positions, the slaves' count and the rows.
     fn rows_of(
         slave: (usize, usize),
         master: (usize, usize),
         gap: f64,
         tri: [bool; 2],
-        tilt: f64,
+        moved: impl Fn(V3) -> V3,
     ) -> (Vec<f64>, usize, Vec<Candidate>) {
         let (mut xs, sf) = grid(slave, gap, 0, true, tri[0]);
         let ns = xs.len();
         let (xm, mf) = grid(master, 0.0, ns, false, tri[1]);
-        xs.extend(xm);
-        for p in &mut xs[ns..] {
-            p[1] = p[0] * tilt.tan();
-        }
+        xs.extend(xm.into_iter().map(moved));
         let flat: Vec<f64> = xs.iter().flatten().copied().collect();
         let x = Positions::new(&flat, 3);
         let kept = KeptFaces::new(&mf, x, 0.0);
@@ -280,7 +277,7 @@ mod tests {
             ((2, 2), (5, 3), [true, true]),
         ];
         for (slave, master, tri) in cases {
-            let (flat, ns, out) = rows_of(slave, master, 0.01, tri, 0.0);
+            let (flat, ns, out) = rows_of(slave, master, 0.01, tri, |p| p);
             assert_eq!(out.len(), ns, "{slave:?} on {master:?}");
             let mut load = vec![0.0; flat.len() / 3];
             let pos = |n: usize| [flat[3 * n], flat[3 * n + 1], flat[3 * n + 2]];
@@ -346,7 +343,9 @@ mod tests {
         // along the master's normal, so a slide of the slave along the master changes
         // no row's linearised gap.
         let tilt: f64 = 0.1;
-        let (_, ns, out) = rows_of((3, 2), (4, 3), 0.2, [false, false], tilt);
+        let (_, ns, out) = rows_of((3, 2), (4, 3), 0.2, [false, false], |p| {
+            [p[0], p[0] * tilt.tan(), p[2]]
+        });
         assert_eq!(out.len(), ns);
         for c in &out {
             let n = [-tilt.sin(), tilt.cos(), 0.0];
@@ -368,20 +367,13 @@ mod tests {
     fn a_master_under_part_of_the_slave_weights_what_it_covers() {
         // The master grid shifted by 0.3 in x: slave nodes at x = 0 and 1/3 see it
         // over part of their support only, and a node beyond its end gets no row.
-        let (mut xs, sf) = grid((3, 1), 0.1, 0, true, false);
-        let ns = xs.len();
-        let (xm, mf) = grid((2, 2), 0.0, ns, false, false);
-        xs.extend(xm.into_iter().map(|p| [p[0] + 0.5, p[1], p[2]]));
-        let flat: Vec<f64> = xs.iter().flatten().copied().collect();
-        let x = Positions::new(&flat, 3);
-        let kept = KeptFaces::new(&mf, x, 0.0);
-        let slaves: Vec<usize> = (0..ns).collect();
-        let mut out = Vec::new();
-        rows((0, 0), &slaves, &sf, &mf, &kept, 0.5, x, &mut out);
+        let (flat, _, out) = rows_of((3, 1), (2, 2), 0.1, [false, false], |p| {
+            [p[0] + 0.5, p[1], p[2]]
+        });
         // Nodes at x = 0 get none; at x = 1/3 the master covers [0.5, 2/3] of the
         // support [0, 2/3] of a hat 3x: ∫ over the cover of (2 − 3x) in x, times ½ in
         // z (the slave's one row of cells, its nodes on z = 0 and 1: ½ each).
-        let xs_of: Vec<f64> = out.iter().map(|c| xs[c.slave][0]).collect();
+        let xs_of: Vec<f64> = out.iter().map(|c| flat[3 * c.slave]).collect();
         assert!(xs_of.iter().all(|&v| v > 0.3), "{xs_of:?}");
         for c in &out {
             assert!((c.gap - 0.1).abs() < 1e-14, "{c:?}");
