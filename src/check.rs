@@ -424,8 +424,8 @@ fn damping_lines(model: &Model) -> Result<Vec<String>> {
         model,
         &crate::modal::ModalOptions {
             count: 6.min(model.mesh.n_dofs()),
-            shift: None,
             backend: crate::linsolve::Backend::Faer,
+            ..Default::default()
         },
     )?;
     for (i, m) in found.modes.iter().enumerate().filter(|(_, m)| !m.rigid) {

@@ -107,16 +107,21 @@ enum Command {
         out: PathBuf,
     },
     /// The lowest eigenfrequencies and mode shapes (shift-invert Lanczos on the run's
-    /// factor): modes.csv, modes.json and modes.pvd in the output directory.
+    /// factor, checked by a Sturm count), or those nearest a frequency: modes.csv,
+    /// modes.json, modes.pvd and the charts in the output directory.
     Modes {
         #[command(flatten)]
         scenario: ScenarioArgs,
-        /// Number of modes, the lowest.
+        /// Number of modes: the lowest, or the nearest --around.
         #[arg(long, default_value_t = 10)]
         count: usize,
-        /// The shift σ (rad²/s², zero or negative); default −1e-4 tr K / tr M.
-        #[arg(long, allow_hyphen_values = true)]
+        /// The shift σ (rad²/s², zero or negative); default −1e-7 tr K / tr M.
+        #[arg(long, allow_hyphen_values = true, conflicts_with = "around")]
         shift: Option<f64>,
+        /// The modes nearest this frequency (Hz) instead of the lowest (an LDLᵀ of
+        /// K − (2πF)²M, faer whatever the backend).
+        #[arg(long)]
+        around: Option<f64>,
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -426,12 +431,14 @@ fn main() -> ExitCode {
             scenario,
             count,
             shift,
+            around,
             out,
             backend,
         } => scenario.load().and_then(|model| {
             let opts = rothe::modal::ModalOptions {
                 count,
                 shift,
+                around,
                 backend,
             };
             let modes = rothe::modal::modes(&model, &opts)?;
@@ -442,12 +449,29 @@ fn main() -> ExitCode {
                 modes.steps,
                 modes.shift
             );
+            let sturm = &modes.sturm;
+            println!(
+                "Sturm check: {} eigenvalues {} by the inertia of K − μM, all found",
+                sturm.count,
+                if sturm.below.is_finite() {
+                    format!(
+                        "in [{:.6e}, {:.6e}) Hz",
+                        rothe::modal::hz(sturm.below),
+                        rothe::modal::hz(sturm.above)
+                    )
+                } else {
+                    format!("below {:.6e} Hz", rothe::modal::hz(sturm.above))
+                }
+            );
+            if let Some(note) = rothe::modal::history_note(&model) {
+                println!("note: {note}");
+            }
             println!("mode  f (Hz)          omega (rad/s)   residual");
-            for (i, m) in modes.modes.iter().enumerate() {
+            for m in &modes.modes {
                 let w = m.omega();
                 println!(
                     "{:>4}  {:<14.6e}  {:<14.6e}  {:.1e}{}",
-                    i + 1,
+                    m.number,
                     w / (2.0 * std::f64::consts::PI),
                     w,
                     m.residual,

@@ -14,6 +14,7 @@
 //! so the two compare factorisation codes on the same factor.
 
 pub mod faer_backend;
+pub mod ldlt;
 pub mod ordering;
 pub mod supernodal;
 

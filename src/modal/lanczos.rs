@@ -4,8 +4,9 @@
 //! `S = (K − σM)⁻¹ M` is self-adjoint in the `M` inner product with eigenvalues
 //! `θ = 1/(λ − σ)`: the lowest `λ` above `σ` are its largest `θ`, well separated, and
 //! Lanczos finds them in a few dozen products, each one solve with the factor of
-//! `K − σM`. Every new vector is orthogonalised against all earlier ones twice
-//! (classical Gram–Schmidt in the `M` inner product, repeated), so the basis stays
+//! `K − σM`. Every new vector is orthogonalised against all earlier ones (classical
+//! Gram–Schmidt in the `M` inner product, repeated when the first pass removed most
+//! of the vector: "twice is enough", Daniel–Gragg–Kaufman–Stewart), so the basis stays
 //! `M`-orthonormal to round-off and no spurious copies of converged pairs appear. The
 //! Ritz pairs of the tridiagonal matrix are tested every few steps: a pair has
 //! converged when its residual bound `|β_{j+1} s_j|` is below `tol · θ`.
@@ -23,6 +24,19 @@ pub struct Ritz {
     pub steps: usize,
 }
 
+/// What [`lanczos`] looks for.
+#[derive(Clone, Copy, Debug)]
+pub struct Wanted {
+    /// Pairs.
+    pub count: usize,
+    /// At most this many steps.
+    pub max_steps: usize,
+    /// A pair has converged when its residual bound is below `tol · |θ|`.
+    pub tol: f64,
+    /// The largest `|θ|` (a shift inside the spectrum) instead of the largest `θ`.
+    pub nearest: bool,
+}
+
 /// Why Lanczos stopped short.
 #[derive(Debug)]
 pub enum Shortfall {
@@ -37,38 +51,41 @@ pub enum Shortfall {
     Operator(crate::error::Error),
 }
 
-/// The `count` largest eigenpairs of an `M`-self-adjoint operator `S` on vectors of
-/// length `n` `M`-orthogonal to the `locked` ones (`M`-orthonormal eigenvectors found
+/// The `wanted.count` largest eigenpairs (largest in magnitude when `nearest`: a
+/// shift inside the spectrum, whose `θ` has both signs) of an `M`-self-adjoint
+/// operator `S` on vectors of length `n` `M`-orthogonal to the `locked` ones (`M`-orthonormal eigenvectors found
 /// before). `op` is handed `z = M q` and writes `S q` (for shift and invert,
-/// `S q = (K − σM)⁻¹ z`: one solve); `mass` applies `M`; at most `max_steps` steps,
-/// converged to `tol`. The start vector is fixed (deterministic), so a run repeats.
+/// `S q = (K − σM)⁻¹ z`: one solve); `mass` applies `M`. The start vector is fixed (deterministic), so a run repeats.
 /// An invariant subspace found early (the whole space, when `n` is small) ends the
 /// iteration with exact pairs.
 ///
 /// One start vector meets each distinct eigenvalue once in exact arithmetic: of a
 /// multiple one (a free body's rigid modes, a square section's two bending modes) it
-/// may find fewer copies than there are. [`super::modes`] therefore runs it again
-/// with what it found locked until nothing new enters.
+/// may find fewer copies than there are. [`super::modes`] therefore checks the count
+/// against the inertia of a factor (Sturm) and runs it again with what it found
+/// locked for the ones missed.
 pub fn lanczos(
     n: usize,
-    count: usize,
-    max_steps: usize,
-    tol: f64,
+    wanted: &Wanted,
     locked: &[Vec<f64>],
     mut op: impl FnMut(&[f64], &mut [f64]) -> crate::error::Result<()>,
     mass: impl Fn(&[f64], &mut [f64]),
 ) -> Result<Ritz, Shortfall> {
+    let Wanted {
+        count,
+        max_steps,
+        tol,
+        nearest,
+    } = *wanted;
     let max_steps = max_steps.min(n.saturating_sub(locked.len()));
-    let m_locked: Vec<Vec<f64>> = locked
-        .iter()
-        .map(|x| {
-            let mut y = vec![0.0; n];
-            mass(x, &mut y);
-            y
-        })
-        .collect();
-    let mut q: Vec<Vec<f64>> = Vec::new();
-    let mut mq: Vec<Vec<f64>> = Vec::new();
+    // The locked vectors, then the Lanczos vectors, as the columns of one basis.
+    let mut basis = Basis::new(n, locked.len() + max_steps.min(4 * count + 40));
+    let mut my = vec![0.0; n];
+    for x in locked {
+        mass(x, &mut my);
+        basis.push(x, &my);
+    }
+    let first = locked.len();
     let (mut alpha, mut beta) = (Vec::<f64>::new(), Vec::<f64>::new());
     // A fixed start with every component present (a low-discrepancy sequence).
     let mut v: Vec<f64> = (0..n)
@@ -77,28 +94,40 @@ pub fn lanczos(
     let mut mv = vec![0.0; n];
     let mut w = vec![0.0; n];
     loop {
-        // Orthogonalise v against the basis (twice) and normalise it in M.
+        // Orthogonalise v against the basis and normalise it in M. The basis is
+        // M-orthonormal, so ‖v‖²_M before a pass is ‖v‖²_M after it plus Σ c_i²: a
+        // second pass only when the first removed most of v (Σ c_i² above what is
+        // left: the DGKS criterion, the norm fell below 1/√2 of itself), where the
+        // first pass's round-off matters; one product with M per pass.
+        let mut b = 0.0;
         for _ in 0..2 {
+            let removed = basis.project_out(&mut v);
             mass(&v, &mut mv);
-            for (qi, mqi) in locked.iter().zip(&m_locked).chain(q.iter().zip(&mq)) {
-                let c = dot(mqi, &v);
-                axpy(-c, qi, &mut v);
+            b = dot(&v, &mv).max(0.0).sqrt();
+            if removed <= b * b {
+                break;
             }
         }
-        mass(&v, &mut mv);
-        let b = dot(&v, &mv).max(0.0).sqrt();
-        let j = q.len();
+        let j = basis.len() - first;
         if j > 0 {
             beta.push(b);
         }
         let scale_ref = alpha.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let exhausted = j > 0 && b <= 1e-13 * scale_ref.max(f64::MIN_POSITIVE);
-        if exhausted || j == max_steps || (j > 0 && j % 5 == 0 && j >= count) {
+        if exhausted || j == max_steps || (j > 0 && j >= count + 2) {
             // The Ritz pairs of T_j and their residual bounds.
             let t = tridiagonal(&alpha, &beta[..j - 1]);
             let eig = SymmetricEigen::new(t);
             let mut order: Vec<usize> = (0..j).collect();
-            order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+            let key = |i: usize| {
+                let th = eig.eigenvalues[i];
+                if nearest {
+                    th.abs()
+                } else {
+                    th
+                }
+            };
+            order.sort_by(|&a, &b| key(b).total_cmp(&key(a)));
             let bound = if exhausted { 0.0 } else { b };
             let converged = order
                 .iter()
@@ -114,8 +143,8 @@ pub fn lanczos(
                     .iter()
                     .map(|&i| {
                         let mut x = vec![0.0; n];
-                        for (k, qk) in q.iter().enumerate() {
-                            axpy(eig.eigenvectors[(k, i)], qk, &mut x);
+                        for k in 0..j {
+                            axpy(eig.eigenvectors[(k, i)], basis.column(first + k), &mut x);
                         }
                         x
                     })
@@ -142,13 +171,68 @@ pub fn lanczos(
         op(&mv, &mut w).map_err(Shortfall::Operator)?;
         let a = dot(&w, &mv);
         alpha.push(a);
-        q.push(std::mem::take(&mut v));
-        mq.push(mv.clone());
-        v = w.clone();
-        axpy(-a, &q[j], &mut v);
+        basis.push(&v, &mv);
+        std::mem::swap(&mut v, &mut w);
+        axpy(-a, basis.column(first + j), &mut v);
         if j > 0 {
-            axpy(-beta[j - 1], &q[j - 1], &mut v);
+            axpy(-beta[j - 1], basis.column(first + j - 1), &mut v);
         }
+    }
+}
+
+/// `M`-orthonormal vectors `q_i` and their products `M q_i`, as the columns of two
+/// column-major `n × k` arrays, so that a Gram–Schmidt pass is two matrix-vector
+/// products (vectorised) instead of `2k` separate sweeps.
+struct Basis {
+    n: usize,
+    q: Vec<f64>,
+    mq: Vec<f64>,
+}
+
+impl Basis {
+    /// Room for `columns` vectors of length `n` (more grow the arrays).
+    fn new(n: usize, columns: usize) -> Self {
+        Basis {
+            n,
+            q: Vec::with_capacity(n * columns),
+            mq: Vec::with_capacity(n * columns),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.q.len() / self.n.max(1)
+    }
+
+    fn push(&mut self, q: &[f64], mq: &[f64]) {
+        self.q.extend_from_slice(q);
+        self.mq.extend_from_slice(mq);
+    }
+
+    fn column(&self, i: usize) -> &[f64] {
+        &self.q[i * self.n..(i + 1) * self.n]
+    }
+
+    /// One classical Gram–Schmidt pass in the `M` inner product: `c = Qᵀ M v`,
+    /// `v ← v − Q c`; returns `Σ c_i²`, the `M`-norm² it removed.
+    fn project_out(&self, v: &mut [f64]) -> f64 {
+        use faer::linalg::matmul::matmul;
+        use faer::{Accum, MatMut, MatRef, Par};
+        let (n, k) = (self.n, self.len());
+        if k == 0 {
+            return 0.0;
+        }
+        let q = MatRef::from_column_major_slice(&self.q, n, k);
+        let mq = MatRef::from_column_major_slice(&self.mq, n, k);
+        let mut c = vec![0.0; k];
+        {
+            let vr = MatRef::from_column_major_slice(v, n, 1);
+            let cm = MatMut::from_column_major_slice_mut(&mut c, k, 1);
+            matmul(cm, Accum::Replace, mq.transpose(), vr, 1.0, Par::Seq);
+        }
+        let cr = MatRef::from_column_major_slice(&c, k, 1);
+        let vm = MatMut::from_column_major_slice_mut(v, n, 1);
+        matmul(vm, Accum::Add, q, cr, -1.0, Par::Seq);
+        dot(&c, &c)
     }
 }
 
@@ -165,8 +249,23 @@ fn tridiagonal(alpha: &[f64], beta: &[f64]) -> DMatrix<f64> {
     t
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+/// `aᵀb` in four interleaved partial sums: independent additions the processor
+/// overlaps (and vectorises), where one running sum waits on each addition.
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    let mut s = [0.0; 4];
+    for (x, y) in ca.zip(cb) {
+        for k in 0..4 {
+            s[k] += x[k] * y[k];
+        }
+    }
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 fn axpy(c: f64, x: &[f64], y: &mut [f64]) {
@@ -196,7 +295,13 @@ mod tests {
                 y[i] = 2.0 * x[i];
             }
         };
-        let r = lanczos(n, 5, 60, 1e-12, &[], op, mass).unwrap_or_else(|_| panic!("converges"));
+        let wanted = Wanted {
+            count: 5,
+            max_steps: 60,
+            tol: 1e-12,
+            nearest: false,
+        };
+        let r = lanczos(n, &wanted, &[], op, mass).unwrap_or_else(|_| panic!("converges"));
         for (i, th) in r.theta.iter().enumerate() {
             let lambda = sigma + 1.0 / th;
             assert!(

@@ -12,28 +12,47 @@
 
 pub mod lanczos;
 pub mod step;
+mod sturm;
 
 use crate::assembly::{Assembler, Mass};
 use crate::error::{Error, Result};
+use crate::linsolve::ldlt::Ldlt;
 use crate::linsolve::Backend;
 use crate::model::Model;
-use crate::system::{DofMap, EffectiveSystem, Factored};
+use crate::system::{DofMap, EffectiveSystem, Factored, ReducedMatrix};
+use lanczos::dot;
 
 /// What to compute.
 #[derive(Clone, Copy, Debug)]
 pub struct ModalOptions {
-    /// Number of modes, the lowest.
+    /// Number of modes: the lowest, or the nearest `around`.
     pub count: usize,
-    /// The shift `σ` (rad²/s², negative); `None`: `−10⁻⁴ tr K / tr M` over the free
-    /// dofs, below every mode of a discretised body.
+    /// The shift `σ` (rad²/s², zero or negative) of the Cholesky factor; `None`:
+    /// `−10⁻⁷ tr K / tr M` over the free dofs, below every mode of a discretised body.
     pub shift: Option<f64>,
-    /// The linear solver.
+    /// A frequency (Hz): the modes nearest it instead of the lowest, from an `LDLᵀ`
+    /// of `K − (2πF)²M` (indefinite; faer whatever the backend).
+    pub around: Option<f64>,
+    /// The linear solver of the Cholesky factor.
     pub backend: Backend,
+}
+
+impl Default for ModalOptions {
+    fn default() -> Self {
+        ModalOptions {
+            count: 10,
+            shift: None,
+            around: None,
+            backend: Backend::default(),
+        }
+    }
 }
 
 /// One eigenpair.
 #[derive(Clone, Debug)]
 pub struct Mode {
+    /// Its place in the spectrum, from 1 (the lowest; rigid modes counted).
+    pub number: usize,
     /// `λ = ω²` (rad²/s²).
     pub lambda: f64,
     /// A rigid-body mode: `λ` below `10⁻¹⁰ tr K / tr M`, round-off of zero.
@@ -59,6 +78,20 @@ impl Mode {
     }
 }
 
+/// The Sturm check of a set of modes: the eigenvalues of `K x = λ M x` in
+/// `[below, above)` counted by the inertia of `K − μM` at both ends (`LDLᵀ`,
+/// Sylvester's law), equal to the number found there.
+#[derive(Clone, Copy, Debug)]
+pub struct Sturm {
+    /// The lower end (`−∞` for the lowest modes: nothing to count there).
+    pub below: f64,
+    /// The upper end: just above the highest eigenvalue found.
+    pub above: f64,
+    /// Eigenvalues in the interval, by the inertia; all were found (the first
+    /// Lanczos run's, plus the copies it missed), then cut to the count asked.
+    pub count: usize,
+}
+
 /// The modes of a model.
 #[derive(Clone, Debug)]
 pub struct Modes {
@@ -68,6 +101,8 @@ pub struct Modes {
     pub shift: f64,
     /// Lanczos steps (solves with the factor).
     pub steps: usize,
+    /// The Sturm check the modes passed.
+    pub sturm: Sturm,
     /// `ι_rᵀ M ι_r`: the mass the free dofs carry along each direction.
     pub total_mass: [f64; 3],
     /// Mesh dimension.
@@ -76,12 +111,74 @@ pub struct Modes {
     pub lumped: bool,
     /// Free dofs.
     pub n_free: usize,
+    /// The factor Lanczos solves with: its analysis, factorisation (a shift moved
+    /// off an eigenvalue counts each attempt) and solves.
+    pub timing: crate::system::SystemTiming,
+    /// The Sturm check's `LDLᵀ` analysis and factorisations (s).
+    pub sturm_s: f64,
+    /// Wall time of the whole computation, assembly included (s).
+    pub total_s: f64,
 }
 
-/// The `count` lowest modes of `model` (see the module's text).
+/// The factor Lanczos solves with: the Cholesky of the runs at a shift below the
+/// spectrum, or an `LDLᵀ` at a shift inside it.
+enum Factor {
+    Definite(Box<EffectiveSystem>),
+    Indefinite(Box<Ldlt>),
+}
+
+/// `K − μM` on the free dofs, its `LDLᵀ` and the time they take: the inertia at
+/// any `μ`, and the factor of `--around`.
+struct Shifted<'a> {
+    reduced: ReducedMatrix,
+    ldlt: Option<Ldlt>,
+    dofs: &'a DofMap,
+    mass: &'a Mass,
+    k: &'a [f64],
+    order: Option<Vec<usize>>,
+    timing: crate::system::SystemTiming,
+}
+
+impl Shifted<'_> {
+    /// Factorises `K − μM`; `μ` is moved off an eigenvalue (a zero pivot) by a
+    /// relative `10⁻⁸` up to three times. Returns the `μ` used and the number of
+    /// eigenvalues below it.
+    fn factorize(&mut self, mut mu: f64, scale: f64) -> Result<(f64, usize)> {
+        for attempt in 0.. {
+            self.reduced
+                .fill(self.dofs, -mu, self.mass, &[(1.0, self.k)]);
+            if self.ldlt.is_none() {
+                let t = std::time::Instant::now();
+                self.ldlt = Some(Ldlt::analyze(&self.reduced.csc, self.order.as_deref())?);
+                self.timing.analysis_s += t.elapsed().as_secs_f64();
+            }
+            let ldlt = self.ldlt.as_mut().expect("analysed above");
+            let t = std::time::Instant::now();
+            let res = ldlt.factorize(&self.reduced.csc);
+            self.timing.factorization_s += t.elapsed().as_secs_f64();
+            match res {
+                Ok(inertia) => return Ok((mu, inertia.negative)),
+                Err(_) if attempt < 3 => mu += 1e-8 * mu.abs().max(scale * 1e-6),
+                Err(e) => return Err(e),
+            }
+        }
+        unreachable!("the loop returns")
+    }
+}
+
+/// The `count` lowest modes of `model`, or the `count` nearest `opts.around` (see
+/// the module's text and `theory/modal.md`).
 pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
+    let started = std::time::Instant::now();
     if opts.count == 0 {
         return Err(Error::config("--count", "ask for at least one mode"));
+    }
+    if opts.shift.is_some() && opts.around.is_some() {
+        return Err(Error::config(
+            "--around",
+            "give a shift (--shift, below the spectrum) or a frequency to look around \
+             (--around), not both",
+        ));
     }
     let mesh = &model.mesh;
     let asm = Assembler::new(mesh);
@@ -137,94 +234,106 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
         ));
     }
     let scale = tr_k / tr_m;
-    let mut sigma = match opts.shift {
-        Some(s) if !(s.is_finite() && s <= 0.0) => {
+    let mut shifted = Shifted {
+        reduced: ReducedMatrix::new(pattern, &dofs),
+        ldlt: None,
+        dofs: &dofs,
+        mass: &mass,
+        k: &k,
+        order: None,
+        timing: Default::default(),
+    };
+    let nested = model
+        .analysis
+        .iteration
+        .ordering
+        .nested_dissection(n_free, pattern.dim);
+    let mut main_timing = crate::system::SystemTiming::default();
+    let (mut sigma, mut factor, below_sigma) = match opts.around {
+        Some(f) if !(f.is_finite() && f > 0.0) => {
             return Err(Error::config(
-                "--shift",
-                format!(
-                    "{s} rad²/s²: the shift must be zero or negative (the factor of K − σM \
-                     is a Cholesky, positive only below the lowest mode)"
-                ),
+                "--around",
+                format!("{f} Hz: the frequency to look around must be positive"),
             ))
         }
-        Some(s) => s,
-        None => -1e-4 * scale,
+        Some(f) => {
+            if nested {
+                shifted.order = Some(shifted.reduced.nested_dissection(&dofs, &mesh.coords));
+            }
+            let sigma = (2.0 * std::f64::consts::PI * f).powi(2);
+            let (sigma, below) = shifted.factorize(sigma, scale)?;
+            let ldlt = shifted.ldlt.take().expect("factorised");
+            main_timing = shifted.timing;
+            shifted.timing = Default::default();
+            (sigma, Factor::Indefinite(Box::new(ldlt)), below)
+        }
+        None => {
+            let sigma = match opts.shift {
+                Some(s) if !(s.is_finite() && s <= 0.0) => {
+                    return Err(Error::config(
+                        "--shift",
+                        format!(
+                            "{s} rad²/s²: the shift must be zero or negative (the factor of \
+                             K − σM is a Cholesky, positive only below the lowest mode; \
+                             --around F looks inside the spectrum)"
+                        ),
+                    ))
+                }
+                Some(s) => s,
+                None => -1e-7 * scale,
+            };
+            let sys = EffectiveSystem::new(
+                pattern,
+                dofs.clone(),
+                opts.backend,
+                model.analysis.iteration.ordering,
+                &mesh.coords,
+            )?;
+            shifted.order = sys.ordering();
+            (sigma, Factor::Definite(Box::new(sys)), 0)
+        }
     };
-    let mut sys = EffectiveSystem::new(
-        pattern,
-        dofs,
-        opts.backend,
-        model.analysis.iteration.ordering,
-        &mesh.coords,
-    )?;
     // A shift at an eigenvalue (zero, for a free body) does not factor: the shift is
     // moved below it.
-    for attempt in 0.. {
-        sys.refill(-sigma, &mass, &[(1.0, &k)]);
-        match sys.factorize()? {
-            Factored::Ok => break,
-            Factored::NotPositiveDefinite { .. } if attempt < 3 => {
-                sigma = sigma.min(0.0) - 1e-6 * scale * 100f64.powi(attempt);
-            }
-            Factored::NotPositiveDefinite { dof, message } => {
-                return Err(Error::NotPositiveDefinite {
-                    backend: sys.backend(),
-                    column: dof,
-                    message: format!("K − σM at σ = {sigma:e}: {message}"),
-                })
+    if let Factor::Definite(sys) = &mut factor {
+        for attempt in 0.. {
+            sys.refill(-sigma, &mass, &[(1.0, &k)]);
+            match sys.factorize()? {
+                Factored::Ok => break,
+                Factored::NotPositiveDefinite { .. } if attempt < 3 => {
+                    sigma = sigma.min(0.0) - 1e-6 * scale * 100f64.powi(attempt);
+                }
+                Factored::NotPositiveDefinite { dof, message } => {
+                    return Err(Error::NotPositiveDefinite {
+                        backend: sys.backend(),
+                        column: dof,
+                        message: format!("K − σM at σ = {sigma:e}: {message}"),
+                    })
+                }
             }
         }
     }
-    let max_steps = (20 * opts.count + 60).min(n_free);
-    let shortfall = |e: lanczos::Shortfall| match e {
-        lanczos::Shortfall::Operator(e) => e,
-        lanczos::Shortfall::NotConverged { converged, steps } => Error::Stepping(format!(
-            "modal analysis: {converged} of {} modes converged in {steps} Lanczos steps; \
-             ask for fewer or give a shift nearer the lowest (--shift)",
-            opts.count
-        )),
+    let search = sturm::Search {
+        count: opts.count,
+        sigma,
+        nearest: opts.around.is_some(),
+        below_sigma,
+        scale,
     };
-    let mut run = |count: usize, locked: &[Vec<f64>]| {
-        lanczos::lanczos(
-            n_free,
-            count,
-            max_steps,
-            1e-10,
-            locked,
-            |x, y| {
-                y.copy_from_slice(x);
-                sys.solve(y)
-            },
-            |x, y| apply(&m_full, x, y),
-        )
-    };
-    // Found, then checked with what was found locked: a copy of a multiple
-    // eigenvalue the first run missed comes out above the lowest found and enters.
-    let first = run(opts.count, &[]).map_err(shortfall)?;
-    let mut steps = first.steps;
-    let mut pairs: Vec<(f64, Vec<f64>)> = first.theta.into_iter().zip(first.vectors).collect();
-    while pairs.len() < n_free {
-        let locked: Vec<Vec<f64>> = pairs.iter().map(|p| p.1.clone()).collect();
-        let more = match run(1, &locked) {
-            Ok(r) => r,
-            Err(lanczos::Shortfall::NotConverged { .. }) => break,
-            Err(e) => return Err(shortfall(e)),
-        };
-        steps += more.steps;
-        let lowest = pairs.last().map_or(f64::INFINITY, |p| p.0);
-        let (theta, x) = (more.theta[0], more.vectors[0].clone());
-        if theta <= lowest * (1.0 + 1e-8) {
-            break;
-        }
-        pairs.push((theta, x));
-        pairs.sort_by(|a, b| b.0.total_cmp(&a.0));
-        pairs.truncate(opts.count);
-    }
-    let ritz = lanczos::Ritz {
-        theta: pairs.iter().map(|p| p.0).collect(),
-        vectors: pairs.into_iter().map(|p| p.1).collect(),
-        steps,
-    };
+    let found = sturm::search(
+        &search,
+        n_free,
+        |x, y| {
+            y.copy_from_slice(x);
+            match &mut factor {
+                Factor::Definite(sys) => sys.solve(y),
+                Factor::Indefinite(ldlt) => ldlt.solve(y),
+            }
+        },
+        |x, y| apply(&m_full, x, y),
+        |mu| shifted.factorize(mu, scale),
+    )?;
+    let (pairs, steps, first_number) = (found.pairs, found.steps, found.first_number);
     let dim = mesh.dim;
     let mut total_mass = [0.0; 3];
     let iota: Vec<Vec<f64>> = (0..dim)
@@ -239,10 +348,10 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
         apply(&m_full, &iota[r], &mut m_iota[r]);
         total_mass[r] = dot(&iota[r], &m_iota[r]);
     }
-    let mut modes = Vec::with_capacity(ritz.theta.len());
+    let mut modes = Vec::with_capacity(pairs.len());
     let (mut kx, mut mx) = (vec![0.0; n_free], vec![0.0; n_free]);
-    for (theta, x) in ritz.theta.iter().zip(&ritz.vectors) {
-        let lambda = sigma + 1.0 / theta;
+    for (i, (lambda, x)) in pairs.iter().enumerate() {
+        let lambda = *lambda;
         let rigid = lambda.abs() <= 1e-10 * scale;
         apply(&k_full, x, &mut kx);
         apply(&m_full, x, &mut mx);
@@ -260,6 +369,7 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
         let mut shape = Vec::new();
         scatter(x, &mut shape);
         modes.push(Mode {
+            number: first_number + i,
             lambda,
             rigid,
             shape,
@@ -267,15 +377,45 @@ pub fn modes(model: &Model, opts: &ModalOptions) -> Result<Modes> {
             participation,
         });
     }
+    let timing = match &factor {
+        Factor::Definite(sys) => sys.timing(),
+        Factor::Indefinite(_) => crate::system::SystemTiming {
+            solves: steps,
+            ..main_timing
+        },
+    };
     Ok(Modes {
         modes,
         shift: sigma,
-        steps: ritz.steps,
+        steps,
+        sturm: found.sturm,
         total_mass,
         dim,
         lumped,
         n_free,
+        timing,
+        sturm_s: shifted.timing.analysis_s + shifted.timing.factorization_s,
+        total_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// What the modes of a model with a material beyond linear elasticity are: those
+/// of its initial, elastic stiffness (`None` when every material is linear elastic).
+pub fn history_note(model: &Model) -> Option<&'static str> {
+    model
+        .materials
+        .iter()
+        .any(|m| !m.is_linear_elastic())
+        .then_some(
+            "the modes are those of the initial, elastic stiffness; a material with \
+             viscosity, damage or plasticity damps or softens them as the run evolves",
+        )
+}
+
+/// The frequency (Hz) of an eigenvalue `λ = ω²`, signed as `λ` (a shift below the
+/// spectrum is negative).
+pub fn hz(lambda: f64) -> f64 {
+    lambda.signum() * lambda.abs().sqrt() / (2.0 * std::f64::consts::PI)
 }
 
 /// `tr K` and `tr M` over the free dofs.
@@ -290,10 +430,6 @@ fn traces(asm: &Assembler, k: &[f64], mass: &Mass, free: &[usize]) -> (f64, f64)
         };
         (a + at(k, f), b + m)
     })
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn norm(a: &[f64]) -> f64 {
@@ -339,7 +475,13 @@ pub fn highest_frequency(model: &Model) -> Result<f64> {
             *yi = d[f] * v;
         }
     };
-    let r = lanczos::lanczos(free.len(), 1, 400, 1e-8, &[], op, mass).map_err(|e| match e {
+    let wanted = lanczos::Wanted {
+        count: 1,
+        max_steps: 400,
+        tol: 1e-8,
+        nearest: false,
+    };
+    let r = lanczos::lanczos(free.len(), &wanted, &[], op, mass).map_err(|e| match e {
         lanczos::Shortfall::Operator(e) => e,
         lanczos::Shortfall::NotConverged { steps, .. } => Error::Stepping(format!(
             "the largest frequency did not converge in {steps} Lanczos steps"

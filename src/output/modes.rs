@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::modal::step::{backward_euler, trapezoidal};
+use crate::modal::step::{backward_euler, generalized_alpha, trapezoidal};
 use crate::modal::Modes;
 use crate::model::Model;
 
@@ -22,10 +22,14 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
     for a in &axes[..dim] {
         write!(csv, ",eff_mass_{a},eff_mass_{a}_sum").expect("to a string");
     }
-    csv.push_str(",be_damping_ratio,be_period_ratio,trapezoidal_period_ratio,residual\n");
+    csv.push_str(
+        ",be_damping_ratio,be_period_ratio,trapezoidal_period_ratio,ga_damping_ratio,\
+         ga_period_ratio,residual\n",
+    );
+    let rho_inf = model.analysis.time.rho_inf;
     let mut sums = [0.0; 3];
     let mut rows = Vec::new();
-    for (i, m) in modes.modes.iter().enumerate() {
+    for m in &modes.modes {
         let w = m.omega();
         let f = w / (2.0 * std::f64::consts::PI);
         let period = if w > 0.0 { 1.0 / f } else { f64::INFINITY };
@@ -33,10 +37,11 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
         let peak = m.shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let gm = 1.0 / (peak * peak);
         let (be, tr) = (backward_euler(w, h), trapezoidal(w, h));
+        let ga = generalized_alpha(w, h, rho_inf);
         write!(
             csv,
             "{},{:.12e},{:.12e},{:.12e},{},{:.12e}",
-            i + 1,
+            m.number,
             w,
             f,
             period,
@@ -54,12 +59,12 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
         }
         writeln!(
             csv,
-            ",{:.9e},{:.9e},{:.9e},{:.3e}",
-            be.damping, be.period, tr.period, m.residual
+            ",{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.3e}",
+            be.damping, be.period, tr.period, ga.damping, ga.period, m.residual
         )
         .expect("to a string");
         rows.push(serde_json::json!({
-            "index": i + 1,
+            "index": m.number,
             "omega_rad_s": w,
             "f_hz": f,
             "period_s": if period.is_finite() { serde_json::json!(period) } else { serde_json::Value::Null },
@@ -68,6 +73,7 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
             "effective_mass": fractions,
             "backward_euler": {"damping_ratio": be.damping, "period_ratio": be.period},
             "trapezoidal": {"damping_ratio": tr.damping, "period_ratio": tr.period},
+            "generalized_alpha": {"rho_inf": rho_inf, "damping_ratio": ga.damping, "period_ratio": ga.period},
             "residual": m.residual,
         }));
     }
@@ -84,6 +90,12 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
         "dt": h,
         "total_mass_kg": &modes.total_mass[..dim],
         "stiffness": "linear, at the initial state",
+        "note": crate::modal::history_note(model),
+        "sturm": {
+            "below_rad2_s2": if modes.sturm.below.is_finite() { serde_json::json!(modes.sturm.below) } else { serde_json::Value::Null },
+            "above_rad2_s2": modes.sturm.above,
+            "eigenvalues_counted": modes.sturm.count,
+        },
     });
     let path = dir.join("modes.json");
     let text = serde_json::to_string_pretty(&json).expect("plain values");
@@ -92,27 +104,27 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
     let mut vtk = super::vtk::VtkSeries::named(dir, &model.mesh, "modes", "mode")?;
     let zero = vec![0.0; model.mesh.n_dofs()];
     let cells = vec![[0.0; 6]; model.mesh.n_elements()];
-    for (i, m) in modes.modes.iter().enumerate() {
+    for m in &modes.modes {
         let peak = m.shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let shape: Vec<f64> = m.shape.iter().map(|x| x / peak).collect();
-        vtk.write(i + 1, (i + 1) as f64, &shape, &zero, &[], &cells, &[])?;
+        vtk.write(m.number, m.number as f64, &shape, &zero, &[], &cells, &[])?;
     }
     written.push(dir.join("modes.pvd"));
-    written.extend(plots(modes, h, dir)?);
+    written.extend(plots(modes, h, rho_inf, dir)?);
     Ok(written)
 }
 
 /// `spectrum.png/svg` (the frequencies by mode number) and `step_effect.png/svg`
-/// (backward Euler's damping ratio and both schemes' period errors at the
-/// scenario's step, against the frequency): which modes the step resolves.
-fn plots(modes: &Modes, h: f64, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
+/// (backward Euler's and generalized-α's damping ratios and the three schemes'
+/// period errors at the scenario's step, against the frequency): which modes the
+/// step resolves.
+fn plots(modes: &Modes, h: f64, rho_inf: f64, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
     use crate::plot::{draw, Figure, Series, Style};
     let elastic: Vec<(usize, f64)> = modes
         .modes
         .iter()
-        .enumerate()
-        .filter(|(_, m)| !m.rigid)
-        .map(|(i, m)| (i + 1, m.omega()))
+        .filter(|m| !m.rigid)
+        .map(|m| (m.number, m.omega()))
         .collect();
     let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
     let spectrum = Figure::new("Eigenfrequencies", "mode", "f [Hz]").with(Series::new(
@@ -123,6 +135,10 @@ fn plots(modes: &Modes, h: f64, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
     let f: Vec<f64> = elastic.iter().map(|&(_, w)| hz(w)).collect();
     let be: Vec<_> = elastic.iter().map(|&(_, w)| backward_euler(w, h)).collect();
     let tr: Vec<_> = elastic.iter().map(|&(_, w)| trapezoidal(w, h)).collect();
+    let ga: Vec<_> = elastic
+        .iter()
+        .map(|&(_, w)| generalized_alpha(w, h, rho_inf))
+        .collect();
     let effect = Figure::new(
         format!("What the step h = {h:e} s does to each mode"),
         "f [Hz]",
@@ -144,6 +160,18 @@ fn plots(modes: &Modes, h: f64, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
         "trapezoidal: period error T'/T - 1",
         &f,
         &tr.iter().map(|e| e.period - 1.0).collect::<Vec<_>>(),
+        Style::LineWithMarkers,
+    ))
+    .with(Series::from_xy(
+        format!("generalized-alpha (rho_inf {rho_inf}): damping ratio"),
+        &f,
+        &ga.iter().map(|e| e.damping).collect::<Vec<_>>(),
+        Style::LineWithMarkers,
+    ))
+    .with(Series::from_xy(
+        format!("generalized-alpha (rho_inf {rho_inf}): period error T'/T - 1"),
+        &f,
+        &ga.iter().map(|e| e.period - 1.0).collect::<Vec<_>>(),
         Style::LineWithMarkers,
     ));
     let mut out = Vec::new();

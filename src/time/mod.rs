@@ -15,7 +15,7 @@ pub mod cfl;
 mod diagnostics;
 mod export;
 pub mod forces;
-mod generalized_alpha;
+pub(crate) mod generalized_alpha;
 mod implicit;
 mod kept_factor;
 pub mod march;

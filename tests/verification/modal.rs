@@ -11,8 +11,7 @@ use crate::common::model;
 fn options(count: usize) -> ModalOptions {
     ModalOptions {
         count,
-        shift: None,
-        backend: Backend::Faer,
+        ..Default::default()
     }
 }
 
@@ -211,8 +210,8 @@ fn a_dense_generalised_solve_and_both_backends_give_the_same_frequencies() {
             &m,
             &ModalOptions {
                 count: 8,
-                shift: None,
                 backend,
+                ..Default::default()
             },
         )
         .unwrap();
@@ -296,7 +295,7 @@ fn modes_refuses_bad_input_and_writes_its_tables_and_shapes() {
             &ModalOptions {
                 count,
                 shift,
-                backend: Backend::Faer,
+                ..Default::default()
             },
         )
         .unwrap_err()
@@ -479,4 +478,114 @@ fn the_exact_critical_step_is_the_lumped_chains_and_above_the_element_bound() {
         exact >= bound && exact < 1.5 * bound,
         "{exact} against {bound}"
     );
+}
+
+/// Two identical plane-stress cantilevers side by side, not connected: every
+/// eigenvalue of the pair is double.
+fn twin_cantilevers() -> String {
+    let body = |name: &str, y: f64| {
+        format!(
+            r#"
+[[bodies]]
+name = "{name}"
+material = "steel"
+thickness = 0.1
+mesh = {{ kind = "rectangle", origin = [0.0, {y}], size = [1.0, 0.1], divisions = [20, 2] }}
+[[supports]]
+set = "{name}.left"
+fix = ["x", "y"]
+"#
+        )
+    };
+    format!(
+        r#"
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-6
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.3
+rho = 7850.0
+{}{}"#,
+        body("a", 0.0),
+        body("b", 0.5)
+    )
+}
+
+#[test]
+fn the_sturm_count_finds_the_copies_of_double_eigenvalues_lanczos_missed() {
+    // One start vector meets each distinct eigenvalue once: of the twins' double
+    // eigenvalues the first Lanczos run finds one copy, and the inertia of K − μM
+    // (twice as many below μ) sends it back for the others. Each frequency comes
+    // twice, equal to a single cantilever's, the set M-orthonormal.
+    let twins = model(&twin_cantilevers());
+    let single_text = twin_cantilevers();
+    let cut = single_text.find("\n[[bodies]]\nname = \"b\"").unwrap();
+    let single = modes(&model(&single_text[..cut]), &options(3)).unwrap();
+    for count in [2, 4, 6] {
+        let found = modes(&twins, &options(count)).unwrap();
+        for i in 0..count {
+            let (f, g) = (hz(&found, i), hz(&single, i / 2));
+            assert!(
+                (f / g - 1.0).abs() < 1e-9,
+                "{count} modes, mode {}: {f} Hz, single {g} Hz",
+                i + 1
+            );
+        }
+        assert!(found.sturm.count >= count);
+        orthonormal(&twins, &found);
+    }
+}
+
+#[test]
+fn the_modes_around_a_frequency_are_the_nearest_numbered_in_the_spectrum() {
+    // The bar's axial spectrum f_k = (2k − 1) c/(4L) (discrete, from the lowest
+    // twelve): the three nearest a frequency between f_6 and f_7 are f_5..f_7 or
+    // f_6..f_8, numbered so, from an LDLᵀ inside the spectrum whose inertia says how
+    // many lie below.
+    let m = model(&bar(60));
+    let lowest = modes(&m, &options(12)).unwrap();
+    let f: Vec<f64> = (0..12).map(|k| hz(&lowest, k)).collect();
+    let target = f[5] + 0.4 * (f[6] - f[5]);
+    let around = modes(
+        &m,
+        &ModalOptions {
+            count: 3,
+            around: Some(target),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let mut expect: Vec<usize> = (0..12).collect();
+    expect.sort_by(|&a, &b| (f[a] - target).abs().total_cmp(&(f[b] - target).abs()));
+    let mut nearest: Vec<usize> = expect[..3].to_vec();
+    nearest.sort();
+    for (mode, &k) in around.modes.iter().zip(&nearest) {
+        assert_eq!(mode.number, k + 1);
+        let got = mode.omega() / (2.0 * std::f64::consts::PI);
+        assert!(
+            (got / f[k] - 1.0).abs() < 1e-10,
+            "mode {}: {got} against {}",
+            k + 1,
+            f[k]
+        );
+        assert!(mode.residual < 1e-8, "residual {}", mode.residual);
+    }
+    orthonormal(&m, &around);
+    // Looking around a negative or zero frequency, or with a shift too, is refused.
+    for (around, shift) in [(Some(-5.0), None), (Some(100.0), Some(-1.0))] {
+        let e = modes(
+            &m,
+            &ModalOptions {
+                count: 3,
+                around,
+                shift,
+                ..Default::default()
+            },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("--around"), "{e}");
+    }
 }

@@ -67,8 +67,8 @@ pub(super) fn modal_targets(model: &mut Model, xi: f64, modes: [usize; 2]) -> Re
         model,
         &crate::modal::ModalOptions {
             count,
-            shift: None,
             backend: crate::linsolve::Backend::Faer,
+            ..Default::default()
         },
     )
     .map_err(|e| Error::config("analysis.damping.modes", e.to_string()))?;
