@@ -41,9 +41,10 @@ pub struct Report {
     /// The stable step of central differences (element eigenvalue bound), its block
     /// and element.
     pub stable: Option<(f64, usize, usize)>,
-    /// Central differences: the exact undamped stable step `2/ω_max` of the whole
-    /// mesh (`λ_max` of `M_lumped⁻¹K` by Lanczos).
-    pub exact_step: Option<f64>,
+    /// Central differences: the stable step of the whole mesh (`λ_max` of
+    /// `M_lumped⁻¹K` by Lanczos, shortened for the damping taken at the half-step
+    /// velocity).
+    pub exact_step: Option<crate::modal::ExactStep>,
     /// The time scheme (for a dynamic analysis).
     pub scheme: Option<crate::model::TimeScheme>,
     /// Generalized-α's spectral radius at infinity.
@@ -208,7 +209,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         cfl,
         stable: crate::time::cfl::stable_step(model).map(|c| (c.dt, c.block, c.element)),
         exact_step: if a.time.scheme == crate::model::TimeScheme::CentralDifference {
-            Some(2.0 / crate::modal::highest_frequency(model)?)
+            Some(crate::modal::exact_stable_step(model)?)
         } else {
             None
         },
@@ -366,11 +367,21 @@ impl fmt::Display for Report {
                 self.steps.1 / dt_s
             )?;
         }
-        if let Some(dt_e) = self.exact_step {
+        if let Some(e) = self.exact_step {
+            let damping = if e.damping_rate > 0.0 {
+                format!(
+                    ", shortened for the damping rate c = {:.4e} 1/s",
+                    e.damping_rate
+                )
+            } else {
+                ", undamped".to_string()
+            };
             writeln!(
                 f,
-                "exact step  {dt_e:.4e} s (2/ω_max of the whole mesh, M_lumped⁻¹K by Lanczos, undamped); h / exact = {:.3}",
-                self.steps.1 / dt_e
+                "exact step  {:.4e} s (2/ω_max of the whole mesh, M_lumped⁻¹K by Lanczos, ω_max = {:.4e} rad/s{damping}); h / exact = {:.3}",
+                e.dt,
+                e.omega_max,
+                self.steps.1 / e.dt
             )?;
         }
         writeln!(

@@ -168,6 +168,20 @@ impl TimeScheme {
     }
 }
 
+/// How central differences bound their step (`analysis.critical_step`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum CriticalStepRule {
+    /// Element by element, `min_e 2/ω_e` (a bound below the mesh's own limit; no
+    /// global computation).
+    #[default]
+    Element,
+    /// The mesh's own limit from its largest eigenvalue (Lanczos on `M_L⁻¹K`; the
+    /// damping rate from `M_L⁻¹C`): exact for undamped and stiffness-proportional
+    /// damping, a bound otherwise (`modal::exact_stable_step`).
+    Eigen,
+}
+
 /// What the second-order implicit schemes do with the free flight before a step
 /// (`analysis.contact_predictor`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
@@ -220,6 +234,8 @@ pub struct TimeSettings {
     pub scheme: TimeScheme,
     /// Central differences: the fraction of the critical step of the default step.
     pub omega: f64,
+    /// Central differences: how the stable step is bounded.
+    pub critical_step: CriticalStepRule,
     /// Generalized-α: the spectral radius at `ωh → ∞`, in `[0, 1]`.
     pub rho_inf: f64,
     /// The second-order schemes' contact predictor.

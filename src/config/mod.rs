@@ -313,6 +313,12 @@ pub struct AnalysisSpec {
     /// takes (the paper's `ω`). Default 0.9.
     #[serde(default)]
     pub omega: Option<f64>,
+    /// Central differences: how the stable step is bounded, `element` (default:
+    /// `min_e 2/ω_e`, element by element) or `eigen` (the mesh's own `2/ω_max`, by
+    /// Lanczos on `M_L⁻¹K`, shortened for the damping the scheme takes at the
+    /// half-step velocity).
+    #[serde(default)]
+    pub critical_step: Option<crate::model::CriticalStepRule>,
     /// Generalized-α: the spectral radius at `ωh → ∞` in `[0, 1]` (1 damps nothing,
     /// 0 annihilates the highest modes in one step). Default 0.8.
     #[serde(default)]

@@ -10,9 +10,12 @@
 //! the consistent or lumped mass as the scenario says; supports and prescribed
 //! motion fix their dofs, bars are in `K` and `M` like any element.
 
+mod critical;
 pub mod lanczos;
 pub mod step;
 mod sturm;
+
+pub use critical::{exact_stable_step, highest_frequency, ExactStep};
 
 use crate::assembly::{Assembler, Mass};
 use crate::error::{Error, Result};
@@ -434,58 +437,4 @@ fn traces(asm: &Assembler, k: &[f64], mass: &Mass, free: &[usize]) -> (f64, f64)
 
 fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
-}
-
-/// The largest circular frequency `ω_max` of `K φ = ω² M_L φ` on the free dofs,
-/// `M_L` the lumped mass (the explicit path's): central differences are stable for
-/// `h < 2/ω_max` without damping. Lanczos on `M_L⁻¹K` (self-adjoint in the `M_L`
-/// inner product; no factor) finds the top of the spectrum first; its Ritz value is
-/// taken when the residual bound is below `10⁻⁸` of it, which puts the value itself
-/// far closer (the error goes with the residual squared).
-pub fn highest_frequency(model: &Model) -> Result<f64> {
-    let mesh = &model.mesh;
-    let asm = Assembler::new(mesh);
-    let k = asm.stiffness(mesh, &model.materials, model.idealisation);
-    let Mass::Lumped(d) = asm.mass(mesh, &model.materials, true) else {
-        return Err(Error::Internal("a lumped mass is a diagonal".into()));
-    };
-    let dofs = DofMap::new(mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
-    let free = dofs.free;
-    if free.is_empty() {
-        return Err(Error::config(
-            "supports",
-            "every dof is fixed: the model has no free motion",
-        ));
-    }
-    let n = mesh.n_dofs();
-    let (mut full, mut out) = (vec![0.0; n], vec![0.0; n]);
-    // Lanczos hands the operator `z = M_L q` and wants `S q = M_L⁻¹ K q`.
-    let op = |z: &[f64], y: &mut [f64]| {
-        for (&f, &v) in free.iter().zip(z) {
-            full[f] = v / d[f];
-        }
-        asm.pattern.matvec(&k, &full, &mut out);
-        for (yi, &f) in y.iter_mut().zip(&free) {
-            *yi = out[f] / d[f];
-        }
-        Ok(())
-    };
-    let mass = |x: &[f64], y: &mut [f64]| {
-        for ((yi, &f), &v) in y.iter_mut().zip(&free).zip(x) {
-            *yi = d[f] * v;
-        }
-    };
-    let wanted = lanczos::Wanted {
-        count: 1,
-        max_steps: 400,
-        tol: 1e-8,
-        nearest: false,
-    };
-    let r = lanczos::lanczos(free.len(), &wanted, &[], op, mass).map_err(|e| match e {
-        lanczos::Shortfall::Operator(e) => e,
-        lanczos::Shortfall::NotConverged { steps, .. } => Error::Stepping(format!(
-            "the largest frequency did not converge in {steps} Lanczos steps"
-        )),
-    })?;
-    Ok(r.theta[0].max(0.0).sqrt())
 }

@@ -37,6 +37,7 @@ pub fn model_of(
                 kind: AnalysisKind::Static,
                 scheme: rothe::model::TimeScheme::BackwardEuler,
                 omega: 0.9,
+                critical_step: Default::default(),
                 rho_inf: 0.8,
                 contact_predictor: Default::default(),
                 dt: 1.0,

@@ -588,3 +588,75 @@ fn explicit_ledgers_close_with_every_material_model() {
         }
     }
 }
+
+#[test]
+fn the_exact_critical_step_is_the_measured_stability_limit() {
+    // analysis.critical_step = "eigen": the mesh's own limit from Lanczos on M_L⁻¹K
+    // (and M_L⁻¹C for the dashpots), against the limit measured by bisection on the
+    // step: below it the energy stays bounded over 4000 steps, above it grows past
+    // 10⁶. Undamped, and with Kelvin-Voigt's η = αC (ξ = 0.5 in the highest mode),
+    // where the damped limit 2/(√(ω² + c²/4) + c/2) is exact too. The element bound
+    // lies below both.
+    let undamped = load(&plate(None, 2e-3), false).unwrap();
+    let omega = rothe::modal::highest_frequency(&undamped).unwrap();
+    let alpha = 1.0 / omega;
+    let cases = [
+        ("undamped", "model = \"elastic\"".to_string()),
+        (
+            "Kelvin-Voigt, eta = alpha C",
+            format!("model = \"kelvin_voigt\"\nalpha = {alpha:e}"),
+        ),
+    ];
+    for (what, material) in &cases {
+        let eigen = "critical_step = \"eigen\"";
+        let probe = load(&damped_plate(1e-7, 1.0, material, eigen), true).unwrap();
+        let exact = rothe::modal::exact_stable_step(&probe).unwrap();
+        let bound = rothe::time::cfl::stable_step(&probe).unwrap().dt;
+        let holds = |h: f64| {
+            let m = load(&damped_plate(h, 4000.0, material, ""), true).unwrap();
+            let (drift, finite) = energy_drift(&m);
+            finite && drift < 2.0
+        };
+        let (mut lo, mut hi) = (0.95 * exact.dt, 1.05 * exact.dt);
+        assert!(
+            holds(lo) && !holds(hi),
+            "{what}: the limit is not bracketed"
+        );
+        for _ in 0..8 {
+            let mid = 0.5 * (lo + hi);
+            if holds(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let measured = 0.5 * (lo + hi);
+        eprintln!(
+            "{what}: exact {:.6e} s, measured {measured:.6e} s ({:+.3} %), element bound {bound:.6e} s",
+            exact.dt,
+            100.0 * (exact.dt / measured - 1.0)
+        );
+        assert!(
+            (exact.dt / measured - 1.0).abs() < 0.005,
+            "{what}: exact {} against measured {measured}",
+            exact.dt
+        );
+        assert!(bound <= exact.dt * (1.0 + 1e-9), "{what}: bound {bound}");
+        // The scenario's default step is omega (0.9) times the exact one; a given
+        // step above it is refused, naming the rule.
+        let chosen = load(
+            &damped_plate(1e-7, 1.0, material, eigen).replace("dt = 1e-7\n", ""),
+            false,
+        )
+        .unwrap();
+        assert!(
+            (chosen.analysis.time.dt / (0.9 * exact.dt) - 1.0).abs() < 1e-12,
+            "{what}: default step {}",
+            chosen.analysis.time.dt
+        );
+        let e = load(&damped_plate(1.01 * exact.dt, 10.0, material, eigen), false)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("analysis.dt") && e.contains("eigen"), "{e}");
+    }
+}

@@ -25,8 +25,8 @@ use crate::error::{Error, Result};
 use crate::fe::{Idealisation, StrainSpace};
 use crate::mesh::Mesh;
 use crate::model::{
-    Analysis, AnalysisKind, Body, ContactPredictor, ContactSettings, Damping, Formulation,
-    IterationSettings, Model, OutputSettings, TimeScheme, TimeSettings,
+    Analysis, AnalysisKind, Body, ContactPredictor, ContactSettings, CriticalStepRule, Damping,
+    Formulation, IterationSettings, Model, OutputSettings, TimeScheme, TimeSettings,
 };
 
 /// Builds the model of `s`; relative file names resolve against `dir`.
@@ -207,6 +207,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 kind: a.kind,
                 scheme: a.scheme,
                 omega: a.omega.unwrap_or(DEFAULT_OMEGA),
+                critical_step: a.critical_step.unwrap_or_default(),
                 rho_inf: a.rho_inf.unwrap_or(DEFAULT_RHO_INF),
                 contact_predictor: a.contact_predictor.unwrap_or_default(),
                 dt: a.dt.unwrap_or(f64::NAN),
@@ -540,6 +541,12 @@ fn unread_keys(a: &super::AnalysisSpec) -> Vec<String> {
                     .into(),
             );
         }
+    } else if a.critical_step.is_some() {
+        w.push(
+            "analysis.critical_step is read by central differences only; the implicit \
+             schemes ignore it"
+                .into(),
+        );
     }
     w
 }
@@ -553,7 +560,9 @@ const DEFAULT_OMEGA: f64 = 0.9;
 /// Central differences: the step defaults to `ω` times the paper's critical step
 /// `L_e/c` (never above `ω` times the stable step); a given step above the stable
 /// step `min_e 2/ω_e` is refused (unless `allow_unstable`), naming the limit and the
-/// element that sets it (`time::cfl`, `theory/explicit.md`).
+/// element that sets it (`time::cfl`, `theory/explicit.md`). With
+/// `critical_step = "eigen"` the stable step is the mesh's own (`modal::exact_stable_step`)
+/// and the default step `ω` times it.
 fn explicit_step(model: &mut Model, dt: Option<f64>, opts: &LoadOptions) -> Result<()> {
     let (Some(paper), Some(stable)) = (
         crate::time::cfl::critical_step(model),
@@ -564,21 +573,43 @@ fn explicit_step(model: &mut Model, dt: Option<f64>, opts: &LoadOptions) -> Resu
             "no element to set the critical step",
         ));
     };
+    let eigen = match model.analysis.time.critical_step {
+        CriticalStepRule::Eigen => Some(
+            crate::modal::exact_stable_step(model)
+                .map_err(|e| Error::config("analysis.critical_step", e.to_string()))?,
+        ),
+        CriticalStepRule::Element => None,
+    };
     let where_ = model.describe_point(stable.block, stable.element);
     let a = &mut model.analysis;
+    let (limit, what) = match eigen {
+        Some(e) => (
+            e.dt,
+            format!(
+                "the mesh's own limit 2/(√(ω_max² + c²/4) + c/2), ω_max = {:.6e} rad/s, \
+                 c = {:.6e} 1/s (critical_step = \"eigen\"); the element bound is {:.6e} s",
+                e.omega_max, e.damping_rate, stable.dt
+            ),
+        ),
+        None => (stable.dt, format!("2/ω_max of {where_}")),
+    };
     match dt {
         None => {
-            a.time.dt = a.time.omega * paper.dt.min(stable.dt);
+            a.time.dt = a.time.omega
+                * match eigen {
+                    Some(e) => e.dt,
+                    None => paper.dt.min(stable.dt),
+                };
             step_count("analysis.dt", a.time.t_end, a.time.dt)?;
         }
-        Some(h) if h > stable.dt && !opts.allow_unstable => {
+        Some(h) if h > limit && !opts.allow_unstable => {
             return Err(Error::config(
                 "analysis.dt",
                 format!(
-                    "{h:?} s exceeds the stable step {:.6e} s of central differences \
-                     (2/ω_max of {where_}; the paper's estimate L_e/c is {:.6e} s); omit dt \
-                     for omega x the estimate, or run with --allow-unstable for a stability study",
-                    stable.dt, paper.dt
+                    "{h:?} s exceeds the stable step {limit:.6e} s of central differences \
+                     ({what}; the paper's estimate L_e/c is {:.6e} s); omit dt for omega x \
+                     the estimate, or run with --allow-unstable for a stability study",
+                    paper.dt
                 ),
             ));
         }
