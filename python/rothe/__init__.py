@@ -39,6 +39,7 @@ __all__ = [
     "Error",
     "Scenario",
     "Run",
+    "Modes",
     "load",
     "loads",
     "from_dict",
@@ -152,6 +153,35 @@ class Scenario:
         critical step, the scheme, ``rho_inf`` and the contact predictor, warnings,
         materials and contact pairs; ``text`` holds the printed report."""
         return json.loads(self._native.check_json())
+
+    def modes(
+        self,
+        count: int = 10,
+        shift: Optional[float] = None,
+        around: Optional[float] = None,
+        out: Optional[PathLike] = None,
+        backend: str = "faer",
+    ) -> "Modes":
+        """The ``count`` lowest eigenfrequencies and mode shapes of ``K x = ω² M x``
+        (``rothe modes``): shift-invert Lanczos on the runs' factor at the initial,
+        elastic state, checked by a Sturm count. ``shift`` (rad²/s², zero or
+        negative) moves the Cholesky's shift; ``around`` (Hz) gives the ``count``
+        modes nearest that frequency instead (an LDLᵀ inside the spectrum).
+        ``out`` also writes ``modes.csv``, ``modes.json``, ``modes.pvd`` and the
+        charts there. Bad input raises :class:`Error` naming the option.
+        """
+        if not isinstance(count, int) or isinstance(count, bool):
+            raise Error(f"count: {count!r} is not a whole number of modes")
+        if count < 1:
+            raise Error("--count: ask for at least one mode")
+        info, shapes, files = self._native.modes(
+            count,
+            None if shift is None else float(shift),
+            None if around is None else float(around),
+            None if out is None else os.fspath(out),
+            str(backend),
+        )
+        return Modes(json.loads(info), shapes, [Path(f) for f in files])
 
     def run(
         self,
@@ -316,6 +346,46 @@ class Run:
     def damage(self) -> np.ndarray:
         """``cell_data("damage")[:, 0]``."""
         return self.cell_data("damage")[:, 0]
+
+
+class Modes:
+    """Eigenfrequencies and mode shapes (:meth:`Scenario.modes`).
+
+    ``number`` (place in the spectrum, from 1), ``frequency`` (Hz), ``omega``
+    (rad/s), ``period`` (s, ``inf`` for a rigid mode), ``rigid`` and ``residual``
+    are 1-D arrays, one entry per mode, lowest first; ``effective_mass`` is
+    ``(modes, dim)``, each mode's effective modal mass fraction per direction;
+    ``shapes`` is ``(modes, nodes, dim)``, each shape ``M``-normalised
+    (``φᵀMφ = 1``). ``info`` is ``modes.json`` as a dict (the Sturm check, the
+    shift, what the scenario's step does to each mode) and ``files`` what was
+    written.
+    """
+
+    def __init__(self, info: Dict[str, Any], shapes: np.ndarray, files: List[Path]):
+        self.info = info
+        rows = info["modes"]
+        self.number = np.array([r["index"] for r in rows], dtype=int)
+        self.frequency = np.array([r["f_hz"] for r in rows], dtype=float)
+        self.omega = np.array([r["omega_rad_s"] for r in rows], dtype=float)
+        self.period = np.array(
+            [math.inf if r["period_s"] is None else r["period_s"] for r in rows], dtype=float
+        )
+        self.rigid = np.array([r["rigid"] for r in rows], dtype=bool)
+        self.residual = np.array([r["residual"] for r in rows], dtype=float)
+        dim = len(info["total_mass_kg"])
+        self.effective_mass = np.array(
+            [[e["fraction"] for e in r["effective_mass"]] for r in rows], dtype=float
+        ).reshape(len(rows), dim)
+        self.shapes = shapes.reshape(len(rows), -1, dim)
+        self.files = files
+
+    def __len__(self) -> int:
+        return len(self.number)
+
+    def __repr__(self) -> str:
+        f = ", ".join(f"{x:.4g}" for x in self.frequency[:4])
+        more = ", ..." if len(self) > 4 else ""
+        return f"<rothe.Modes {len(self)} modes: {f}{more} Hz>"
 
 
 # --- tables -----------------------------------------------------------------------

@@ -18,6 +18,14 @@ class NativeScenario:
     ) -> Tuple[Optional[str], str, str, List[Tuple[str, str]], List[str], List[Tuple[str, str]]]: ...
     def check_text(self) -> str: ...
     def check_json(self) -> str: ...
+    def modes(
+        self,
+        count: int,
+        shift: Optional[float],
+        around: Optional[float],
+        out: Optional[str],
+        backend_name: str,
+    ) -> Tuple[str, np.ndarray, List[str]]: ...
     def run(
         self,
         out: Optional[str],

@@ -287,6 +287,48 @@ impl NativeScenario {
         Ok(v.to_string())
     }
 
+    /// The lowest `count` modes (or the `count` nearest `around` Hz): `modes.json`'s
+    /// value as JSON text, the `M`-normalised shapes `(modes, dofs)`, and the files
+    /// written into `out` (none without it).
+    #[pyo3(signature = (count, shift, around, out, backend_name))]
+    #[allow(clippy::type_complexity)]
+    fn modes<'py>(
+        &self,
+        py: Python<'py>,
+        count: usize,
+        shift: Option<f64>,
+        around: Option<f64>,
+        out: Option<PathBuf>,
+        backend_name: &str,
+    ) -> PyResult<(String, Bound<'py, PyArray2<f64>>, Vec<PathBuf>)> {
+        let model = self.model.clone();
+        let backend = backend(backend_name)?;
+        let (json, shapes, k, files) = py
+            .detach(move || -> rothe::Result<_> {
+                let opts = rothe::modal::ModalOptions {
+                    count,
+                    shift,
+                    around,
+                    backend,
+                };
+                let modes = rothe::modal::modes(&model, &opts)?;
+                let json = rothe::output::modes::summary(&model, &modes).to_string();
+                let files = match &out {
+                    Some(dir) => rothe::output::modes::write(&model, &modes, dir)?,
+                    None => Vec::new(),
+                };
+                let shapes: Vec<f64> = modes
+                    .modes
+                    .iter()
+                    .flat_map(|m| m.shape.iter().copied())
+                    .collect();
+                Ok((json, shapes, modes.modes.len(), files))
+            })
+            .map_err(py_err)?;
+        let n = self.model.mesh.n_dofs();
+        Ok((json, PyArray1::from_vec(py, shapes).reshape([k, n])?, files))
+    }
+
     /// Runs the scenario. `out = None`: in memory, nothing written.
     #[pyo3(signature = (out, overwrite, record_fields, bar, callback, threads, backend_name))]
     #[allow(clippy::too_many_arguments)]

@@ -304,3 +304,60 @@ def test_to_pandas(examples):
     pd = pytest.importorskip("pandas")
     df = two_blocks(examples, **{"analysis.t_end": 1e-4}).run().to_pandas()
     assert isinstance(df, pd.DataFrame) and "D_num" in df.columns and len(df) == 101
+
+
+AXIAL_BAR = """
+[analysis]
+t_end = 1.0e-4
+dt = 1.0e-6
+[materials.steel]
+model = "elastic"
+E = 210e9
+nu = 0.0
+rho = 7850.0
+[[bodies]]
+name = "bar"
+material = "steel"
+thickness = 0.05
+mesh = { kind = "rectangle", size = [1.0, 0.05], divisions = [80, 1] }
+[[supports]]
+set = "bar.left"
+fix = ["x"]
+[[supports]]
+set = "bar.all"
+fix = ["y"]
+"""
+
+
+def test_modes_of_an_axial_bar_match_its_closed_form_and_the_command_line(tmp_path, cli):
+    # A fixed-free bar: f_k = (2k − 1) c / (4L), from above with consistent mass.
+    s = rothe.loads(AXIAL_BAR)
+    m = s.modes(count=3)
+    c = (210e9 / 7850.0) ** 0.5
+    exact = np.array([(2 * k - 1) * c / 4.0 for k in (1, 2, 3)])
+    assert len(m) == 3 and list(m.number) == [1, 2, 3]
+    assert np.all(m.frequency > exact) and np.all(m.frequency / exact - 1 < 1e-3)
+    assert np.allclose(m.omega, 2 * np.pi * m.frequency)
+    assert m.shapes.shape == (3, 162, 2) and not m.rigid.any()
+    # The first axial mode carries 8/π² of the bar's mass along x; the fraction is
+    # of the mass on the free dofs, ι_fᵀ M_ff ι_f = M (1 − 2/(3n)) with consistent
+    # mass and the end column of n = 80 elements fixed; none along y (fixed).
+    assert abs(m.effective_mass[0, 0] - (8 / np.pi**2) / (1 - 2 / 240)) < 2e-4
+    assert np.all(m.effective_mass[:, 1] == 0.0)
+    assert m.info["sturm"]["eigenvalues_counted"] >= 3
+    # The modes nearest a frequency, numbered in the spectrum; files as the CLI's.
+    near = s.modes(count=1, around=float(exact[1]), out=tmp_path / "py")
+    assert list(near.number) == [2] and abs(near.frequency[0] / m.frequency[1] - 1) < 1e-9
+    assert {f.name for f in near.files} >= {"modes.csv", "modes.json", "modes.pvd"}
+    scenario = tmp_path / "bar.toml"
+    scenario.write_text(AXIAL_BAR)
+    subprocess.run(
+        [cli, "modes", scenario, "--count", "1", "--around", repr(float(exact[1])),
+         "--out", tmp_path / "cli"],
+        check=True, capture_output=True,
+    )
+    assert (tmp_path / "py" / "modes.csv").read_bytes() == (tmp_path / "cli" / "modes.csv").read_bytes()
+    for bad, field in [(dict(count=0), "--count"), (dict(around=-1.0), "--around"),
+                       (dict(shift=5.0), "--shift"), (dict(backend="x"), "backend")]:
+        with pytest.raises(rothe.Error, match=field):
+            s.modes(**bad)

@@ -11,10 +11,40 @@ use crate::modal::step::{backward_euler, generalized_alpha, trapezoidal};
 use crate::modal::Modes;
 use crate::model::Model;
 
-/// Writes `modes.csv`, `modes.json` and the VTK shapes of `modes` into `dir`;
-/// returns the files written.
+/// Writes `modes.csv`, `modes.json`, the VTK shapes of `modes` and the charts into
+/// `dir`; returns the files written.
 pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let (csv, json) = tables(model, modes);
+    let mut written = Vec::new();
+    let path = dir.join("modes.csv");
+    std::fs::write(&path, csv).map_err(|e| Error::io(&path, e))?;
+    written.push(path);
+    let path = dir.join("modes.json");
+    let text = serde_json::to_string_pretty(&json).expect("plain values");
+    std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
+    written.push(path);
+    let mut vtk = super::vtk::VtkSeries::named(dir, &model.mesh, "modes", "mode")?;
+    let zero = vec![0.0; model.mesh.n_dofs()];
+    let cells = vec![[0.0; 6]; model.mesh.n_elements()];
+    for m in &modes.modes {
+        let peak = m.shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let shape: Vec<f64> = m.shape.iter().map(|x| x / peak).collect();
+        vtk.write(m.number, m.number as f64, &shape, &zero, &[], &cells, &[])?;
+    }
+    written.push(dir.join("modes.pvd"));
+    let (h, rho_inf) = (model.analysis.time.dt, model.analysis.time.rho_inf);
+    written.extend(plots(modes, h, rho_inf, dir)?);
+    Ok(written)
+}
+
+/// What `modes.json` holds, as a value (the Python module's `Modes.info`).
+pub fn summary(model: &Model, modes: &Modes) -> serde_json::Value {
+    tables(model, modes).1
+}
+
+/// The text of `modes.csv` and the value of `modes.json`.
+fn tables(model: &Model, modes: &Modes) -> (String, serde_json::Value) {
     let h = model.analysis.time.dt;
     let dim = modes.dim;
     let axes = ["x", "y", "z"];
@@ -51,7 +81,12 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
         .expect("to a string");
         let mut fractions = Vec::new();
         for r in 0..dim {
-            let frac = m.participation[r].powi(2) / modes.total_mass[r];
+            // No free mass along a direction (all of it fixed): nothing to take part.
+            let frac = if modes.total_mass[r] > 0.0 {
+                m.participation[r].powi(2) / modes.total_mass[r]
+            } else {
+                0.0
+            };
             sums[r] += frac;
             write!(csv, ",{frac:.9e},{:.9e}", sums[r]).expect("to a string");
             fractions
@@ -77,10 +112,6 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
             "residual": m.residual,
         }));
     }
-    let mut written = Vec::new();
-    let path = dir.join("modes.csv");
-    std::fs::write(&path, csv).map_err(|e| Error::io(&path, e))?;
-    written.push(path);
     let json = serde_json::json!({
         "modes": rows,
         "shift_rad2_s2": modes.shift,
@@ -97,21 +128,7 @@ pub fn write(model: &Model, modes: &Modes, dir: &Path) -> Result<Vec<std::path::
             "eigenvalues_counted": modes.sturm.count,
         },
     });
-    let path = dir.join("modes.json");
-    let text = serde_json::to_string_pretty(&json).expect("plain values");
-    std::fs::write(&path, text).map_err(|e| Error::io(&path, e))?;
-    written.push(path);
-    let mut vtk = super::vtk::VtkSeries::named(dir, &model.mesh, "modes", "mode")?;
-    let zero = vec![0.0; model.mesh.n_dofs()];
-    let cells = vec![[0.0; 6]; model.mesh.n_elements()];
-    for m in &modes.modes {
-        let peak = m.shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let shape: Vec<f64> = m.shape.iter().map(|x| x / peak).collect();
-        vtk.write(m.number, m.number as f64, &shape, &zero, &[], &cells, &[])?;
-    }
-    written.push(dir.join("modes.pvd"));
-    written.extend(plots(modes, h, rho_inf, dir)?);
-    Ok(written)
+    (csv, json)
 }
 
 /// `spectrum.png/svg` (the frequencies by mode number) and `step_effect.png/svg`
