@@ -320,4 +320,30 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn too_few_steps_say_how_many_pairs_converged_and_return_none() {
+        // diag(1..=200), five pairs wanted in at most eight steps: a shortfall that
+        // counts the converged, never the unconverged pairs as found.
+        let n = 200;
+        let op = |x: &[f64], y: &mut [f64]| {
+            for i in 0..n {
+                y[i] = x[i] / (i as f64 + 2.0);
+            }
+            Ok(())
+        };
+        let wanted = Wanted {
+            count: 5,
+            max_steps: 8,
+            tol: 1e-12,
+            nearest: false,
+        };
+        match lanczos(n, &wanted, &[], op, |x, y| y.copy_from_slice(x)) {
+            Err(Shortfall::NotConverged { converged, steps }) => {
+                assert!(converged < 5 && steps == 8, "{converged} in {steps}");
+            }
+            Err(Shortfall::Operator(e)) => panic!("{e}"),
+            Ok(r) => panic!("{} pairs reported from 8 steps", r.theta.len()),
+        }
+    }
 }

@@ -143,6 +143,22 @@ fn a_free_body_has_three_rigid_modes_in_the_plane_and_six_in_space() {
             );
         }
         orthonormal(&m, &found);
+        // A shift of zero is an eigenvalue of a free body: its factor fails, the
+        // shift is moved below and the same modes come out.
+        let at_zero = modes(
+            &m,
+            &ModalOptions {
+                count: rigid + 3,
+                shift: Some(0.0),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(at_zero.shift < 0.0, "{dim}D: shift {}", at_zero.shift);
+        for (a, b) in at_zero.modes.iter().zip(&found.modes).skip(rigid) {
+            assert!((a.lambda / b.lambda - 1.0).abs() < 1e-9, "{dim}D");
+        }
+        assert_eq!(at_zero.modes.iter().filter(|x| x.rigid).count(), rigid);
     }
 }
 
