@@ -156,40 +156,44 @@ fn plots(modes: &Modes, h: f64, rho_inf: f64, dir: &Path) -> Result<Vec<std::pat
         .iter()
         .map(|&(_, w)| generalized_alpha(w, h, rho_inf))
         .collect();
+    // Log–log: backward Euler's damping rises as ωh (slope 1), the period errors
+    // as (ωh)² (slope 2), generalized-α's damping as (ωh)³; values that are not
+    // positive (round-off at the lowest modes) are left out.
+    let series = |label: String, y: Vec<f64>| {
+        let points = f
+            .iter()
+            .zip(y)
+            .filter(|&(_, y)| y > 0.0)
+            .map(|(&x, y)| (x, y))
+            .collect();
+        Series::new(label, points, Style::LineWithMarkers)
+    };
+    let ga_label = |what: &str| format!("generalized-alpha (rho_inf {rho_inf}): {what}");
     let effect = Figure::new(
         format!("What the step h = {h:e} s does to each mode"),
         "f [Hz]",
         "ratio",
     )
-    .with(Series::from_xy(
-        "backward Euler: damping ratio",
-        &f,
-        &be.iter().map(|e| e.damping).collect::<Vec<_>>(),
-        Style::LineWithMarkers,
+    .log_log()
+    .with(series(
+        "backward Euler: damping ratio".into(),
+        be.iter().map(|e| e.damping).collect(),
     ))
-    .with(Series::from_xy(
-        "backward Euler: period error T'/T - 1",
-        &f,
-        &be.iter().map(|e| e.period - 1.0).collect::<Vec<_>>(),
-        Style::LineWithMarkers,
+    .with(series(
+        "backward Euler: period error T'/T - 1".into(),
+        be.iter().map(|e| e.period - 1.0).collect(),
     ))
-    .with(Series::from_xy(
-        "trapezoidal: period error T'/T - 1",
-        &f,
-        &tr.iter().map(|e| e.period - 1.0).collect::<Vec<_>>(),
-        Style::LineWithMarkers,
+    .with(series(
+        "trapezoidal: period error T'/T - 1".into(),
+        tr.iter().map(|e| e.period - 1.0).collect(),
     ))
-    .with(Series::from_xy(
-        format!("generalized-alpha (rho_inf {rho_inf}): damping ratio"),
-        &f,
-        &ga.iter().map(|e| e.damping).collect::<Vec<_>>(),
-        Style::LineWithMarkers,
+    .with(series(
+        ga_label("damping ratio"),
+        ga.iter().map(|e| e.damping).collect(),
     ))
-    .with(Series::from_xy(
-        format!("generalized-alpha (rho_inf {rho_inf}): period error T'/T - 1"),
-        &f,
-        &ga.iter().map(|e| e.period - 1.0).collect::<Vec<_>>(),
-        Style::LineWithMarkers,
+    .with(series(
+        ga_label("period error T'/T - 1"),
+        ga.iter().map(|e| e.period - 1.0).collect(),
     ));
     let mut out = Vec::new();
     out.extend(draw(&spectrum, &dir.join("spectrum"))?);
