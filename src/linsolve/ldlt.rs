@@ -167,6 +167,18 @@ impl Ldlt {
 mod tests {
     use super::*;
 
+    /// The largest error of `x` solved back from `b = A x` with the factor `f` of `a`.
+    fn solve_error(f: &mut Ldlt, a: &LowerCsc) -> f64 {
+        let x: Vec<f64> = (0..a.n).map(|i| (i as f64 * 0.7).sin()).collect();
+        let mut b = vec![0.0; a.n];
+        a.sym_matvec(&x, &mut b);
+        f.solve(&mut b).unwrap();
+        x.iter()
+            .zip(&b)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max)
+    }
+
     /// The lower triangle of the tridiagonal `n × n` matrix with `diag` and `off`.
     fn tridiagonal(n: usize, diag: impl Fn(usize) -> f64, off: f64) -> LowerCsc {
         let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
@@ -202,15 +214,7 @@ mod tests {
                 let inertia = f.factorize(&a).unwrap();
                 assert_eq!(inertia.negative, below, "n {n}, μ {mu}");
                 assert_eq!(inertia.negative + inertia.positive, n);
-                let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
-                let mut b = vec![0.0; n];
-                a.sym_matvec(&x, &mut b);
-                f.solve(&mut b).unwrap();
-                let err = x
-                    .iter()
-                    .zip(&b)
-                    .map(|(p, q)| (p - q).abs())
-                    .fold(0.0, f64::max);
+                let err = solve_error(&mut f, &a);
                 assert!(err < 1e-9, "n {n}, μ {mu}: solve error {err}");
             }
         }
@@ -256,15 +260,7 @@ mod tests {
                 }
             }
             assert_eq!(inertia.negative, below, "μ {mu}");
-            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
-            let mut b = vec![0.0; n];
-            a.sym_matvec(&x, &mut b);
-            f.solve(&mut b).unwrap();
-            let err = x
-                .iter()
-                .zip(&b)
-                .map(|(p, q)| (p - q).abs())
-                .fold(0.0, f64::max);
+            let err = solve_error(&mut f, &a);
             assert!(err < 1e-8, "μ {mu}: solve error {err}");
         }
     }
