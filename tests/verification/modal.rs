@@ -15,20 +15,20 @@ fn options(count: usize) -> ModalOptions {
     }
 }
 
+/// A short dynamic run's `[analysis]` (with the lines `extra`) and steel of
+/// Poisson's ratio `nu`: the head of every scenario here.
+fn steel(nu: f64, extra: &str) -> String {
+    format!(
+        "\n[analysis]\nt_end = 1.0e-4\ndt = 1.0e-6\n{extra}[materials.steel]\n\
+         model = \"elastic\"\nE = 210e9\nnu = {nu:?}\nrho = 7850.0\n"
+    )
+}
+
 /// A steel bar 1 m long (plane stress, ν = 0) of `n` elements along, fixed at its left
 /// end, its lateral motion suppressed: an axial bar, `c = √(E/ρ)`.
 fn bar(n: usize) -> String {
     format!(
-        r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-6
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.0
-rho = 7850.0
-[[bodies]]
+        r#"{head}[[bodies]]
 name = "bar"
 material = "steel"
 thickness = 0.05
@@ -39,7 +39,8 @@ fix = ["x"]
 [[supports]]
 set = "bar.all"
 fix = ["y"]
-"#
+"#,
+        head = steel(0.0, "")
     )
 }
 
@@ -96,20 +97,12 @@ fn free_body(dim: usize) -> Model {
         "thickness = 0.1\nmesh = { kind = \"rectangle\", size = [0.4, 0.1], divisions = [8, 2] }"
     };
     model(&format!(
-        r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-6
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
+        r#"{head}[[bodies]]
 name = "b"
 material = "steel"
 {mesh}
-"#
+"#,
+        head = steel(0.3, "")
     ))
 }
 
@@ -264,24 +257,15 @@ fn a_thin_box_with_its_depth_fixed_has_its_plane_strain_sections_modes() {
             )
         };
         format!(
-            r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-6
-plane = "strain"
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
+            r#"{head}[[bodies]]
 name = "b"
 material = "steel"
 {mesh}
 [[supports]]
 set = "b.left"
 {fix}
-{extra}"#
+{extra}"#,
+            head = steel(0.3, "plane = \"strain\"\n")
         )
     };
     let plane = modes(&model(&text(false)), &options(4)).unwrap();
@@ -444,23 +428,12 @@ fn rayleigh_damping_from_modal_targets_gives_the_ratio_at_both() {
         assert!(e.contains(field), "{damping}: {e}");
     }
     // A free body's rigid modes have no frequency to damp at.
-    let free = r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-6
-damping = { ratio = 0.02, modes = [1, 4] }
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
-name = "b"
-material = "steel"
-thickness = 0.1
-mesh = { kind = "rectangle", size = [0.4, 0.1], divisions = [8, 2] }
-"#;
-    let e = rothe::config::from_str(free, std::path::Path::new("."))
+    let free = format!(
+        "{}[[bodies]]\nname = \"b\"\nmaterial = \"steel\"\nthickness = 0.1\n\
+         mesh = {{ kind = \"rectangle\", size = [0.4, 0.1], divisions = [8, 2] }}\n",
+        steel(0.3, "damping = { ratio = 0.02, modes = [1, 4] }\n")
+    );
+    let e = rothe::config::from_str(&free, std::path::Path::new("."))
         .unwrap_err()
         .to_string();
     assert!(
@@ -513,20 +486,7 @@ fix = ["x", "y"]
 "#
         )
     };
-    format!(
-        r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-6
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-{}{}"#,
-        body("a", 0.0),
-        body("b", 0.5)
-    )
+    format!("{}{}{}", steel(0.3, ""), body("a", 0.0), body("b", 0.5))
 }
 
 #[test]
@@ -610,16 +570,7 @@ fn the_modes_around_a_frequency_are_the_nearest_numbered_in_the_spectrum() {
 /// `ny` elements through the height and `5 ny` along.
 fn stubby_cantilever(ny: usize) -> String {
     format!(
-        r#"
-[analysis]
-t_end = 1.0e-4
-dt = 1.0e-6
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.3
-rho = 7850.0
-[[bodies]]
+        r#"{head}[[bodies]]
 name = "beam"
 material = "steel"
 thickness = 0.05
@@ -628,7 +579,8 @@ mesh = {{ kind = "rectangle", size = [1.0, 0.2], divisions = [{nx}, {ny}] }}
 set = "beam.left"
 fix = ["x", "y"]
 "#,
-        nx = 5 * ny
+        nx = 5 * ny,
+        head = steel(0.3, "")
     )
 }
 
