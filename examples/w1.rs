@@ -61,7 +61,7 @@ fn main() -> rothe::Result<()> {
                 solves += r.iterations;
                 n += 1;
             }
-            Marched::Cut { .. } => cuts += 1,
+            Marched::Cut { .. } | Marched::Rejected { .. } => cuts += 1,
         }
         Ok(())
     })?;

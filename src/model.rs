@@ -248,6 +248,58 @@ pub struct TimeSettings {
     pub lumped_mass: bool,
     /// Where the implicit schemes keep the state of linear viscoelastic materials.
     pub viscoelastic_state: ViscoelasticState,
+    /// Error-controlled steps (`analysis.adaptive`; `None`: fixed steps).
+    pub adaptive: Option<Adaptive>,
+}
+
+/// Error-controlled steps (`analysis.adaptive`, `theory/adaptive.md`): each step
+/// judged by the scheme's local error estimate, the sizes on the ladder
+/// `dt_max / 2^k`, impacts landed on as events.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// The tolerance on a step's relative error measure.
+    pub tolerance: f64,
+    /// The top rung (s).
+    pub dt_max: f64,
+    /// The smallest step wanted (s); the bottom rung is the largest `dt_max / 2^k`
+    /// not below it.
+    pub dt_min: f64,
+    /// How a step's error is measured.
+    pub norm: ErrorNorm,
+    /// Steps held at the bottom rung after an impact before the step may grow.
+    pub impact_steps: usize,
+}
+
+/// The numeric factors an error-controlled run keeps besides the current one.
+pub const KEPT_FACTORS: usize = 3;
+
+impl Adaptive {
+    /// The ladder's rungs `dt_max / 2^k` down to the bottom.
+    pub fn rungs(&self) -> usize {
+        let mut h = self.dt_max;
+        let mut n = 1;
+        while 0.5 * h >= self.dt_min * (1.0 - 1e-12) {
+            h *= 0.5;
+            n += 1;
+        }
+        n
+    }
+
+    /// The factors kept besides the current one: one per other rung, at most
+    /// [`KEPT_FACTORS`].
+    pub fn kept_factors(&self) -> usize {
+        (self.rungs() - 1).min(KEPT_FACTORS)
+    }
+}
+
+/// The measure of a step's local error (`analysis.adaptive.norm`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ErrorNorm {
+    /// `√(½ eᵀKe / E)`: the error's elastic energy relative to the state's
+    /// mechanical energy (`theory/adaptive.md`).
+    #[default]
+    Energy,
 }
 
 /// Damping `C = ζ M + a_m M + a_k K`.
@@ -323,6 +375,9 @@ pub struct ContactSettings {
 pub struct OutputSettings {
     /// Write VTK every this many steps (0: never).
     pub vtk_every: usize,
+    /// Write VTK at the multiples of this time instead (s), landed on by the steps
+    /// of an error-controlled run.
+    pub vtk_every_time: Option<f64>,
 }
 
 /// Fill-reducing ordering of the effective matrix. Nested dissection is handed to

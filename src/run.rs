@@ -22,6 +22,7 @@ use crate::output::recorder::{Recorder, Snapshot};
 use crate::output::summary::{
     EnergySummary, MaterialSummary, RunStatus, SolverSummary, Summary, TimingSummary,
 };
+use crate::time::adaptive::{march_adaptive, AdaptiveControl};
 use crate::time::backward_euler::BackwardEuler;
 use crate::time::central_difference::CentralDifference;
 use crate::time::march::{march, Marched, StepControl};
@@ -237,6 +238,10 @@ pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
         steps: 0,
         t_end: 0.0,
         dt: a.time.dt,
+        adaptive: a
+            .time
+            .adaptive
+            .map(|_| crate::time::adaptive::AdaptiveReport::default()),
         scheme: (a.time.kind == AnalysisKind::Dynamic).then_some(a.time.scheme),
         rho_inf: (a.time.kind == AnalysisKind::Dynamic
             && a.time.scheme == TimeScheme::GeneralizedAlpha)
@@ -395,15 +400,14 @@ fn integrate<I: Integrator>(
     kept: &mut Kept,
 ) -> Result<()> {
     let mut s = integrator.initial_state()?;
-    let vtk_every = model.analysis.output.vtk_every;
     // The Gauss-point state of a step the VTK series writes, when `s` keeps it in
     // nodal fields.
-    let output_points = |integrator: &I, s: &State| {
-        (vtk_every > 0 && s.step % vtk_every == 0)
+    let output_points = |integrator: &I, s: &State, rec: &Recorder| {
+        rec.vtk_due(s.step, s.t)
             .then(|| integrator.output_points(s))
             .flatten()
     };
-    let built = output_points(integrator, &s);
+    let built = output_points(integrator, &s, rec);
     rec.record(model, &snapshot(&s, built.as_deref(), 0, 0.0))?;
     let summary_path = (!opts.hooks.no_files).then(|| opts.out.join("summary.json"));
     let summary_path = summary_path.as_deref();
@@ -415,19 +419,19 @@ fn integrate<I: Integrator>(
     let t_end = model.analysis.time.t_end;
     let mut counts = Counts::default();
     let mut step_cuts = 0;
-    let control = StepControl::of(model);
-    let outcome = march(integrator, &mut s, control, |integrator, s, m| {
+    let mut adapted = crate::time::adaptive::AdaptiveReport::default();
+    let observe = |integrator: &I, s: &State, m: Marched| {
         match m {
             Marched::Step(report) => {
                 counts.add(report.iterations);
                 if s.step % PROGRESS_EVERY == 0 {
                     pb.set_message(counts.progress(&integrator.solver()));
                 }
-                let built = output_points(integrator, s);
+                let built = output_points(integrator, s, rec);
+                let on_cadence = rec.vtk_due(s.step, s.t);
                 let snap = snapshot(s, built.as_deref(), report.iterations, report.nl_residual);
                 rec.record(model, &snap)?;
                 pb.set_position(((s.t / t_end) * n_steps as f64) as u64);
-                let on_cadence = vtk_every > 0 && s.step % vtk_every == 0;
                 if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {
                     fill(summary, s, integrator, rec);
                     counts.fill(summary, step_cuts);
@@ -467,9 +471,26 @@ fn integrate<I: Integrator>(
                 step_cuts += 1;
                 pb.set_message(format!("step cut to h = {h:.3e} ({reason})"));
             }
+            Marched::Rejected { h, eta, retry } => {
+                pb.set_message(format!(
+                    "h = {h:.3e} s: error {eta:.2e} above the tolerance, again at {retry:.3e} s"
+                ));
+            }
         }
         Ok(())
-    });
+    };
+    let outcome = match AdaptiveControl::of(model) {
+        None => march(integrator, &mut s, StepControl::of(model), observe),
+        Some(control) => {
+            let r = march_adaptive(integrator, &mut s, control, &mut adapted, observe);
+            summary.adaptive = Some(adapted);
+            if let Some(w) = adapted.floor_warning() {
+                eprintln!("warning: {w}");
+                summary.warnings.push(w);
+            }
+            r
+        }
+    };
     pb.finish_and_clear();
     fill(summary, &s, integrator, rec);
     counts.fill(summary, step_cuts);

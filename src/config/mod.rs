@@ -355,6 +355,15 @@ pub struct AnalysisSpec {
     /// Write a VTK file every this many steps; 0 for none.
     #[serde(default = "default_vtk_every")]
     pub vtk_every: usize,
+    /// Write a VTK file at every multiple of this time (s) instead of by steps: the
+    /// steps of an error-controlled run land on those times; a fixed-step run writes
+    /// the first step at or past each. Default none.
+    #[serde(default)]
+    pub vtk_every_time: Option<f64>,
+    /// Error-controlled steps (the implicit schemes): `{ tolerance, dt_min, dt_max,
+    /// norm, impact_steps }` (theory/adaptive.md). Absent: fixed steps of `dt`.
+    #[serde(default)]
+    pub adaptive: Option<AdaptiveSpec>,
     /// Relative residual tolerance of the equilibrium iterations of materials with
     /// history. Default 1e-8: well below discretisation error, well above round-off.
     #[serde(default = "default_tolerance")]
@@ -412,6 +421,37 @@ pub struct AnalysisSpec {
     /// VTK output).
     #[serde(default)]
     pub viscoelastic_state: Option<crate::model::ViscoelasticState>,
+}
+
+/// `analysis.adaptive`: error-controlled steps.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AdaptiveSpec {
+    /// The largest relative error measure a step may have. Default 1e-4.
+    #[serde(default = "default_adaptive_tolerance")]
+    pub tolerance: f64,
+    /// The smallest step wanted (s): the bottom rung is the largest `dt_max / 2^k`
+    /// not below it. Default `dt_max / 2¹⁰`.
+    #[serde(default)]
+    pub dt_min: Option<f64>,
+    /// The largest step (s), the ladder's top. Default `analysis.dt`.
+    #[serde(default)]
+    pub dt_max: Option<f64>,
+    /// How a step's error is measured: `energy` (the only one, the default).
+    #[serde(default)]
+    pub norm: crate::model::ErrorNorm,
+    /// Steps held at the bottom rung after an impact before the step may grow.
+    /// Default 10.
+    #[serde(default = "default_impact_steps")]
+    pub impact_steps: usize,
+}
+
+fn default_adaptive_tolerance() -> f64 {
+    1e-4
+}
+
+fn default_impact_steps() -> usize {
+    10
 }
 
 fn default_displacement_tolerance() -> f64 {

@@ -18,7 +18,7 @@ const NONE: usize = usize::MAX;
 /// `S = (A⁻¹)_DD` for the contact dofs met so far.
 #[derive(Default)]
 pub(crate) struct Compliance {
-    /// The factorisation `S` belongs to (`EffectiveSystem::factorizations`).
+    /// The factorisation `S` belongs to (`EffectiveSystem::factor_id`).
     generation: usize,
     /// The free equations in `D`, in the order of `S`'s rows and columns.
     eqs: Vec<usize>,
@@ -38,15 +38,15 @@ pub(crate) struct Compliance {
 impl Compliance {
     /// Whether `S` belongs to the current factor of `sys`.
     pub fn is_current(&self, sys: &EffectiveSystem) -> bool {
-        !self.eqs.is_empty() && self.generation == sys.factorizations()
+        !self.eqs.is_empty() && self.generation == sys.factor_id()
     }
 
     /// Makes `S` hold every free equation of `needed` for the current factor of `sys`
     /// (clearing it first when the factor changed).
     pub fn cover(&mut self, sys: &mut EffectiveSystem, needed: &[usize]) -> Result<()> {
         let n = sys.dofs().n_free();
-        if self.generation != sys.factorizations() || self.slot.len() != n {
-            self.generation = sys.factorizations();
+        if self.generation != sys.factor_id() || self.slot.len() != n {
+            self.generation = sys.factor_id();
             self.eqs.clear();
             self.s.clear();
             self.slot.clear();

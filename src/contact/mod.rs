@@ -20,6 +20,7 @@ pub mod collision;
 mod compliance;
 pub(crate) mod coulomb;
 pub mod detect;
+pub mod events;
 pub mod implicit;
 pub mod kinematic;
 pub mod master;

@@ -161,13 +161,16 @@ impl SymmetricSolver for FaerCholesky {
     fn factorize(&mut self, a: &LowerCsc) -> Result<()> {
         let sym = self.symbolic.as_ref().ok_or_else(|| not_analysed(NAME))?;
         self.factorized = false;
+        let oom = |what: &str| Error::Solver {
+            backend: NAME,
+            message: format!("out of memory allocating the {what}"),
+        };
+        if self.l_values.len() != sym.len_val() {
+            // First factorisation, or the values were handed out (`take_numeric`).
+            self.l_values =
+                crate::buffers::try_zeroed(sym.len_val()).ok_or_else(|| oom("factor values"))?;
+        }
         if self.factor_scratch.is_none() {
-            let oom = |what: &str| Error::Solver {
-                backend: NAME,
-                message: format!("out of memory allocating the {what}"),
-            };
-            let len = sym.len_val();
-            self.l_values = crate::buffers::try_zeroed(len).ok_or_else(|| oom("factor values"))?;
             let freq = sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default());
             let mut scratch = MemBuffer::try_new(freq).map_err(|_| oom("factor workspace"))?;
             crate::buffers::touch(&mut scratch);
@@ -248,6 +251,21 @@ impl SymmetricSolver for FaerCholesky {
         match super::inverse_order(&order) {
             Some(inv) => self.ordering = Some((order, inv)),
             None => self.ordering = None,
+        }
+    }
+
+    fn take_numeric(&mut self) -> Option<Vec<f64>> {
+        if !self.factorized {
+            return None;
+        }
+        self.factorized = false;
+        Some(std::mem::take(&mut self.l_values))
+    }
+
+    fn put_numeric(&mut self, values: Vec<f64>) {
+        if self.symbolic.as_ref().map(|s| s.len_val()) == Some(values.len()) {
+            self.l_values = values;
+            self.factorized = true;
         }
     }
 

@@ -156,6 +156,18 @@ pub trait SymmetricSolver: Send {
     /// The elimination order the last analysis used (`order[k]` eliminated `k`-th),
     /// when the backend exposes it.
     fn ordering(&self) -> Option<Vec<usize>>;
+    /// Moves the numeric factor out, leaving the solver unfactorised with its
+    /// analysis, for a caller that keeps the factors of several matrices of one
+    /// pattern (the steps of an error-controlled run); `None` where the backend
+    /// cannot hand it out, and then nothing changes.
+    fn take_numeric(&mut self) -> Option<Vec<f64>> {
+        None
+    }
+    /// Makes `values`, which [`SymmetricSolver::take_numeric`] gave on the same
+    /// analysis, the factor again.
+    fn put_numeric(&mut self, values: Vec<f64>) {
+        let _ = values;
+    }
 }
 
 pub(crate) fn not_analysed(backend: &'static str) -> Error {

@@ -39,11 +39,51 @@ pub struct Snapshot<'a> {
     pub nl_residual: f64,
 }
 
+/// When the VTK series writes a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cadence {
+    /// Every this many steps (0: never).
+    Steps(usize),
+    /// At the first state at or past each multiple of `every` (s); `next` is the
+    /// next such time.
+    Time {
+        /// The interval (s).
+        every: f64,
+        /// The next frame's time (s).
+        next: f64,
+    },
+}
+
+impl Cadence {
+    /// The cadence `analysis.vtk_every_time` (else `vtk_every`) asks for.
+    pub fn of(o: &crate::model::OutputSettings) -> Self {
+        match o.vtk_every_time {
+            Some(every) => Cadence::Time { every, next: 0.0 },
+            None => Cadence::Steps(o.vtk_every),
+        }
+    }
+
+    /// Whether the state of `step` at `t` gets a frame.
+    pub fn due(&self, step: usize, t: f64) -> bool {
+        match *self {
+            Cadence::Steps(k) => k > 0 && step % k == 0,
+            Cadence::Time { every, next } => t >= next - 1e-9 * every,
+        }
+    }
+
+    /// A frame was written at `t`: the next is at the following multiple.
+    pub fn written(&mut self, t: f64) {
+        if let Cadence::Time { every, next } = self {
+            *next = ((t / *every + 1e-9).floor() + 1.0) * *every;
+        }
+    }
+}
+
 /// Writes a run's history, VTK series and probe extremes as it goes.
 pub struct Recorder {
     history: History,
     vtk: Option<VtkSeries>,
-    vtk_every: usize,
+    cadence: Cadence,
     probes: BTreeMap<String, ProbeSummary>,
     samples: Vec<[f64; 3]>,
     contact: BTreeMap<String, ContactSummary>,
@@ -77,7 +117,10 @@ impl Recorder {
             keep,
         )?;
         let vtk = match out {
-            Some(out) if model.analysis.output.vtk_every > 0 => {
+            Some(out)
+                if model.analysis.output.vtk_every > 0
+                    || model.analysis.output.vtk_every_time.is_some() =>
+            {
                 Some(VtkSeries::new(out, &model.mesh)?)
             }
             _ => None,
@@ -89,7 +132,7 @@ impl Recorder {
         Ok(Recorder {
             history,
             vtk,
-            vtk_every: model.analysis.output.vtk_every,
+            cadence: Cadence::of(&model.analysis.output),
             probes,
             samples: Vec::with_capacity(model.probes.len()),
             contact: pair_names
@@ -102,6 +145,11 @@ impl Recorder {
             fields: None,
             kept_fields: None,
         })
+    }
+
+    /// Whether the state of `step` at `t` gets a VTK frame.
+    pub fn vtk_due(&self, step: usize, t: f64) -> bool {
+        self.vtk.is_some() && self.cadence.due(step, t)
     }
 
     /// Also keeps every recorded state's displacement in memory.
@@ -169,7 +217,8 @@ impl Recorder {
             f.extend_from_slice(s.u);
         }
         if let Some(vtk) = &mut self.vtk {
-            if s.step % self.vtk_every == 0 {
+            if self.cadence.due(s.step, s.t) {
+                self.cadence.written(s.t);
                 let extra = if s.points.is_empty() {
                     Vec::new()
                 } else {

@@ -290,8 +290,13 @@ pub struct Summary {
     pub steps: usize,
     /// Time reached.
     pub t_end: f64,
-    /// Step size.
+    /// Step size (an error-controlled run: the first step).
     pub dt: f64,
+    /// An error-controlled run's account of its steps (`steps_accepted`,
+    /// `steps_rejected`, `dt_min_used`, `dt_max_used`, …), flattened into the
+    /// summary; absent for fixed steps.
+    #[serde(flatten)]
+    pub adaptive: Option<crate::time::adaptive::AdaptiveReport>,
     /// The time scheme of a dynamic run (`backward_euler`, `trapezoidal`,
     /// `generalized_alpha`, `central_difference`); absent in statics.
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -109,6 +109,20 @@ pub struct EffectiveSystem {
     factorizations: usize,
     timing: SystemTiming,
     nested_dissection: bool,
+    /// The identity of the current factor (`factor_id`) and its key, when the
+    /// factor was labelled as a matrix the caller may ask for again.
+    current: (usize, Option<u64>),
+    /// Numeric factors kept by key (`keep_factors`), least recently used first.
+    kept: Vec<KeptFactor>,
+    /// How many factors besides the current one are kept.
+    capacity: usize,
+}
+
+/// A numeric factor kept aside, with its identity and key.
+struct KeptFactor {
+    key: u64,
+    id: usize,
+    values: Vec<f64>,
 }
 
 impl EffectiveSystem {
@@ -141,7 +155,65 @@ impl EffectiveSystem {
                 ..Default::default()
             },
             nested_dissection,
+            current: (0, None),
+            kept: Vec::new(),
+            capacity: 0,
         })
+    }
+
+    /// Keeps up to `capacity` numeric factors besides the current one, so that
+    /// [`EffectiveSystem::switch_factor`] finds a labelled matrix's factor again
+    /// instead of refactorising (0, the default: none kept).
+    pub fn keep_factors(&mut self, capacity: usize) {
+        self.capacity = capacity;
+        self.kept.truncate(capacity);
+    }
+
+    /// Labels the current factor as the one of the matrix `key` (the caller's name
+    /// for it, e.g. a step size's bits).
+    pub fn label_factor(&mut self, key: u64) {
+        self.current.1 = Some(key);
+    }
+
+    /// Makes the factor labelled `key` current if it is kept (the current one, if
+    /// labelled, is kept in turn, the least recently used dropped beyond the
+    /// capacity), and says whether it was. On `false` the caller refills and
+    /// factorises (the solver may be left without a factor).
+    pub fn switch_factor(&mut self, key: u64) -> bool {
+        if self.capacity == 0 {
+            return false;
+        }
+        if self.current.1 == Some(key) {
+            return true;
+        }
+        if let Some(old) = self.current.1.take() {
+            if let Some(values) = self.solver.take_numeric() {
+                self.kept.push(KeptFactor {
+                    key: old,
+                    id: self.current.0,
+                    values,
+                });
+                if self.kept.len() > self.capacity {
+                    self.kept.remove(0);
+                }
+            }
+        }
+        match self.kept.iter().position(|k| k.key == key) {
+            Some(i) => {
+                let k = self.kept.remove(i);
+                self.solver.put_numeric(k.values);
+                self.current = (k.id, Some(key));
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The identity of the current numeric factor: a new one at each factorisation,
+    /// the same again when [`EffectiveSystem::switch_factor`] brings a kept factor
+    /// back (what depends on the factor, the contact compliance, is keyed by it).
+    pub fn factor_id(&self) -> usize {
+        self.current.0
     }
 
     /// Writes `c_m M + Σ c_i A_i` (matrices on the shared pattern) on the free dofs.
@@ -155,6 +227,7 @@ impl EffectiveSystem {
         let t = Instant::now();
         let res = self.solver.factorize(&self.reduced.csc);
         self.factorizations += 1;
+        self.current = (self.factorizations, None);
         self.timing.factorization_s += t.elapsed().as_secs_f64();
         match res {
             Ok(()) => Ok(Factored::Ok),

@@ -295,6 +295,12 @@ impl<'m> Core<'m> {
                 ),
             });
         }
+        if let Some(a) = &model.analysis.time.adaptive {
+            // The ladder's factors, each step size's kept for when the run returns
+            // to it (counted in the memory estimate, `memory::of_model`).
+            sys.keep_factors(a.kept_factors());
+            sys.label_factor(ops.h().to_bits());
+        }
         let predictor = (ops.dynamic().is_some()
             && model.analysis.time.contact_predictor == ContactPredictor::Stabilised)
             .then(|| Predictor::new(model, &ops, backend))
@@ -363,12 +369,69 @@ impl<'m> Core<'m> {
             self.scratch.factor.valid = f == Factored::Ok;
             return Ok(());
         }
-        match self.ops.refactor(&mut self.sys, &self.ops.kt)? {
-            Factored::Ok => Ok(()),
+        // A size the run had before finds its factor kept (an error-controlled run's
+        // ladder); the matrix is refilled all the same, so that it is the factor's.
+        let key = h.to_bits();
+        self.ops.refill(&mut self.sys, &self.ops.kt);
+        if self.sys.switch_factor(key) {
+            return Ok(());
+        }
+        match self.sys.factorize()? {
+            Factored::Ok => {
+                self.sys.label_factor(key);
+                Ok(())
+            }
             Factored::NotPositiveDefinite { message, .. } => Err(Error::Stepping(format!(
                 "the effective matrix for h = {h:e} is not positive definite ({message})"
             ))),
         }
+    }
+
+    /// The scheme's order, for the error-controlled step (dynamics only).
+    pub fn order(&self) -> Option<u32> {
+        match (self.ops.dynamic(), self.ops.rule()) {
+            (None, _) => None,
+            (Some(_), Rule::BackwardEuler) => Some(1),
+            (Some(_), _) => Some(2),
+        }
+    }
+
+    /// The local error measure of the step from `before` to `after`
+    /// (`theory/adaptive.md`): the displacement error of the scheme's estimate, zero
+    /// on the constrained dofs (their motion is prescribed), in the energy norm of
+    /// the elastic stiffness relative to the state's mechanical energy.
+    pub fn local_error(
+        &mut self,
+        before: &State,
+        after: &State,
+        est: &mut super::local_error::Estimator,
+    ) -> Option<f64> {
+        use super::local_error as le;
+        self.ops.dynamic()?;
+        let h = after.t - before.t;
+        let n = after.u.len();
+        est.e.resize(n, 0.0);
+        match self.ops.rule() {
+            Rule::BackwardEuler => le::backward_euler(h, &before.v, &after.v, &mut est.e),
+            Rule::GeneralizedAlpha(a) => {
+                le::newmark(le::coefficient(&a), h, &before.a, &after.a, &mut est.e)
+            }
+            Rule::Trapezoidal => {
+                if !est.trapezoidal(h, &before.v, &after.v) {
+                    return None;
+                }
+            }
+        }
+        for &d in &self.sys.dofs().constrained {
+            est.e[d] = 0.0;
+        }
+        est.ke.resize(n, 0.0);
+        self.ops
+            .asm
+            .pattern
+            .matvec(&self.ops.k, &est.e, &mut est.ke);
+        let energy = after.ledger.kinetic() + after.ledger.elastic();
+        Some(le::energy_measure(&est.e, &est.ke, energy))
     }
 
     /// Time per phase.
@@ -554,5 +617,18 @@ impl<S: ImplicitKind> Integrator for Implicit<'_, S> {
 
     fn solver(&self) -> SolverFacts {
         self.core.solver()
+    }
+
+    fn order(&self) -> Option<u32> {
+        self.core.order()
+    }
+
+    fn local_error(
+        &mut self,
+        before: &State,
+        after: &State,
+        estimator: &mut super::local_error::Estimator,
+    ) -> Option<f64> {
+        self.core.local_error(before, after, estimator)
     }
 }

@@ -50,7 +50,7 @@ impl KeptFactor {
     /// first factorisation), made at the coefficients `coefficients`.
     pub fn hold(&mut self, kt: Vec<f64>, sys: &EffectiveSystem, coefficients: (f64, f64, f64)) {
         self.factored_kt = kt;
-        self.held = Some((sys.factorizations(), coefficients));
+        self.held = Some((sys.factor_id(), coefficients));
     }
 
     /// Whether the iteration asks for the tangent of this evaluation with the
@@ -87,7 +87,7 @@ impl KeptFactor {
         sys: &mut EffectiveSystem,
         kt: &[f64],
     ) -> Result<Factored> {
-        let key = (sys.factorizations(), ops.coefficients());
+        let key = (sys.factor_id(), ops.coefficients());
         if self.held == Some(key) && self.factored_kt == kt {
             self.reused += 1;
             return Ok(Factored::Ok);
@@ -98,7 +98,7 @@ impl KeptFactor {
         if f == Factored::Ok {
             self.factored_kt.clear();
             self.factored_kt.extend_from_slice(kt);
-            self.held = Some((sys.factorizations(), ops.coefficients()));
+            self.held = Some((sys.factor_id(), ops.coefficients()));
         }
         Ok(f)
     }

@@ -19,6 +19,16 @@ pub enum Marched<'a> {
         /// Why the step failed.
         reason: &'a str,
     },
+    /// An error-controlled step converged but its error measure exceeded the
+    /// tolerance: it was taken back, to be tried again at `retry`.
+    Rejected {
+        /// The step's size.
+        h: f64,
+        /// Its relative error measure.
+        eta: f64,
+        /// The size tried next.
+        retry: f64,
+    },
 }
 
 /// How [`march`] may change the step.
@@ -100,12 +110,7 @@ where
                 ..
             }) => {
                 // Not the iteration's fault: a smaller step would not help.
-                return Err(Error::NonFinite {
-                    quantity: quantity.to_string(),
-                    value,
-                    location: dof.map(|d| integrator.model().describe_dof(d)),
-                    t: s.t + integrator.h(),
-                });
+                return Err(non_finite(integrator, s, quantity, dof, value));
             }
             StepOutcome::Rejected(r) if 0.5 * h < h_min => {
                 return Err(Error::Stepping(format!(
@@ -145,6 +150,22 @@ where
         }
     }
     Ok(())
+}
+
+/// The error of a step whose data was not finite, located.
+pub(crate) fn non_finite<I: Integrator + ?Sized>(
+    integrator: &I,
+    s: &State,
+    quantity: &str,
+    dof: Option<usize>,
+    value: f64,
+) -> Error {
+    Error::NonFinite {
+        quantity: quantity.to_string(),
+        value,
+        location: dof.map(|d| integrator.model().describe_dof(d)),
+        t: s.t + integrator.h(),
+    }
 }
 
 /// Takes `n` steps of the current `h` (no cuts; a rejected step is an error): for

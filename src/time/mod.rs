@@ -8,6 +8,7 @@
 //! [`backward_euler::BackwardEuler`] ([`Implicit`]); its step equation goes through the one
 //! equilibrium loop of [`crate::nonlinear`].
 
+pub mod adaptive;
 pub mod backward_euler;
 mod booking;
 pub mod central_difference;
@@ -154,6 +155,25 @@ pub trait Integrator {
     /// (state kept in nodal fields); `None` otherwise.
     fn output_points(&self, s: &State) -> Option<Vec<StateStore>> {
         let _ = s;
+        None
+    }
+
+    /// The scheme's order `p` (its local error goes as `h^(p+1)`), when it has an
+    /// error estimate for [`Integrator::local_error`]; `None` otherwise.
+    fn order(&self) -> Option<u32> {
+        None
+    }
+
+    /// The relative local error measure `η` of the step just taken from `before` to
+    /// `after` (`theory/adaptive.md`), `estimator` carrying what the estimate needs
+    /// of earlier steps; `None` when the scheme has no estimate, or none yet.
+    fn local_error(
+        &mut self,
+        before: &State,
+        after: &State,
+        estimator: &mut local_error::Estimator,
+    ) -> Option<f64> {
+        let _ = (before, after, estimator);
         None
     }
 

@@ -44,6 +44,7 @@ pub fn model_of(
                 t_end: 1.0,
                 lumped_mass: false,
                 viscoelastic_state: rothe::model::ViscoelasticState::Nodal,
+                adaptive: None,
             },
             damping: rothe::model::Damping {
                 zeta: 0.0,
@@ -65,7 +66,10 @@ pub fn model_of(
                 qp: rothe::model::ContactQp::Condensed,
                 friction_guess: true,
             },
-            output: rothe::model::OutputSettings { vtk_every: 0 },
+            output: rothe::model::OutputSettings {
+                vtk_every: 0,
+                vtk_every_time: None,
+            },
         },
     }
 }

@@ -6,6 +6,7 @@
 //! must not allocate terabytes), then the meshes are built and checked, then the bars,
 //! supports, loads and probes that refer to their sets.
 
+mod adaptive;
 mod checks;
 mod constraints;
 mod contacts;
@@ -215,6 +216,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 t_end: a.t_end,
                 lumped_mass: explicit || a.mass == Some(super::MassKind::Lumped),
                 viscoelastic_state: a.viscoelastic_state.unwrap_or_default(),
+                adaptive: adaptive::adaptive(a)?,
             },
             damping: Damping {
                 zeta: a.zeta,
@@ -248,6 +250,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
             },
             output: OutputSettings {
                 vtk_every: a.vtk_every,
+                vtk_every_time: adaptive::vtk_every_time(a)?,
             },
         },
         warnings: unread_keys(a),

@@ -24,7 +24,7 @@ impl ContactCorrection<'_> {
         let nf = self.setup.dofs.free.len();
         let t = Instant::now();
         // S pays once the factor has outlived a QP (theory/contact.md).
-        let generation = sys.factorizations();
+        let generation = sys.factor_id();
         let compliant =
             self.work.compliance.is_current(sys) || self.work.qp_generation == generation;
         self.work.qp_generation = generation;
