@@ -163,6 +163,25 @@ enum StudyCommand {
         #[command(flatten)]
         sweep: SweepArgs,
     },
+    /// An error-controlled scenario (`analysis.adaptive`) at a sequence of
+    /// tolerances, beside fixed steps at the ladder's rungs: the error each reaches
+    /// against a fixed-step reference, and the steps it took.
+    Tolerance {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        /// The tolerances, comma separated.
+        #[arg(long, value_delimiter = ',', required = true)]
+        tolerances: Vec<f64>,
+        /// Fixed-step runs at dt_max, dt_max/2, … dt_max/2^N beside them.
+        #[arg(long, default_value_t = rothe::study::tolerance_study::DEFAULT_FIXED_HALVINGS)]
+        fixed_halvings: usize,
+        /// The reference's fixed step (s); default the ladder's bottom rung (it must
+        /// divide it).
+        #[arg(long)]
+        reference_dt: Option<f64>,
+        #[command(flatten)]
+        sweep: SweepArgs,
+    },
     /// The scenario for a sequence of mesh sizes (`meshing.element_size`).
     Mesh {
         #[command(flatten)]
@@ -358,9 +377,9 @@ fn main() -> ExitCode {
         Command::Material { file, .. } => file.clone(),
         Command::Compare { scenario, .. } => scenario.scenario.clone(),
         Command::Study { study } => match study {
-            StudyCommand::Time { scenario, .. } | StudyCommand::Mesh { scenario, .. } => {
-                scenario.scenario.clone()
-            }
+            StudyCommand::Time { scenario, .. }
+            | StudyCommand::Mesh { scenario, .. }
+            | StudyCommand::Tolerance { scenario, .. } => scenario.scenario.clone(),
             StudyCommand::Collect { dir } => dir.clone(),
         },
         Command::Plot { dir } => dir.clone(),
@@ -533,6 +552,23 @@ fn study_command(study: StudyCommand) -> rothe::Result<()> {
             };
             let plan =
                 rothe::study::time_study::plan(&scenario.scenario, &base, &hs, reference_halvings)?;
+            sweep.execute(&plan)
+        }
+        StudyCommand::Tolerance {
+            scenario,
+            tolerances,
+            fixed_halvings,
+            reference_dt,
+            sweep,
+        } => {
+            let base = scenario.overrides()?;
+            let plan = rothe::study::tolerance_study::plan(
+                &scenario.scenario,
+                &base,
+                &tolerances,
+                fixed_halvings,
+                reference_dt,
+            )?;
             sweep.execute(&plan)
         }
         StudyCommand::Mesh {

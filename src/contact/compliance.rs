@@ -26,6 +26,10 @@ pub(crate) struct Compliance {
     slot: Vec<usize>,
     /// `S`, column-major `k x k`, `k = eqs.len()`.
     s: Vec<f64>,
+    /// The `(generation, eqs, slot, s)` of earlier factors the system keeps
+    /// (`EffectiveSystem::keeps_factors`: an error-controlled run's ladder), so that
+    /// `S` is found again, grown in the same order, when its factor comes back.
+    kept: Vec<(usize, Vec<usize>, Vec<usize>, Vec<f64>)>,
     // Workspace: new equations and their columns of `A⁻¹`; the slots a condensed
     // operator's rows touch, their positions among them, and `S G_Uᵀ`.
     fresh: Vec<usize>,
@@ -38,7 +42,9 @@ pub(crate) struct Compliance {
 impl Compliance {
     /// Whether `S` belongs to the current factor of `sys`.
     pub fn is_current(&self, sys: &EffectiveSystem) -> bool {
-        !self.eqs.is_empty() && self.generation == sys.factor_id()
+        let id = sys.factor_id();
+        (!self.eqs.is_empty() && self.generation == id)
+            || self.kept.iter().any(|(g, e, ..)| *g == id && !e.is_empty())
     }
 
     /// Makes `S` hold every free equation of `needed` for the current factor of `sys`
@@ -46,11 +52,27 @@ impl Compliance {
     pub fn cover(&mut self, sys: &mut EffectiveSystem, needed: &[usize]) -> Result<()> {
         let n = sys.dofs().n_free();
         if self.generation != sys.factor_id() || self.slot.len() != n {
-            self.generation = sys.factor_id();
-            self.eqs.clear();
-            self.s.clear();
-            self.slot.clear();
-            self.slot.resize(n, NONE);
+            let id = sys.factor_id();
+            let mut old = (
+                self.generation,
+                std::mem::take(&mut self.eqs),
+                std::mem::take(&mut self.slot),
+                std::mem::take(&mut self.s),
+            );
+            if let Some(i) = self.kept.iter().position(|(g, ..)| *g == id) {
+                // The factor came back: its S, as it was.
+                let (g, eqs, slot, s) = self.kept.remove(i);
+                (self.generation, self.eqs, self.slot, self.s) = (g, eqs, slot, s);
+            } else {
+                self.generation = id;
+                self.slot.resize(n, NONE);
+            }
+            if sys.keeps_factors() && !old.1.is_empty() && old.2.len() == n {
+                self.kept.push(std::mem::take(&mut old));
+                if self.kept.len() > crate::model::KEPT_FACTORS + 1 {
+                    self.kept.remove(0);
+                }
+            }
         }
         self.fresh.clear();
         for &e in needed {

@@ -66,6 +66,7 @@ pub fn collect(dir: &Path) -> Result<Collected> {
         StudyKind::Mesh => super::mesh_study::collect(dir, &runs)?,
         StudyKind::Compare => super::compare::collect(dir, &runs)?,
         StudyKind::Report => super::report::collect(dir, &runs)?,
+        StudyKind::Tolerance => super::tolerance_study::collect(dir, &runs)?,
     };
     if !incomplete.is_empty() {
         md.push_str("\n## Runs that did not complete\n\n");

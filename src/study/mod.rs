@@ -1,5 +1,5 @@
 //! Sweeps of runs and what is learnt from them: convergence in the time step
-//! ([`time_study`]) and in the mesh ([`mesh_study`]), the implicit path against the
+//! ([`time_study`]), error-controlled steps against fixed ones ([`tolerance_study`]) and in the mesh ([`mesh_study`]), the implicit path against the
 //! explicit one ([`compare`]), and the paper's benchmarks ([`report`]).
 //!
 //! Every sweep is a [`plan::Plan`] of independent `rothe run`s, each into its own
@@ -22,6 +22,7 @@ pub mod run_data;
 pub mod sweep;
 pub mod table;
 pub mod time_study;
+pub mod tolerance_study;
 
 pub use collect::collect;
 pub use plan::{Plan, PlannedRun, StudyKind};

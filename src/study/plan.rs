@@ -23,6 +23,8 @@ pub enum StudyKind {
     Compare,
     /// The paper's benchmarks: every model and mesh.
     Report,
+    /// An error-controlled scenario at a sequence of tolerances, beside fixed steps.
+    Tolerance,
 }
 
 /// One run of a sweep.

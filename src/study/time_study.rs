@@ -40,6 +40,13 @@ pub fn plan(
     reference_halvings: usize,
 ) -> Result<Plan> {
     let scenario = super::plan::absolute(scenario)?;
+    let model = load_with_overrides(&scenario, &LoadOptions::default(), base)?;
+    if model.analysis.time.adaptive.is_some() {
+        return Err(Error::config(
+            "analysis.adaptive",
+            "a time study compares runs at fixed steps h, and the scenario chooses its              steps from an error estimate: remove the key (--unset analysis.adaptive), or              study the tolerance instead (rothe study tolerance)",
+        ));
+    }
     let mut hs: Vec<f64> = hs.to_vec();
     if hs.len() < 2 || hs.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
         return Err(Error::config(

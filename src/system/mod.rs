@@ -169,6 +169,11 @@ impl EffectiveSystem {
         self.kept.truncate(capacity);
     }
 
+    /// Whether factors are kept ([`EffectiveSystem::keep_factors`] above 0).
+    pub fn keeps_factors(&self) -> bool {
+        self.capacity > 0
+    }
+
     /// Labels the current factor as the one of the matrix `key` (the caller's name
     /// for it, e.g. a step size's bits).
     pub fn label_factor(&mut self, key: u64) {

@@ -226,7 +226,10 @@ where
                     report.steps_at_floor += 1;
                 }
                 if on_ladder {
+                    // The time on the ladder is a count of bottom rungs: no drift
+                    // from summing the steps.
                     n += (h / tick).round() as u64;
+                    s.t = t0 + n as f64 * tick;
                 }
                 report.steps_accepted += 1;
                 if report.steps_accepted == 1 {

@@ -7,6 +7,7 @@ mod common;
 #[path = "../../benches/common/workload.rs"]
 mod workload;
 
+mod adaptive;
 mod benchmarks;
 mod contact;
 mod contact3d;

@@ -16,7 +16,13 @@ use crate::common::model;
 /// A concrete cantilever 2 x 0.5 m (thickness 0.2 m, 8 x 2 elements) clamped on
 /// the left, with `scheme`, step `h` to `t_end`, and `extra` lines (a velocity, a
 /// load, damping).
-fn cantilever(scheme: &str, h: f64, t_end: f64, velocity: [f64; 2], extra: &str) -> String {
+pub(crate) fn cantilever(
+    scheme: &str,
+    h: f64,
+    t_end: f64,
+    velocity: [f64; 2],
+    extra: &str,
+) -> String {
     format!(
         r#"
 [analysis]
