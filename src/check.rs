@@ -32,6 +32,8 @@ pub struct Report {
     pub dofs: (usize, usize),
     /// Steps, step size, end time.
     pub steps: (usize, f64, f64),
+    /// An error-controlled run's plan (`None` for fixed steps).
+    pub adaptive: Option<crate::time::adaptive::AdaptivePlan>,
     /// History rows and their bytes.
     pub history: (usize, u64),
     /// VTK files and their total bytes.
@@ -125,7 +127,10 @@ pub fn volume(model: &Model) -> Volume {
     // A row: 12 ledger columns, 2 solver columns, 2 per probe, about 20 bytes each.
     let row_bytes = (16 + 2 * probes) as u64 * 20;
     let history = (steps + 1, (steps as u64 + 1) * row_bytes);
-    let vtk_files = steps.checked_div(a.output.vtk_every).map_or(0, |k| k + 1);
+    let vtk_files = match a.output.vtk_every_time {
+        Some(every) => (a.time.t_end / every + 1e-9).floor() as usize + 1,
+        None => steps.checked_div(a.output.vtk_every).map_or(0, |k| k + 1),
+    };
     // Points (3 doubles), connectivity, two vector fields, cell fields, as ASCII.
     let vtk_file_bytes =
         (mesh.n_nodes() as u64) * (3 + 3 + 3) * 24 + (mesh.n_elements() as u64) * (5 + 6) * 24;
@@ -204,6 +209,7 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         elements: mesh.n_elements(),
         dofs: (mesh.n_dofs(), system.dofs().n_free()),
         steps: (steps, a.time.dt, a.time.t_end),
+        adaptive: crate::time::adaptive::AdaptivePlan::of(model),
         history,
         vtk,
         cfl,
@@ -345,7 +351,10 @@ impl fmt::Display for Report {
         for (i, l) in self.damping.iter().enumerate() {
             writeln!(f, "{}{l}", if i == 0 { "damping     " } else { "  " })?;
         }
-        writeln!(f, "steps       {steps} of h = {dt:e} s to T = {t_end:e} s")?;
+        match &self.adaptive {
+            Some(plan) => writeln!(f, "steps       {plan}; T = {t_end:e} s")?,
+            None => writeln!(f, "steps       {steps} of h = {dt:e} s to T = {t_end:e} s")?,
+        }
         writeln!(
             f,
             "output      history.csv {} rows ({}), {} VTK files ({})",

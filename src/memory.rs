@@ -139,10 +139,18 @@ pub fn human(bytes: u64) -> String {
 /// The memory estimate of a model (the factor's exact nonzeros when known).
 pub fn of_model(model: &Model, factor_nnz: Option<usize>) -> Estimate {
     let mut est = of_mesh(&model.mesh, &model.materials, factor_nnz);
-    if model.analysis.time.contact_predictor == crate::model::ContactPredictor::Stabilised {
-        // The predictor's factor of the mass, on the same pattern and ordering.
-        est.factor *= 2;
-    }
+    let factors = 1
+        + u64::from(
+            model.analysis.time.contact_predictor == crate::model::ContactPredictor::Stabilised,
+        )
+        // An error-controlled run keeps the factors of other rungs of its ladder.
+        + model
+            .analysis
+            .time
+            .adaptive
+            .map_or(0, |a| a.kept_factors() as u64);
+    // The predictor's factor of the mass is on the same pattern and ordering.
+    est.factor *= factors;
     est
 }
 

@@ -76,12 +76,80 @@ impl AdaptiveReport {
     pub fn floor_warning(&self) -> Option<String> {
         (self.steps_at_floor > 0).then(|| {
             format!(
-                "{} steps stood above analysis.adaptive.tolerance at the bottom rung \
+                "{} step(s) stood above analysis.adaptive.tolerance at the bottom rung \
                  {:.3e} s (outside impacts): lower analysis.adaptive.dt_min to meet the \
                  tolerance there",
                 self.steps_at_floor, self.bottom_rung
             )
         })
+    }
+}
+
+/// What an error-controlled run plans (`rothe check`): its ladder, the factors it
+/// keeps, the bounds of its step count and its first impact from the initial motion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptivePlan {
+    /// The settings.
+    pub settings: Adaptive,
+    /// The bottom rung (s).
+    pub bottom: f64,
+    /// Rungs on the ladder.
+    pub rungs: usize,
+    /// Factors kept besides the current one.
+    pub kept: usize,
+    /// Steps if every step were the top rung, and if every step were the bottom.
+    pub steps: (usize, usize),
+    /// The first impact of a pair, every node moving at its initial velocity.
+    pub first_impact: Option<f64>,
+}
+
+impl AdaptivePlan {
+    /// The plan of `model`'s error-controlled steps (`None` for fixed steps).
+    pub fn of(model: &crate::model::Model) -> Option<Self> {
+        let a = model.analysis.time.adaptive?;
+        let bottom = Ladder::new(a.dt_max, a.dt_min, a.tolerance, 1).dt_min;
+        let t_end = model.analysis.time.t_end;
+        let u0 = vec![0.0; model.mesh.n_dofs()];
+        let v0 = model.initial_velocity();
+        let contact = crate::contact::ContactState::initial(model, &u0);
+        Some(AdaptivePlan {
+            settings: a,
+            bottom,
+            rungs: a.rungs(),
+            kept: a.kept_factors(),
+            steps: (
+                (t_end / a.dt_max).ceil() as usize,
+                (t_end / bottom).ceil() as usize,
+            ),
+            first_impact: crate::contact::events::first_impact(model, &u0, &v0, t_end, &contact),
+        })
+    }
+}
+
+impl std::fmt::Display for AdaptivePlan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "error-controlled, tolerance {:e} (energy norm); steps dt_max / 2^k from {:e} to \
+             {:e} s ({} rung(s), {} factor(s) kept besides the current); between {} (all at \
+             dt_max) and {} (all at the bottom) steps",
+            self.settings.tolerance,
+            self.settings.dt_max,
+            self.bottom,
+            self.rungs,
+            self.kept,
+            self.steps.0,
+            self.steps.1
+        )?;
+        if let Some(t) = self.first_impact {
+            write!(
+                f,
+                "; the first impact at about {t:.4e} s (the initial motion), then {} steps at \
+                 the bottom",
+                self.settings.impact_steps
+            )?;
+        }
+        Ok(())
     }
 }
 

@@ -446,6 +446,16 @@ fn bad_adaptive_input_is_refused_by_name() {
         &with("backward_euler", "vtk_every_time = 0.0"),
         &["analysis.vtk_every_time"],
     );
+    // A bottom rung too long for the wave an impact sends: warned of, by name.
+    let m = benchmark_1(3e-3, &["analysis.adaptive.dt_min=1.6e-5"]);
+    assert!(
+        m.warnings
+            .iter()
+            .any(|w| w.contains("analysis.adaptive.dt_min") && w.contains("L_e/c")),
+        "{:?}",
+        m.warnings
+    );
+    assert!(benchmark_1(3e-3, &[]).warnings.is_empty());
 }
 
 #[test]
@@ -496,4 +506,54 @@ fn the_studies_refuse_what_they_cannot_study() {
         .unwrap();
         assert!(m.analysis.time.adaptive.is_none(), "{}", r.id);
     }
+}
+
+#[test]
+fn a_run_reports_its_steps_and_lands_its_frames() {
+    // From the command line: VTK frames at every 0.5 ms exactly, the summary's
+    // account of the steps, and `rothe check`'s plan.
+    let dir = tempfile::tempdir().unwrap();
+    let file = crate::common::scenario(
+        dir.path(),
+        "forced.toml",
+        &forced_cantilever_text("generalized_alpha", 1e-4).replace("vtk_every = 0\n", ""),
+    );
+    let out = dir.path().join("out");
+    let (ok, _, err) = crate::common::rothe(&[
+        "run",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    let pvd = std::fs::read_to_string(out.join("result.pvd")).unwrap();
+    let times: Vec<f64> = pvd
+        .split("timestep=\"")
+        .skip(1)
+        .map(|s| s[..s.find('"').unwrap()].parse().unwrap())
+        .collect();
+    assert_eq!(times.len(), 9, "{times:?}");
+    for (k, t) in times.iter().enumerate() {
+        assert!((t - 5e-4 * k as f64).abs() < 1e-15, "{times:?}");
+    }
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let steps = s["steps"].as_u64().unwrap();
+    assert_eq!(s["steps_accepted"].as_u64(), Some(steps));
+    assert!(s["steps_rejected"].as_u64().is_some());
+    let (lo, hi) = (
+        s["dt_min_used"].as_f64().unwrap(),
+        s["dt_max_used"].as_f64().unwrap(),
+    );
+    assert!(
+        lo >= 2.5e-4 / 1024.0 && lo < hi && hi <= 2.5e-4,
+        "{lo} {hi}"
+    );
+    let (ok, plan, err) = crate::common::rothe(&["check", file.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        plan.contains("error-controlled") && plan.contains("between 16 (all at dt_max) and 16384"),
+        "{plan}"
+    );
 }

@@ -4,7 +4,7 @@
 use super::checks::positive;
 use crate::config::AnalysisSpec;
 use crate::error::{Error, Result};
-use crate::model::{Adaptive, AnalysisKind, TimeScheme};
+use crate::model::{Adaptive, AnalysisKind, Model, TimeScheme};
 
 /// The default bottom of the ladder, relative to its top: ten halvings.
 const DEFAULT_RUNGS_BELOW: i32 = 10;
@@ -109,4 +109,30 @@ pub(super) fn vtk_every_time(a: &AnalysisSpec) -> Result<Option<f64>> {
         ));
     }
     Ok(Some(every))
+}
+
+/// Warns when the bottom rung of an error-controlled run with contact is above the
+/// step an impact needs: the time a stress wave takes to cross the smallest
+/// element (`L_e/c`, the CFL step), below which the implicit step resolves the
+/// wave the impact sends (`theory/adaptive.md`).
+pub(super) fn impact_warning(model: &mut Model) {
+    let Some(a) = model.analysis.time.adaptive else {
+        return;
+    };
+    if model.contacts.is_empty() {
+        return;
+    }
+    let Some(c) = crate::time::cfl::critical_step(model) else {
+        return;
+    };
+    let bottom = crate::time::step_ladder::Ladder::new(a.dt_max, a.dt_min, a.tolerance, 1).dt_min;
+    if bottom > c.dt {
+        model.warnings.push(format!(
+            "analysis.adaptive.dt_min: the bottom rung {bottom:.3e} s is above {:.3e} s, the \
+             time a stress wave takes to cross the smallest element (L_e/c, block {}, \
+             element {}): impacts land on steps too long to resolve the wave they send; \
+             lower dt_min",
+            c.dt, c.block, c.element
+        ));
+    }
 }

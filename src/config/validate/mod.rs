@@ -259,6 +259,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
         explicit_step::explicit_step(&mut model, a.dt, opts)?;
     }
     chatter_warning(&mut model);
+    adaptive::impact_warning(&mut model);
     if let Some(DampingSpec {
         ratio,
         modes: Some([i, j]),
