@@ -447,7 +447,13 @@ fn bad_adaptive_input_is_refused_by_name() {
         &["analysis.vtk_every_time"],
     );
     // A bottom rung too long for the wave an impact sends: warned of, by name.
-    let m = benchmark_1(3e-3, &["analysis.adaptive.dt_min=1.6e-5"]);
+    let m = benchmark_1(
+        3e-3,
+        &[
+            "meshing.element_size=0.1",
+            "analysis.adaptive.dt_min=1.6e-5",
+        ],
+    );
     assert!(
         m.warnings
             .iter()
