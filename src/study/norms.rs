@@ -71,8 +71,14 @@ impl Norms {
 
     /// `(x, y)` for two nodal displacement vectors (`dim` dofs per node).
     pub fn products(&self, x: &[f64], y: &[f64]) -> Products {
+        self.triple(x, y)[1]
+    }
+
+    /// `(x, x)`, `(x, y)` and `(y, y)` in one pass over the points: each the same
+    /// sum, in the same order, as [`Norms::products`] of the pair.
+    pub fn triple(&self, x: &[f64], y: &[f64]) -> [Products; 3] {
         let dim = self.dim;
-        let mut p = Products::default();
+        let mut p = [Products::default(); 3];
         for q in &self.points {
             let (mut vx, mut vy) = ([0.0; 3], [0.0; 3]);
             let (mut gx, mut gy) = ([[0.0; 3]; 3], [[0.0; 3]; 3]);
@@ -87,20 +93,26 @@ impl Norms {
                     }
                 }
             }
-            let mut v = vx[0] * vy[0];
-            for c in 1..dim {
-                v += vx[c] * vy[c];
-            }
-            let mut g = gx[0][0] * gy[0][0];
-            for c in 0..dim {
-                for k in 0..dim {
-                    if c + k > 0 {
-                        g += gx[c][k] * gy[c][k];
+            for (out, (a, b, ga, gb)) in p.iter_mut().zip([
+                (&vx, &vx, &gx, &gx),
+                (&vx, &vy, &gx, &gy),
+                (&vy, &vy, &gy, &gy),
+            ]) {
+                let mut v = a[0] * b[0];
+                for c in 1..dim {
+                    v += a[c] * b[c];
+                }
+                let mut g = ga[0][0] * gb[0][0];
+                for c in 0..dim {
+                    for k in 0..dim {
+                        if c + k > 0 {
+                            g += ga[c][k] * gb[c][k];
+                        }
                     }
                 }
+                out.l2 += q.w * v;
+                out.h1 += q.w * (v + g);
             }
-            p.l2 += q.w * v;
-            p.h1 += q.w * (v + g);
         }
         p
     }

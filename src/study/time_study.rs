@@ -195,9 +195,7 @@ fn diff(a: &[f64], b: &[f64], out: &mut [f64]) {
 
 /// Accumulates one interval's linear error `e_a → e_b` of length `tau`.
 fn accumulate(norms: &Norms, ea: &[f64], eb: &[f64], tau: f64, sup: &mut f64, int: &mut f64) {
-    let aa: Products = norms.products(ea, ea);
-    let ab = norms.products(ea, eb);
-    let bb = norms.products(eb, eb);
+    let [aa, ab, bb]: [Products; 3] = norms.triple(ea, eb);
     *sup = sup.max(aa.l2.max(bb.l2).max(0.0).sqrt());
     *int += tau / 3.0 * (aa.h1 + ab.h1 + bb.h1);
 }
