@@ -46,6 +46,7 @@ __all__ = [
     "material",
     "study_time",
     "study_mesh",
+    "study_tolerance",
     "compare",
     "__version__",
 ]
@@ -503,6 +504,29 @@ def study_time(
     return _study(
         "time", scenario, variants, set, unset, out, h or [], halvings,
         None if reference_halvings is None else str(int(reference_halvings)), jobs, backend,
+    )
+
+
+def study_tolerance(
+    scenario: Union[PathLike, Scenario],
+    out: PathLike,
+    tolerances: Sequence[float],
+    fixed_halvings: Optional[int] = None,
+    reference_dt: Optional[float] = None,
+    variants=None,
+    set=None,
+    unset=None,
+    jobs: Optional[int] = None,
+    backend: str = "faer",
+) -> Dict[str, Any]:
+    """``rothe study tolerance``: an error-controlled scenario (``analysis.adaptive``)
+    at each tolerance, beside fixed steps ``dt_max / 2^k`` (``k`` up to
+    ``fixed_halvings``, default 6) and a fixed-step reference (``reference_dt``,
+    default the ladder's bottom rung); the errors against the steps are in
+    ``tables["study"]``; see :func:`study_time` for the rest."""
+    return _study(
+        "tolerance", scenario, variants, set, unset, out, list(tolerances), fixed_halvings,
+        None if reference_dt is None else repr(float(reference_dt)), jobs, backend,
     )
 
 

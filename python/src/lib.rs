@@ -577,9 +577,10 @@ fn material(py: Python<'_>, file: PathBuf, out: PathBuf) -> PyResult<usize> {
         .map_err(py_err)
 }
 
-/// A study: `kind` is `time`, `mesh` or `compare`; `values` the steps (time), the
-/// element sizes (mesh); `option` the reference halvings (time) or the implicit
-/// scheme (compare). Sweeps the runs into `out` and collects them; returns the
+/// A study: `kind` is `time`, `mesh`, `tolerance` or `compare`; `values` the steps
+/// (time), the element sizes (mesh), the tolerances (tolerance); `halvings` the
+/// step's halvings (time) or the fixed runs' (tolerance); `option` the reference
+/// halvings (time), the reference step (tolerance) or the implicit scheme (compare). Sweeps the runs into `out` and collects them; returns the
 /// Markdown summary and the runs that did not complete.
 #[pyfunction]
 #[pyo3(signature = (kind, scenario, variants, unsets, sets, out, values, halvings, option, jobs, backend_name))]
@@ -602,7 +603,7 @@ fn study(
     let backend = backend(backend_name)?;
     let kind = kind.to_string();
     py.detach(move || -> rothe::Result<(String, Vec<String>)> {
-        use rothe::study::{compare, mesh_study, time_study};
+        use rothe::study::{compare, mesh_study, time_study, tolerance_study};
         let plan = match kind.as_str() {
             "time" => {
                 let reference = option
@@ -621,6 +622,23 @@ fn study(
                 time_study::plan(&scenario, &base, &hs, reference)?
             }
             "mesh" => mesh_study::plan(&scenario, &base, &values)?,
+            "tolerance" => {
+                let reference = option
+                    .as_deref()
+                    .map(|s| {
+                        s.parse::<f64>().map_err(|_| {
+                            rothe::Error::config("reference_dt", format!("`{s}` is no step"))
+                        })
+                    })
+                    .transpose()?;
+                tolerance_study::plan(
+                    &scenario,
+                    &base,
+                    &values,
+                    halvings.unwrap_or(tolerance_study::DEFAULT_FIXED_HALVINGS),
+                    reference,
+                )?
+            }
             "compare" => compare::plan(
                 &scenario,
                 &base,

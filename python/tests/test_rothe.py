@@ -175,6 +175,25 @@ def test_a_time_study_reads_order_two_for_the_trapezoidal_rule(examples, tmp_pat
     assert np.isnan(t["order_linear_Linf_L2"][0])
 
 
+def test_an_adaptive_run_and_a_tolerance_study(examples, tmp_path):
+    # Benchmark 1 coarse, error-controlled: fewer steps than the fixed 1 µs, the
+    # summary's account of them, and the tolerance study's table beside fixed steps.
+    adaptive = {"analysis.dt": 1.6e-5, "analysis.adaptive.dt_max": 1.6e-5,
+                "analysis.adaptive.dt_min": 1e-6}
+    run = two_blocks(examples, **adaptive).run()
+    s = run.summary
+    assert s["steps_accepted"] == s["steps"] < 3000
+    assert s["impacts"] == 1 and s["dt_max_used"] == 1.6e-5
+    r = rothe.study_tolerance(two_blocks(examples, **adaptive), tmp_path / "tol",
+                              tolerances=[1e-2, 1e-3], fixed_halvings=2)
+    assert r["incomplete"] == []
+    t = r["tables"]["study"]
+    assert list(t["run"]) == ["tol0", "tol1", "fixed0", "fixed1", "fixed2"]
+    assert t["steps"][1] > t["steps"][0] and np.all(t["err_linear_L2_H1"] > 0)
+    with pytest.raises(rothe.Error, match="analysis.adaptive"):
+        rothe.study_time(two_blocks(examples, **adaptive), tmp_path / "time", h=[1e-5, 5e-6])
+
+
 def test_compare_and_a_mesh_study_give_their_tables(examples, tmp_path):
     c = rothe.compare(examples / "benchmarks" / "two_blocks.toml", tmp_path / "cmp",
                       implicit_scheme="trapezoidal", set={**SMALL, "analysis.t_end": 1e-3})
