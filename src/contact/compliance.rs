@@ -15,9 +15,9 @@ use crate::system::EffectiveSystem;
 /// Marks a free equation that is no contact dof yet.
 const NONE: usize = usize::MAX;
 
-/// `S = (A⁻¹)_DD` for the contact dofs met so far.
+/// `S` for one factor.
 #[derive(Default)]
-pub(crate) struct Compliance {
+struct Block {
     /// The factorisation `S` belongs to (`EffectiveSystem::factor_id`).
     generation: usize,
     /// The free equations in `D`, in the order of `S`'s rows and columns.
@@ -26,10 +26,17 @@ pub(crate) struct Compliance {
     slot: Vec<usize>,
     /// `S`, column-major `k x k`, `k = eqs.len()`.
     s: Vec<f64>,
-    /// The `(generation, eqs, slot, s)` of earlier factors the system keeps
-    /// (`EffectiveSystem::keeps_factors`: an error-controlled run's ladder), so that
-    /// `S` is found again, grown in the same order, when its factor comes back.
-    kept: Vec<(usize, Vec<usize>, Vec<usize>, Vec<f64>)>,
+}
+
+/// `S = (A⁻¹)_DD` for the contact dofs met so far.
+#[derive(Default)]
+pub(crate) struct Compliance {
+    /// `S` of the current factor.
+    now: Block,
+    /// `S` of earlier factors the system keeps (`EffectiveSystem::keeps_factors`: an
+    /// error-controlled run's ladder), found again, grown in the same order, when
+    /// its factor comes back.
+    kept: Vec<Block>,
     // Workspace: new equations and their columns of `A⁻¹`; the slots a condensed
     // operator's rows touch, their positions among them, and `S G_Uᵀ`.
     fresh: Vec<usize>,
@@ -43,32 +50,29 @@ impl Compliance {
     /// Whether `S` belongs to the current factor of `sys`.
     pub fn is_current(&self, sys: &EffectiveSystem) -> bool {
         let id = sys.factor_id();
-        (!self.eqs.is_empty() && self.generation == id)
-            || self.kept.iter().any(|(g, e, ..)| *g == id && !e.is_empty())
+        std::iter::once(&self.now)
+            .chain(&self.kept)
+            .any(|b| b.generation == id && !b.eqs.is_empty())
     }
 
     /// Makes `S` hold every free equation of `needed` for the current factor of `sys`
     /// (clearing it first when the factor changed).
     pub fn cover(&mut self, sys: &mut EffectiveSystem, needed: &[usize]) -> Result<()> {
         let n = sys.dofs().n_free();
-        if self.generation != sys.factor_id() || self.slot.len() != n {
+        if self.now.generation != sys.factor_id() || self.now.slot.len() != n {
             let id = sys.factor_id();
-            let mut old = (
-                self.generation,
-                std::mem::take(&mut self.eqs),
-                std::mem::take(&mut self.slot),
-                std::mem::take(&mut self.s),
-            );
-            if let Some(i) = self.kept.iter().position(|(g, ..)| *g == id) {
+            let fresh = match self.kept.iter().position(|b| b.generation == id) {
                 // The factor came back: its S, as it was.
-                let (g, eqs, slot, s) = self.kept.remove(i);
-                (self.generation, self.eqs, self.slot, self.s) = (g, eqs, slot, s);
-            } else {
-                self.generation = id;
-                self.slot.resize(n, NONE);
-            }
-            if sys.keeps_factors() && !old.1.is_empty() && old.2.len() == n {
-                self.kept.push(std::mem::take(&mut old));
+                Some(i) => self.kept.remove(i),
+                None => Block {
+                    generation: id,
+                    slot: vec![NONE; n],
+                    ..Default::default()
+                },
+            };
+            let old = std::mem::replace(&mut self.now, fresh);
+            if sys.keeps_factors() && !old.eqs.is_empty() && old.slot.len() == n {
+                self.kept.push(old);
                 if self.kept.len() > crate::model::KEPT_FACTORS + 1 {
                     self.kept.remove(0);
                 }
@@ -76,8 +80,8 @@ impl Compliance {
         }
         self.fresh.clear();
         for &e in needed {
-            if self.slot[e] == NONE {
-                self.slot[e] = self.eqs.len() + self.fresh.len();
+            if self.now.slot[e] == NONE {
+                self.now.slot[e] = self.now.eqs.len() + self.fresh.len();
                 self.fresh.push(e);
             }
         }
@@ -94,17 +98,17 @@ impl Compliance {
         sys.solve_block(&mut self.cols, f)?;
         // Grow S from k x k to (k + f) x (k + f): the old block stays, the new rows
         // and columns come from the new columns of A⁻¹ (A⁻¹ is symmetric).
-        let k = self.eqs.len();
+        let k = self.now.eqs.len();
         let k2 = k + f;
         let mut s = vec![0.0; k2 * k2];
         for j in 0..k {
-            s[j * k2..j * k2 + k].copy_from_slice(&self.s[j * k..(j + 1) * k]);
+            s[j * k2..j * k2 + k].copy_from_slice(&self.now.s[j * k..(j + 1) * k]);
         }
-        self.eqs.extend_from_slice(&self.fresh);
+        self.now.eqs.extend_from_slice(&self.fresh);
         for jn in 0..f {
             let col = &self.cols[jn * n..(jn + 1) * n];
             let j = k + jn;
-            for (i, &e) in self.eqs.iter().enumerate() {
+            for (i, &e) in self.now.eqs.iter().enumerate() {
                 s[i + j * k2] = col[e];
                 s[j + i * k2] = col[e];
             }
@@ -117,7 +121,7 @@ impl Compliance {
                 s[(k + i_n) + (k + jn) * k2] = v;
             }
         }
-        self.s = s;
+        self.now.s = s;
         Ok(())
     }
 
@@ -133,12 +137,12 @@ impl Compliance {
         rows: &[usize],
         w: &mut Vec<f64>,
     ) {
-        let k = self.eqs.len();
+        let k = self.now.eqs.len();
         let m = rows.len();
         self.union.clear();
         for &i in rows {
             self.union
-                .extend(g.row(i).col_indices().iter().map(|&e| self.slot[e]));
+                .extend(g.row(i).col_indices().iter().map(|&e| self.now.slot[e]));
         }
         self.union.sort_unstable();
         self.union.dedup();
@@ -153,8 +157,8 @@ impl Compliance {
             let r = g.row(i);
             let tj = &mut self.t[j * nu..(j + 1) * nu];
             for (&e, &v) in r.col_indices().iter().zip(r.values()) {
-                let c = self.slot[e];
-                let col = &self.s[c * k..(c + 1) * k];
+                let c = self.now.slot[e];
+                let col = &self.now.s[c * k..(c + 1) * k];
                 for (ta, &ua) in tj.iter_mut().zip(&self.union) {
                     *ta += v * col[ua];
                 }
@@ -170,7 +174,7 @@ impl Compliance {
                     .col_indices()
                     .iter()
                     .zip(r.values())
-                    .map(|(&f, &u)| u * tj[self.position[self.slot[f]]])
+                    .map(|(&f, &u)| u * tj[self.position[self.now.slot[f]]])
                     .sum();
                 w[l + j * m] = v;
                 w[j + l * m] = v;
