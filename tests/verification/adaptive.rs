@@ -563,3 +563,25 @@ fn a_run_reports_its_steps_and_lands_its_frames() {
         "{plan}"
     );
 }
+
+#[test]
+fn fixed_steps_end_on_t_end_without_a_sliver_of_a_step() {
+    // 12000 steps of 5e-7 s sum to 1.2e-15 s short of 6 ms: that drift is no step
+    // to take (one of 1e-15 s made the contact predictor's projection stall).
+    let m = model(&cantilever("backward_euler", 5e-7, 6e-3, [0.0, -1.0], ""));
+    let mut i = BackwardEuler::new(&m, Backend::Faer).unwrap();
+    let mut s = i.initial_state();
+    let mut smallest = f64::INFINITY;
+    rothe::time::march::march(
+        &mut i,
+        &mut s,
+        rothe::time::march::StepControl::of(&m),
+        |i, _, _| {
+            smallest = smallest.min(i.h());
+            Ok(())
+        },
+    )
+    .unwrap();
+    assert_eq!(s.step, 12000);
+    assert_eq!(smallest, 5e-7);
+}
