@@ -4,6 +4,7 @@
 //!
 //! Start with [`load`]; the format is documented in the README and `examples/`.
 
+pub mod adaptive;
 mod bodies;
 pub mod exact;
 mod location;
@@ -363,7 +364,7 @@ pub struct AnalysisSpec {
     /// Error-controlled steps (the implicit schemes): `{ tolerance, dt_min, dt_max,
     /// norm, impact_steps }` (theory/adaptive.md). Absent: fixed steps of `dt`.
     #[serde(default)]
-    pub adaptive: Option<AdaptiveSpec>,
+    pub adaptive: Option<adaptive::AdaptiveSpec>,
     /// Relative residual tolerance of the equilibrium iterations of materials with
     /// history. Default 1e-8: well below discretisation error, well above round-off.
     #[serde(default = "default_tolerance")]
@@ -421,37 +422,6 @@ pub struct AnalysisSpec {
     /// VTK output).
     #[serde(default)]
     pub viscoelastic_state: Option<crate::model::ViscoelasticState>,
-}
-
-/// `analysis.adaptive`: error-controlled steps.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AdaptiveSpec {
-    /// The largest relative error measure a step may have. Default 1e-4.
-    #[serde(default = "default_adaptive_tolerance")]
-    pub tolerance: f64,
-    /// The smallest step wanted (s): the bottom rung is the largest `dt_max / 2^k`
-    /// not below it. Default `dt_max / 2¹⁰`.
-    #[serde(default)]
-    pub dt_min: Option<f64>,
-    /// The largest step (s), the ladder's top. Default `analysis.dt`.
-    #[serde(default)]
-    pub dt_max: Option<f64>,
-    /// How a step's error is measured: `energy` (the only one, the default).
-    #[serde(default)]
-    pub norm: crate::model::ErrorNorm,
-    /// Steps held at the bottom rung after an impact before the step may grow.
-    /// Default 10.
-    #[serde(default = "default_impact_steps")]
-    pub impact_steps: usize,
-}
-
-fn default_adaptive_tolerance() -> f64 {
-    1e-4
-}
-
-fn default_impact_steps() -> usize {
-    10
 }
 
 fn default_displacement_tolerance() -> f64 {

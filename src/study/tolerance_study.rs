@@ -17,12 +17,10 @@ use super::norms::Norms;
 use super::plan::{Plan, PlannedRun, StudyKind};
 use super::run_data::RunData;
 use super::table::{num, Table};
+use super::time_study::REFERENCE_ID;
 use crate::config::{load_with_overrides, LoadOptions, Overrides};
 use crate::error::{Error, Result};
 use crate::plot::{draw, Figure, Series, Style};
-
-/// The id of the fixed-step reference run.
-pub const REFERENCE_ID: &str = "reference";
 
 /// Fixed-step runs beside the tolerances, by default: the top rung and 6 halvings.
 pub const DEFAULT_FIXED_HALVINGS: usize = 6;
