@@ -364,7 +364,8 @@ fn the_ledger_closes_under_changing_steps_with_every_material_model() {
 fn the_first_contact_is_found_to_the_ladders_bottom_rung() {
     // The fixed-step run at the bottom rung (0.125 µs) first touches in the step
     // ending at t_c; the error-controlled run lands there, its first step in
-    // contact ending within one bottom rung of t_c, though it fell at 16 µs.
+    // contact ending within one bottom rung of t_c, though it fell at 16 µs, and
+    // without taking a step back.
     let m = benchmark_1(2.7e-3, &[]);
     let bottom = 1.6e-5 / 128.0;
     let mut t_c = None;
@@ -387,6 +388,9 @@ fn the_first_contact_is_found_to_the_ladders_bottom_rung() {
     );
     assert_eq!(report.dt_max_used, 1.6e-5);
     assert_eq!(report.impacts, 1);
+    // The event landed it: no step was taken back on the way (the estimate alone
+    // would find the contact too, by taking back the steps that crossed it).
+    assert_eq!(report.steps_rejected, 0, "{report:?}");
 }
 
 /// Asserts that `text` is refused with a message holding every one of `words`.
