@@ -419,7 +419,8 @@ fn integrate<I: Integrator>(
     let t_end = model.analysis.time.t_end;
     let mut counts = Counts::default();
     let mut step_cuts = 0;
-    let mut adapted = crate::time::adaptive::AdaptiveReport::default();
+    let adaptive = AdaptiveControl::of(model);
+    let adapted = std::cell::Cell::new(crate::time::adaptive::AdaptiveReport::default());
     let observe = |integrator: &I, s: &State, m: Marched| {
         match m {
             Marched::Step(report) => {
@@ -435,6 +436,9 @@ fn integrate<I: Integrator>(
                 if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {
                     fill(summary, s, integrator, rec);
                     counts.fill(summary, step_cuts);
+                    if adaptive.is_some() {
+                        summary.adaptive = Some(adapted.get());
+                    }
                     write_summary(summary, summary_path)?;
                     last_write = Instant::now();
                 }
@@ -479,10 +483,11 @@ fn integrate<I: Integrator>(
         }
         Ok(())
     };
-    let outcome = match AdaptiveControl::of(model) {
+    let outcome = match adaptive {
         None => march(integrator, &mut s, StepControl::of(model), observe),
         Some(control) => {
-            let r = march_adaptive(integrator, &mut s, control, &mut adapted, observe);
+            let r = march_adaptive(integrator, &mut s, control, &adapted, observe);
+            let adapted = adapted.get();
             summary.adaptive = Some(adapted);
             if let Some(w) = adapted.floor_warning() {
                 eprintln!("warning: {w}");

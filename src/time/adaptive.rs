@@ -170,9 +170,31 @@ fn level(ladder: &Ladder, bottom: u32, h: f64) -> u32 {
 
 /// Integrates `s` to `control.t_end` with error-controlled steps (see the module
 /// docs). `observe` sees every step that stands, every step taken back and every
-/// failed one retried smaller; `report` is kept current, so it is right also when
-/// the march fails part way, and `s` then holds the last step that stands.
+/// failed one retried smaller; `report` is current whenever `observe` is called
+/// (so an observer may write it out) and when the march returns, also when it
+/// fails part way, and `s` then holds the last step that stands.
 pub fn march_adaptive<I, F>(
+    integrator: &mut I,
+    s: &mut State,
+    control: AdaptiveControl,
+    report: &std::cell::Cell<AdaptiveReport>,
+    mut observe: F,
+) -> Result<()>
+where
+    I: Integrator + ?Sized,
+    F: FnMut(&I, &State, Marched) -> Result<()>,
+{
+    let mut current = report.get();
+    let result = steps(integrator, s, control, &mut current, |i, s, m, r| {
+        report.set(*r);
+        observe(i, s, m)
+    });
+    report.set(current);
+    result
+}
+
+/// [`march_adaptive`]'s loop, `observe` handed the report as it stands.
+fn steps<I, F>(
     integrator: &mut I,
     s: &mut State,
     control: AdaptiveControl,
@@ -181,7 +203,7 @@ pub fn march_adaptive<I, F>(
 ) -> Result<()>
 where
     I: Integrator + ?Sized,
-    F: FnMut(&I, &State, Marched) -> Result<()>,
+    F: FnMut(&I, &State, Marched, &AdaptiveReport) -> Result<()>,
 {
     let a = control.settings;
     let order = integrator.order().ok_or_else(|| {
@@ -275,6 +297,7 @@ where
                                 eta: eta.unwrap_or(f64::NAN),
                                 retry,
                             },
+                            report,
                         )?;
                         continue;
                     }
@@ -307,7 +330,7 @@ where
                     report.dt_min_used = report.dt_min_used.min(h);
                     report.dt_max_used = report.dt_max_used.max(h);
                 }
-                observe(integrator, s, Marched::Step(&step))?;
+                observe(integrator, s, Marched::Step(&step), report)?;
             }
             StepOutcome::Rejected(Rejection {
                 outcome:
@@ -344,6 +367,7 @@ where
                         h: 0.5 * h,
                         reason: &r.message,
                     },
+                    report,
                 )?;
             }
         }

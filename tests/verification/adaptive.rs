@@ -20,18 +20,20 @@ use crate::trapezoidal::cantilever;
 fn adaptive(m: &Model, mut each: impl FnMut(&State)) -> (State, AdaptiveReport, Vec<f64>) {
     let mut i = BackwardEuler::new(m, Backend::Faer).unwrap();
     let mut s = i.initial_state();
-    let mut report = AdaptiveReport::default();
+    let report = std::cell::Cell::new(AdaptiveReport::default());
     let mut steps = Vec::new();
     let control = AdaptiveControl::of(m).expect("an adaptive scenario");
-    march_adaptive(&mut i, &mut s, control, &mut report, |i, s, marched| {
+    march_adaptive(&mut i, &mut s, control, &report, |i, s, marched| {
         if let Marched::Step(_) = marched {
             steps.push(i.h());
+            // The report is current at every step.
+            assert_eq!(report.get().steps_accepted, steps.len());
             each(s);
         }
         Ok(())
     })
     .unwrap();
-    (s, report, steps)
+    (s, report.get(), steps)
 }
 
 /// Runs `m` with fixed steps of `h` (its `analysis.adaptive` removed), calling
