@@ -122,7 +122,11 @@ pub struct Volume {
 pub fn volume(model: &Model) -> Volume {
     let mesh = &model.mesh;
     let a = &model.analysis;
-    let steps = a.n_steps();
+    // An error-controlled run: the fewest steps it can take (all at dt_max).
+    let steps = match a.time.adaptive {
+        Some(ad) => (a.time.t_end / ad.dt_max).ceil() as usize,
+        None => a.n_steps(),
+    };
     let probes = model.probes.len();
     // A row: 12 ledger columns, 2 solver columns, 2 per probe, about 20 bytes each.
     let row_bytes = (16 + 2 * probes) as u64 * 20;
@@ -357,7 +361,12 @@ impl fmt::Display for Report {
         }
         writeln!(
             f,
-            "output      history.csv {} rows ({}), {} VTK files ({})",
+            "output      history.csv {}{} rows ({}), {} VTK files ({})",
+            if self.adaptive.is_some() {
+                "at least "
+            } else {
+                ""
+            },
             self.history.0,
             human(self.history.1),
             self.vtk.0,

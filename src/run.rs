@@ -426,7 +426,16 @@ fn integrate<I: Integrator>(
             Marched::Step(report) => {
                 counts.add(report.iterations);
                 if s.step % PROGRESS_EVERY == 0 {
-                    pb.set_message(counts.progress(&integrator.solver()));
+                    let mut line = counts.progress(&integrator.solver());
+                    if adaptive.is_some() {
+                        let r = adapted.get();
+                        line.push_str(&format!(
+                            ", h = {:.3e} s, {} taken back",
+                            integrator.h(),
+                            r.steps_rejected
+                        ));
+                    }
+                    pb.set_message(line);
                 }
                 let built = output_points(integrator, s, rec);
                 let on_cadence = rec.vtk_due(s.step, s.t);
