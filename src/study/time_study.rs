@@ -257,6 +257,29 @@ pub fn errors(norms: &Norms, runs: &[&Path], reference: &Path) -> Result<Vec<Err
         .collect())
 }
 
+/// The errors of `runs` against `reference` (their recorded fields), with the norms
+/// of the reference's mesh: each run's `fields.bin` is checked to hold one whole
+/// state per row of its history on that mesh first.
+pub(super) fn against_reference(
+    reference: &RunData,
+    runs: &[&RunData],
+) -> Result<(Norms, Vec<Errors>)> {
+    let model = load_with_overrides(
+        &reference.run.scenario,
+        &LoadOptions::unlimited(),
+        &reference.run.overrides,
+    )?;
+    let norms = Norms::new(&model.mesh);
+    for r in runs.iter().chain(std::iter::once(&reference)) {
+        let states = r.column("t").len() as u64;
+        FieldReader::open(&r.dir.join("fields.bin"))?.expect(states, model.mesh.n_dofs())?;
+    }
+    let paths: Vec<std::path::PathBuf> = runs.iter().map(|r| r.dir.join("fields.bin")).collect();
+    let refs: Vec<&Path> = paths.iter().map(|p| p.as_path()).collect();
+    let errs = errors(&norms, &refs, &reference.dir.join("fields.bin"))?;
+    Ok((norms, errs))
+}
+
 /// Largest `E_kin + E_el` over the run: the discrete energy bound `max_s E_s`.
 fn max_energy(r: &RunData) -> f64 {
     r.column("E_kin")
@@ -297,21 +320,9 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
             runs.len()
         )));
     }
-    let model = load_with_overrides(
-        &reference.run.scenario,
-        &LoadOptions::unlimited(),
-        &reference.run.overrides,
-    )?;
-    let norms = Norms::new(&model.mesh);
-    // Each completed run's fields: one whole state per row of its history, on the
-    // reference's mesh.
-    for r in coarse.iter().chain(std::iter::once(&reference)) {
-        let states = r.column("t").len() as u64;
-        FieldReader::open(&r.dir.join("fields.bin"))?.expect(states, model.mesh.n_dofs())?;
-    }
+    let (norms, errs) = against_reference(reference, &coarse)?;
     let paths: Vec<std::path::PathBuf> = coarse.iter().map(|r| r.dir.join("fields.bin")).collect();
     let refs: Vec<&Path> = paths.iter().map(|p| p.as_path()).collect();
-    let errs = errors(&norms, &refs, &reference.dir.join("fields.bin"))?;
     let h: Vec<f64> = coarse.iter().map(|r| r.run.param).collect();
     let h_ref = reference.run.param;
     let names = [

@@ -13,7 +13,6 @@
 
 use std::path::Path;
 
-use super::norms::Norms;
 use super::plan::{Plan, PlannedRun, StudyKind};
 use super::run_data::RunData;
 use super::table::{num, Table};
@@ -211,15 +210,7 @@ pub fn collect(dir: &Path, runs: &[RunData]) -> Result<String> {
         .iter()
         .filter(|r| r.completed() && r.run.id != REFERENCE_ID)
         .collect();
-    let model = load_with_overrides(
-        &reference.run.scenario,
-        &LoadOptions::unlimited(),
-        &reference.run.overrides,
-    )?;
-    let norms = Norms::new(&model.mesh);
-    let paths: Vec<std::path::PathBuf> = done.iter().map(|r| r.dir.join("fields.bin")).collect();
-    let refs: Vec<&Path> = paths.iter().map(|p| p.as_path()).collect();
-    let errs = super::time_study::errors(&norms, &refs, &reference.dir.join("fields.bin"))?;
+    let (_, errs) = super::time_study::against_reference(reference, &done)?;
     let q_ref = quantities(reference);
     let rel = |a: f64, b: f64| ((a - b) / b).abs();
     let mut table = Table::new(&[
