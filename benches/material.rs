@@ -49,6 +49,7 @@ fn updates(c: &mut Criterion) {
                             eps: *eps,
                             dt: 1e-5,
                             length: 0.1,
+                            tangent: true,
                         },
                         &st_n,
                         &mut st,

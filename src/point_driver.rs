@@ -348,6 +348,7 @@ where
                     eps,
                     dt: p.dt,
                     length: p.length,
+                    tangent: true,
                 },
                 &state_n,
                 &mut state,

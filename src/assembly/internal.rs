@@ -114,6 +114,8 @@ struct Ctx<'a, const V: usize> {
     at_rest: bool,
     /// Keep every history at its committed value (`Material::update_frozen`).
     frozen: bool,
+    /// Whether the points' tangents are read (`StrainStep::tangent`).
+    tangent: bool,
     /// The material's elasticity matrix in the run's idealisation.
     c: [[f64; V]; V],
     /// The averaged drivers of the block's points (`nonlocal::DRIVERS` per point)
@@ -134,6 +136,7 @@ impl<'a, const V: usize> Ctx<'a, V> {
         Ctx {
             drivers: None,
             frozen: false,
+            tangent: true,
             mesh,
             mat,
             kind: block.elements.kind,
@@ -148,6 +151,12 @@ impl<'a, const V: usize> Ctx<'a, V> {
     /// The same context with histories frozen (`frozen`).
     fn frozen(mut self, frozen: bool) -> Self {
         self.frozen = frozen;
+        self
+    }
+
+    /// The same context asking the points for their tangents or not.
+    fn tangent(mut self, tangent: bool) -> Self {
+        self.tangent = tangent;
         self
     }
 
@@ -240,6 +249,7 @@ fn element_points<const D: usize, const V: usize, K: Kinematics<D, V>, F>(
             eps,
             dt,
             length,
+            tangent: cx.tangent,
         };
         let history_n = committed.history(g);
         let averaged = cx
@@ -385,6 +395,10 @@ impl Assembler {
                 base: Shared(trial_buf.as_mut_ptr()),
                 layout,
             };
+            let ng = points_per_element(block.elements.kind);
+            // With a base, a constant-tangent block adds nothing to it.
+            let block_tangent =
+                kp.is_some() && !(by_delta && materials[block.material].has_constant_tangent());
             let cx = Ctx::<V>::new::<D, K>(
                 mesh,
                 &materials[block.material],
@@ -394,16 +408,13 @@ impl Assembler {
                 pass.at_rest,
             )
             .frozen(pass.frozen)
+            .tangent(block_tangent)
             .with_drivers(
                 nonlocal
                     .as_ref()
                     .and_then(|g| g.as_ref())
                     .and_then(|n| n.block(mesh, bi)),
             );
-            let ng = points_per_element(block.elements.kind);
-            // With a base, a constant-tangent block adds nothing to it.
-            let block_tangent =
-                kp.is_some() && !(by_delta && materials[block.material].has_constant_tangent());
             let c_el = cx.c;
             for colour in &self.colours[bi] {
                 // In halves of a fixed tree (`crate::halves`): the same totals in

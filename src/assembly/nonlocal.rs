@@ -21,7 +21,9 @@ use rayon::prelude::*;
 use rstar::primitives::GeomWithData;
 use rstar::RTree;
 
-use crate::fe::{kinematics, stiffness_rule, ElementKind, Kinematics};
+use crate::fe::{
+    kinematics, kinematics_from, rule_shapes, stiffness_rule, ElementKind, Kinematics,
+};
 use crate::material::store::StateStore;
 use crate::material::{Material, MAX_DRIVERS};
 use crate::mesh::Mesh;
@@ -449,8 +451,8 @@ impl NonlocalTable {
                     for (k, el) in chunk.chunks_exact_mut(DRIVERS * ng).enumerate() {
                         let e = c * per + k;
                         let (x, ue, nn) = super::gather::<D>(mesh, b.elements.element(e), u);
-                        for (q, &(xi, _)) in stiffness_rule(kind).iter().enumerate() {
-                            let kin = kinematics(kind, &x[..nn], xi);
+                        for (q, shape) in rule_shapes(kind).iter().enumerate() {
+                            let kin = kinematics_from(kind, &x[..nn], shape);
                             let eps = K::strain(&kin, nn, &ue);
                             let d = mat.drivers::<V, K>(&eps);
                             el[DRIVERS * q..][..DRIVERS].copy_from_slice(&d);

@@ -145,6 +145,7 @@ impl<T: Constitutive + Send + Sync> DynConstitutive for T {
                 eps: array::<V>(eps),
                 dt,
                 length,
+                tangent: true,
             };
             let r = if frozen {
                 self.update_frozen::<V, K>(moduli, &c, &step, state_n, state)

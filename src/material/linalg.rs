@@ -11,7 +11,25 @@ pub type Small = [[f64; MAX_DIM]; MAX_DIM];
 
 /// Solves `a x = b` (leading `n x n` block) by Gaussian elimination with partial
 /// pivoting, overwriting `b` with `x`; `false` if the matrix is singular or not finite.
-pub fn solve_in_place(mut a: Small, b: &mut [f64; MAX_DIM], n: usize) -> bool {
+/// Each size is its own instance with loops of known length (the same operations in
+/// the same order, so the same bits as a loop over `n`).
+pub fn solve_in_place(a: Small, b: &mut [f64; MAX_DIM], n: usize) -> bool {
+    match n {
+        1 => solve_n::<1>(a, b),
+        2 => solve_n::<2>(a, b),
+        3 => solve_n::<3>(a, b),
+        4 => solve_n::<4>(a, b),
+        5 => solve_n::<5>(a, b),
+        6 => solve_n::<6>(a, b),
+        7 => solve_n::<7>(a, b),
+        _ => n == 0,
+    }
+}
+
+/// [`solve_in_place`] for `N` unknowns.
+#[inline]
+fn solve_n<const N: usize>(mut a: Small, b: &mut [f64; MAX_DIM]) -> bool {
+    let n = N;
     for c in 0..n {
         let mut p = c;
         for i in c + 1..n {

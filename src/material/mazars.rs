@@ -296,7 +296,12 @@ fn secant_response<const V: usize>(
     let w = 1.0 - d;
     PointResponse {
         sigma: ce.map(|x| w * x),
-        tangent: c.map(|row| row.map(|x| w * x)),
+        // The secant, when the pass assembles it.
+        tangent: if step.tangent {
+            c.map(|row| row.map(|x| w * x))
+        } else {
+            *c
+        },
         psi: w * y1,
         dissipation: Dissipation {
             damage: 0.5 * (y0 + y1) * dd,

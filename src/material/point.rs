@@ -80,6 +80,12 @@ pub struct StrainStep<const V: usize> {
     /// Characteristic size of the element the point belongs to (m): the crack-band
     /// length of softening laws.
     pub length: f64,
+    /// Whether the consistent tangent is wanted. A pass that assembles no tangent
+    /// asks for none, and a model may then skip it: the response's `tangent` is
+    /// unspecified (the models here leave their elastic `C`) and must not be read.
+    /// The stress, history, energy and dissipation are the same bit for bit either
+    /// way.
+    pub tangent: bool,
 }
 
 impl<const V: usize> Default for StrainStep<V> {
@@ -89,6 +95,7 @@ impl<const V: usize> Default for StrainStep<V> {
             eps: [0.0; V],
             dt: 0.0,
             length: 0.0,
+            tangent: true,
         }
     }
 }
@@ -256,6 +263,7 @@ pub trait Constitutive: std::fmt::Debug {
             eps: *eps,
             dt,
             length: 1.0,
+            tangent: false,
         };
         self.update::<V, K>(moduli, c, &step, None, state, &mut st[..self.n_state(V)])
             .sigma

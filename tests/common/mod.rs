@@ -178,6 +178,7 @@ pub fn point_update<const V: usize, K: rothe::fe::StrainSpace<V>>(
             eps,
             dt: 1e-4,
             length: 0.1,
+            tangent: true,
         },
         state_n,
         &mut st,

@@ -388,7 +388,7 @@ proptest! {
         let (mut st_n, mut st) = (vec![0.0; ns], vec![0.0; ns]);
         let mut eps_n = [0.0; 3];
         for eps in &path {
-            let r = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n, eps: *eps, dt: 1e-4, length: 0.1 }, &st_n, &mut st);
+            let r = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n, eps: *eps, dt: 1e-4, length: 0.1, tangent: true }, &st_n, &mut st);
             let d = r.dissipation;
             prop_assert!(d.damage >= 0.0 && d.plastic >= 0.0, "dissipation {:?}", d);
             match m.law {

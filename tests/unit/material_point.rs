@@ -321,8 +321,8 @@ proptest! {
         let (mut eps_n, mut reps_n) = ([0.0; 3], [0.0; 3]);
         for eps in &path {
             let reps = rotate(*eps, theta);
-            let r = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n, eps: *eps, dt, length: 0.1 }, &st_n, &mut st);
-            let q = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n: reps_n, eps: reps, dt, length: 0.1 }, &rt_n, &mut rt);
+            let r = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n, eps: *eps, dt, length: 0.1, tangent: true }, &st_n, &mut st);
+            let q = m.update::<3, rothe::fe::PlaneStress>(&StrainStep { eps_n: reps_n, eps: reps, dt, length: 0.1, tangent: true }, &rt_n, &mut rt);
             let d = r.dissipation;
             prop_assert!(d.viscous >= 0.0 && d.numerical >= 0.0 && d.damage == 0.0 && d.plastic == 0.0);
             let want = rotate_stress(r.sigma, theta);
@@ -357,6 +357,7 @@ fn predicted_stress_is_the_update_at_unchanged_strain() {
                 eps,
                 dt: 1e-4,
                 length: 0.1,
+                tangent: true,
             },
             &vec![0.0; ns],
             &mut s1,
@@ -368,6 +369,7 @@ fn predicted_stress_is_the_update_at_unchanged_strain() {
                     eps,
                     dt: 1e-4,
                     length: 0.1,
+                    tangent: true,
                 },
                 &s1,
                 &mut s2,

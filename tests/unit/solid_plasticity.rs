@@ -284,6 +284,7 @@ fn plane_stress_paths_of_a_solid_point_follow_the_plane_model() {
                         eps: e3,
                         dt: 1e-4,
                         length: 0.1,
+                        tangent: true,
                     },
                     &h3,
                     &mut n3,

@@ -236,6 +236,7 @@ fn a_failed_return_is_an_outcome_with_its_element() {
             eps: [1e-5, -2e-5, 0.0],
             dt: 1e-5,
             length: 0.25,
+            tangent: true,
         },
         &exhausted,
         &mut [0.0; 6],

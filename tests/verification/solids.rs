@@ -234,6 +234,7 @@ fn uniaxial_both(m: &rothe::material::Material, path: &[f64]) -> Vec<Both> {
                 eps: e3,
                 dt: 1e-3,
                 length: 0.1,
+                tangent: true,
             },
             &h3,
             &mut n3,
@@ -244,6 +245,7 @@ fn uniaxial_both(m: &rothe::material::Material, path: &[f64]) -> Vec<Both> {
                 eps: e6,
                 dt: 1e-3,
                 length: 0.1,
+                tangent: true,
             },
             &h6,
             &mut n6,
@@ -317,6 +319,7 @@ fn solid_linear_models_are_isotropic_and_their_tangents_are_exact() {
             eps,
             dt: 1e-3,
             length: 0.1,
+            tangent: true,
         };
         let update_from = |eps: [f64; 6], h: &[f64]| {
             let mut out = vec![0.0; ns];
@@ -341,6 +344,7 @@ fn solid_linear_models_are_isotropic_and_their_tangents_are_exact() {
                 eps: e3,
                 dt: 1e-3,
                 length: 0.1,
+                tangent: true,
             },
             &vec![0.0; m.n_state(3)],
             &mut o3,
@@ -385,6 +389,7 @@ fn solid_linear_models_are_isotropic_and_their_tangents_are_exact() {
             eps: [e, e, 0.0, e, 0.0, 0.0],
             dt: 1.0,
             length: 1.0,
+            tangent: true,
         },
         &[],
         &mut [],

@@ -84,6 +84,7 @@ pub fn update_in<const V: usize, K: StrainSpace<V>>(
         eps: widen(&step.eps),
         dt: step.dt,
         length: step.length,
+        tangent: step.tangent,
     };
     let s = state_n;
     let solid_n = [s[0], s[1], s[2], s[5], 0.0, 0.0, s[3], s[4]];

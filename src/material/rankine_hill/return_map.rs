@@ -19,7 +19,8 @@ struct Return<const P: usize> {
     sigma: [f64; P],
     /// Multipliers by surface (`P + 1` used).
     dlambda: [f64; 4],
-    /// Algorithmic tangent `∂σ_p/∂ε_p` in the principal frame.
+    /// Algorithmic tangent `∂σ_p/∂ε_p` in the principal frame (zero when not
+    /// asked for).
     d_alg: [[f64; P]; P],
 }
 
@@ -139,6 +140,8 @@ struct Ctx<'a, const P: usize> {
     dinv: [[f64; P]; P],
     kt_n: f64,
     kc_n: f64,
+    /// Whether the algorithmic tangent is wanted (`StrainStep::tangent`).
+    tangent: bool,
 }
 
 impl<const P: usize> Ctx<'_, P> {
@@ -231,6 +234,9 @@ impl<const P: usize> Ctx<'_, P> {
             }
             let norm = stress_part * self.d00 + r[P..n].iter().map(|x| x.abs()).sum::<f64>();
             if norm <= 1e-12 * scale {
+                if !self.tangent {
+                    return Some((dl, s, [[0.0; P]; P]));
+                }
                 // Algorithmic tangent: A = [D⁻¹ + Σ Δλ ∂n/∂σ]⁻¹, D_alg = A − A N (NᵀAN + H)⁻¹ NᵀA.
                 let a = inverse(&jac, P)?;
                 let mut an = [[0.0; P]; 4]; // A n_b
@@ -450,6 +456,7 @@ fn update_once<const V: usize, const P: usize, F: Frame<V, P>>(
         }),
         kt_n,
         kc_n,
+        tangent: step.tangent,
     };
     state.copy_from_slice(state_n);
     let elastic = PointResponse {
@@ -505,8 +512,58 @@ fn update_once<const V: usize, const P: usize, F: Frame<V, P>>(
     state[V] = kt_n + dl_t;
     state[V + 1] = kc_n + ret.dlambda[P];
     let sigma = frame.stress_from(&ret.sigma);
+    let tangent = if step.tangent {
+        frame_tangent::<V, P, F>(&frame, &ee_tr, &ret)
+    } else {
+        *c
+    };
+    let ee: [f64; V] = std::array::from_fn(|i| step.eps[i] - state[i]);
+    let psi = 0.5 * dot3(&ee, &sigma);
+    let psi_n = 0.5 * dot3(&ee_n, &sigma_n);
+    // The paper's trapezoid ½(σⁿ + σⁿ⁺¹):Δεᵖ with each stress paired with its own
+    // flow direction: σ:∂f/∂σ is the surface strength on every surface, so per surface
+    // ½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ. Equal to the literal form for steps that start on the
+    // surface with fixed principal axes (and a radial path for von Mises), never
+    // above it, and non-negative always (theory/plasticity.md).
+    // The committed strengths were read above where the point had yielded.
+    let yt0 = if kt_n == 0.0 {
+        p.prepared[0].strength(kt_n, e, step.length).0
+    } else {
+        y_t
+    };
+    let (yt1, _) = p.prepared[0].strength(state[V], e, step.length);
+    let yc0 = if kc_n == 0.0 {
+        p.prepared[1].strength(kc_n, e, step.length).0
+    } else {
+        y_c
+    };
+    let (yc1, _) = p.prepared[1].strength(state[V + 1], e, step.length);
+    let plastic = 0.5 * (yt0 + yt1) * dl_t + 0.5 * (yc0 + yc1) * ret.dlambda[P];
+    let de: [f64; V] = std::array::from_fn(|i| step.eps[i] - step.eps_n[i]);
+    let work = dot3(&sigma, &de);
+    PointResponse {
+        sigma,
+        tangent,
+        psi,
+        dissipation: Dissipation {
+            plastic,
+            numerical: work - (psi - psi_n) - plastic,
+            ..Default::default()
+        },
+        status: PointStatus::Ok,
+    }
+}
+
+/// The consistent tangent in Voigt form of a return in `frame` from the trial
+/// elastic strain `ee_tr`: the principal-frame normal block plus the spectral shear
+/// terms, rotated back.
+fn frame_tangent<const V: usize, const P: usize, F: Frame<V, P>>(
+    frame: &F,
+    ee_tr: &[f64; V],
+    ret: &Return<P>,
+) -> [[f64; V]; V] {
     // Tangent: principal-frame normal block plus the spectral shear terms.
-    let et = frame.strain_to_frame(&ee_tr);
+    let et = frame.strain_to_frame(ee_tr);
     let mut dp = [[0.0; V]; V];
     for (a, &na) in F::NORMAL.iter().enumerate() {
         for (b, &nb) in F::NORMAL.iter().enumerate() {
@@ -535,32 +592,7 @@ fn update_once<const V: usize, const P: usize, F: Frame<V, P>>(
             tangent[i][j] = v;
         }
     }
-    let ee: [f64; V] = std::array::from_fn(|i| step.eps[i] - state[i]);
-    let psi = 0.5 * dot3(&ee, &sigma);
-    let psi_n = 0.5 * dot3(&ee_n, &sigma_n);
-    // The paper's trapezoid ½(σⁿ + σⁿ⁺¹):Δεᵖ with each stress paired with its own
-    // flow direction: σ:∂f/∂σ is the surface strength on every surface, so per surface
-    // ½(σ̄(κⁿ) + σ̄(κⁿ⁺¹)) Δλ. Equal to the literal form for steps that start on the
-    // surface with fixed principal axes (and a radial path for von Mises), never
-    // above it, and non-negative always (theory/plasticity.md).
-    let (yt0, _) = p.prepared[0].strength(kt_n, e, step.length);
-    let (yt1, _) = p.prepared[0].strength(state[V], e, step.length);
-    let (yc0, _) = p.prepared[1].strength(kc_n, e, step.length);
-    let (yc1, _) = p.prepared[1].strength(state[V + 1], e, step.length);
-    let plastic = 0.5 * (yt0 + yt1) * dl_t + 0.5 * (yc0 + yc1) * ret.dlambda[P];
-    let de: [f64; V] = std::array::from_fn(|i| step.eps[i] - step.eps_n[i]);
-    let work = dot3(&sigma, &de);
-    PointResponse {
-        sigma,
-        tangent,
-        psi,
-        dissipation: Dissipation {
-            plastic,
-            numerical: work - (psi - psi_n) - plastic,
-            ..Default::default()
-        },
-        status: PointStatus::Ok,
-    }
+    tangent
 }
 
 fn numerical_elastic<const V: usize>(c: &[[f64; V]; V], eps: &[f64; V], eps_n: &[f64; V]) -> f64 {
