@@ -52,6 +52,7 @@ pub mod output;
 pub mod plot;
 pub mod point_driver;
 pub mod run;
+pub mod simd;
 pub mod study;
 pub mod system;
 pub mod time;

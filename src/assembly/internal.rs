@@ -18,6 +18,7 @@ use crate::material::{
     MAX_STATE,
 };
 use crate::mesh::Mesh;
+use crate::simd::Simd;
 
 /// Integrated point quantities of one evaluation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -180,6 +181,7 @@ struct TrialOut {
 /// same size at an unchanged strain, from the trial history: for constant-tangent
 /// materials `f_int` of the next step is then `f_pred + K_t Δu` exactly. With
 /// `trial`, the points' trial states are written.
+#[inline(always)]
 fn element_points<const D: usize, const V: usize, K: Kinematics<D, V>, F>(
     cx: &Ctx<V>,
     committed: Committed,
@@ -286,6 +288,154 @@ fn element_points<const D: usize, const V: usize, K: Kinematics<D, V>, F>(
             }
         };
         point(wq * k.det_j * cx.section, &resp, Some(k), &x[..nn], pred);
+    }
+}
+
+/// One colour's leaf of the Gauss-point pass over a block: everything an element's
+/// evaluation reads and where it writes.
+struct ElementLeaf<'a, const D: usize, const V: usize, K> {
+    assembler: &'a Assembler,
+    block: &'a crate::mesh::Block,
+    bi: usize,
+    cx: &'a Ctx<'a, V>,
+    committed: Committed<'a>,
+    trial: TrialOut,
+    u: &'a [f64],
+    f: Shared,
+    f_pred: Option<Shared>,
+    /// The tangent's values when this block assembles into them.
+    k: Option<SharedValues>,
+    /// The tangent is a base plus each element's `Σ w Bᵀ(D − C)B`.
+    by_delta: bool,
+    /// Points per element.
+    points: usize,
+    _space: std::marker::PhantomData<K>,
+}
+
+impl<const D: usize, const V: usize, K: Kinematics<D, V>> ElementLeaf<'_, D, V, K> {
+    /// [`ElementLeaf::elements`] compiled for the instruction set `simd` names.
+    fn run(&self, simd: Simd, chunk: &[usize]) -> PointTotals {
+        match simd {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `Simd::detected` names AVX2 only where the CPU has it.
+            Simd::Avx2 => unsafe { self.elements_avx2(chunk) },
+            _ => self.elements(chunk),
+        }
+    }
+
+    /// [`ElementLeaf::elements`] with AVX2 (wider registers for the same operations:
+    /// no fused multiply-add is written, and Rust never contracts one, so the
+    /// results are those of the baseline build bit for bit).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn elements_avx2(&self, chunk: &[usize]) -> PointTotals {
+        self.elements(chunk)
+    }
+
+    /// Evaluates the elements `chunk` of the colour: their points' updates, forces,
+    /// and tangents when asked; returns the totals of their points.
+    #[inline(always)]
+    fn elements(&self, chunk: &[usize]) -> PointTotals {
+        let mut acc = PointTotals::default();
+        let mut ke = [0.0; MAX_ELEMENT_DOFS * MAX_ELEMENT_DOFS];
+        for &e in chunk {
+            let nodes = self.block.elements.element(e);
+            let mut fe = [0.0; MAX_ELEMENT_DOFS];
+            let mut fe_pred = [0.0; MAX_ELEMENT_DOFS];
+            let nd = D * nodes.len();
+            if self.k.is_some() {
+                ke[..nd * nd].fill(0.0);
+            }
+            let mut changed = !self.by_delta;
+            let mut q = 0;
+            element_points::<D, V, K, _>(
+                self.cx,
+                self.committed,
+                nodes,
+                self.u,
+                e,
+                Some(self.trial),
+                |w, r, k, x, sp| {
+                    acc.psi += w * r.psi;
+                    acc.dissipation += r.dissipation.scaled(w);
+                    if r.status != PointStatus::Ok && acc.failure.is_none() {
+                        acc.failure = Some(PointFailure {
+                            block: self.bi,
+                            element: e,
+                            point: e * self.points + q,
+                        });
+                    }
+                    q += 1;
+                    element::add_point_force::<D, V, K>(
+                        k,
+                        x,
+                        nodes.len(),
+                        w,
+                        &r.sigma,
+                        &mut fe,
+                    );
+                    if self.cx.predict {
+                        element::add_point_force::<D, V, K>(
+                            k,
+                            x,
+                            nodes.len(),
+                            w,
+                            &sp,
+                            &mut fe_pred,
+                        );
+                    }
+                    if self.k.is_some() {
+                        if !self.by_delta {
+                            element::add_point_tangent::<D, V, K>(
+                                k,
+                                x,
+                                nodes.len(),
+                                w,
+                                &r.tangent,
+                                &mut ke,
+                            );
+                        } else if r.tangent != self.cx.c {
+                            let mut d = r.tangent;
+                            for (di, ci) in d.iter_mut().zip(&self.cx.c) {
+                                for (a, b) in di.iter_mut().zip(ci) {
+                                    *a -= b;
+                                }
+                            }
+                            element::add_point_tangent::<D, V, K>(
+                                k,
+                                x,
+                                nodes.len(),
+                                w,
+                                &d,
+                                &mut ke,
+                            );
+                            changed = true;
+                        }
+                    }
+                },
+            );
+            if let Some(kp) = self.k.filter(|_| changed) {
+                self.assembler.scatter(nodes, &ke[..nd * nd], kp);
+            }
+            for (a, &n) in nodes.iter().enumerate() {
+                // SAFETY: no two elements of this colour share node n.
+                let fn_ = unsafe { self.f.slice(D * n, D) };
+                for i in 0..D {
+                    fn_[i] += fe[D * a + i];
+                }
+                if let Some(pp) = self.f_pred {
+                    // SAFETY: as above, for the predicted force.
+                    let pn = unsafe { pp.slice(D * n, D) };
+                    for i in 0..D {
+                        pn[i] += fe_pred[D * a + i];
+                    }
+                }
+            }
+        }
+        acc
     }
 }
 
@@ -415,109 +565,26 @@ impl Assembler {
                     .and_then(|g| g.as_ref())
                     .and_then(|n| n.block(mesh, bi)),
             );
-            let c_el = cx.c;
+            let run = ElementLeaf::<D, V, K> {
+                assembler: self,
+                block,
+                bi,
+                cx: &cx,
+                committed,
+                trial,
+                u,
+                f: fp,
+                f_pred: pp,
+                k: kp.filter(|_| block_tangent),
+                by_delta,
+                points: ng,
+                _space: std::marker::PhantomData,
+            };
+            let simd = self.simd();
             for colour in &self.colours[bi] {
                 // In halves of a fixed tree (`crate::halves`): the same totals in
                 // every run.
-                let leaf = |chunk: &[usize]| {
-                    let mut acc = PointTotals::default();
-                    let mut ke = [0.0; MAX_ELEMENT_DOFS * MAX_ELEMENT_DOFS];
-                    for &e in chunk {
-                        let nodes = block.elements.element(e);
-                        let mut fe = [0.0; MAX_ELEMENT_DOFS];
-                        let mut fe_pred = [0.0; MAX_ELEMENT_DOFS];
-                        let nd = D * nodes.len();
-                        if block_tangent {
-                            ke[..nd * nd].fill(0.0);
-                        }
-                        let mut changed = !by_delta;
-                        let mut q = 0;
-                        element_points::<D, V, K, _>(
-                            &cx,
-                            committed,
-                            nodes,
-                            u,
-                            e,
-                            Some(trial),
-                            |w, r, k, x, sp| {
-                                acc.psi += w * r.psi;
-                                acc.dissipation += r.dissipation.scaled(w);
-                                if r.status != PointStatus::Ok && acc.failure.is_none() {
-                                    acc.failure = Some(PointFailure {
-                                        block: bi,
-                                        element: e,
-                                        point: e * ng + q,
-                                    });
-                                }
-                                q += 1;
-                                element::add_point_force::<D, V, K>(
-                                    k,
-                                    x,
-                                    nodes.len(),
-                                    w,
-                                    &r.sigma,
-                                    &mut fe,
-                                );
-                                if predict {
-                                    element::add_point_force::<D, V, K>(
-                                        k,
-                                        x,
-                                        nodes.len(),
-                                        w,
-                                        &sp,
-                                        &mut fe_pred,
-                                    );
-                                }
-                                if block_tangent {
-                                    if !by_delta {
-                                        element::add_point_tangent::<D, V, K>(
-                                            k,
-                                            x,
-                                            nodes.len(),
-                                            w,
-                                            &r.tangent,
-                                            &mut ke,
-                                        );
-                                    } else if r.tangent != c_el {
-                                        let mut d = r.tangent;
-                                        for (di, ci) in d.iter_mut().zip(&c_el) {
-                                            for (a, b) in di.iter_mut().zip(ci) {
-                                                *a -= b;
-                                            }
-                                        }
-                                        element::add_point_tangent::<D, V, K>(
-                                            k,
-                                            x,
-                                            nodes.len(),
-                                            w,
-                                            &d,
-                                            &mut ke,
-                                        );
-                                        changed = true;
-                                    }
-                                }
-                            },
-                        );
-                        if let Some(kp) = kp.filter(|_| block_tangent && changed) {
-                            self.scatter(nodes, &ke[..nd * nd], kp);
-                        }
-                        for (a, &n) in nodes.iter().enumerate() {
-                            // SAFETY: no two elements of this colour share node n.
-                            let fn_ = unsafe { fp.slice(D * n, D) };
-                            for i in 0..D {
-                                fn_[i] += fe[D * a + i];
-                            }
-                            if let Some(pp) = pp {
-                                // SAFETY: as above, for the predicted force.
-                                let pn = unsafe { pp.slice(D * n, D) };
-                                for i in 0..D {
-                                    pn[i] += fe_pred[D * a + i];
-                                }
-                            }
-                        }
-                    }
-                    acc
-                };
+                let leaf = |chunk: &[usize]| run.run(simd, chunk);
                 let (n, split) = (colour.len(), <[usize]>::split_at);
                 let part = in_halves(
                     &colour[..],

@@ -181,6 +181,8 @@ pub struct Assembler {
     pub colours: Vec<Vec<Vec<usize>>>,
     /// The nonlocal table and its pass buffers (`None` until needed).
     nonlocal: std::sync::Mutex<Option<nonlocal::Nonlocal>>,
+    /// The instruction set of the Gauss-point pass's element loop.
+    simd: crate::simd::Simd,
 }
 
 #[derive(Clone, Copy)]
@@ -205,7 +207,25 @@ impl Assembler {
             pattern,
             colours,
             nonlocal: std::sync::Mutex::new(None),
+            simd: crate::simd::Simd::detected(),
         }
+    }
+
+    /// The same assembler with the Gauss-point pass's element loop compiled for
+    /// `simd` (the default is [`crate::simd::Simd::detected`]); a set the CPU lacks
+    /// falls back to the baseline.
+    pub fn with_simd(mut self, simd: crate::simd::Simd) -> Self {
+        self.simd = if simd == crate::simd::Simd::Avx2 {
+            crate::simd::Simd::available()
+        } else {
+            simd
+        };
+        self
+    }
+
+    /// The instruction set of the Gauss-point pass's element loop.
+    pub fn simd(&self) -> crate::simd::Simd {
+        self.simd
     }
 
     /// The nonlocal table of `materials` on `mesh`, built (or rebuilt, should the

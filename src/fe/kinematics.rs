@@ -146,6 +146,23 @@ pub trait StrainSpace<const V: usize>: Copy + Default + Send + Sync + 'static {
     /// `ν(σ_xx + σ_yy)` in plane strain).
     fn principal_stresses(sigma: &[f64; V], nu: f64) -> [f64; 3];
 
+    /// [`StrainSpace::principal_stresses`] of the elastic stress `sigma = c ε` of a
+    /// strain whose principal values ([`StrainSpace::principal_strains`]) are `e`.
+    /// In the plane, the closed form on `sigma`. In a solid, Hooke's law on the
+    /// principal strains, `σ_i = λ tr ε + 2μ ε_i` (isotropic `C` shares the strain's
+    /// principal axes), which spares a second 3×3 eigenproblem and pairs each
+    /// principal stress with its own strain; equal to the eigenvalues of `sigma` to
+    /// round-off.
+    #[inline]
+    fn principal_elastic_stresses(
+        _c: &[[f64; V]; V],
+        sigma: &[f64; V],
+        _e: &[f64; 3],
+        nu: f64,
+    ) -> [f64; 3] {
+        Self::principal_stresses(sigma, nu)
+    }
+
     /// Hands `user` this space's principal frame (the plane's angle, the solid's
     /// rotation) with its number of principal values.
     fn with_frame<U: FrameUser<V>>(user: U) -> U::Output;
@@ -295,6 +312,18 @@ impl StrainSpace<6> for Solid {
     #[inline]
     fn principal_stresses(s: &[f64; 6], _nu: f64) -> [f64; 3] {
         principal_voigt6(s, 1.0)
+    }
+
+    #[inline]
+    fn principal_elastic_stresses(
+        c: &[[f64; 6]; 6],
+        _sigma: &[f64; 6],
+        e: &[f64; 3],
+        _nu: f64,
+    ) -> [f64; 3] {
+        let (lambda, two_mu) = (c[0][1], c[0][0] - c[0][1]);
+        let trace = e[0] + e[1] + e[2];
+        e.map(|ei| lambda * trace + two_mu * ei)
     }
 
     fn with_frame<U: FrameUser<6>>(user: U) -> U::Output {

@@ -350,7 +350,7 @@ pub fn kinematics(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> PointKinem
 
 /// [`kinematics()`] from the shape values and reference derivatives `reference` of the
 /// point (as [`rule_shapes`] holds them).
-#[inline]
+#[inline(always)]
 pub fn kinematics_from(
     kind: ElementKind,
     x: &[[f64; 3]],
@@ -391,7 +391,7 @@ pub fn kinematics_from(
 
 /// [`kinematics`] of a solid kind of `N` nodes: the 3x3 Jacobian inverted by
 /// cofactors (loops of a known length, which the compiler unrolls).
-#[inline]
+#[inline(always)]
 fn kinematics_solid<const N: usize>(x: &[[f64; 3]], reference: &ReferenceShape) -> PointKinematics {
     let (n, d) = reference;
     let x = &x[..N];

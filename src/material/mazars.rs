@@ -187,7 +187,7 @@ fn damage<const V: usize, K: StrainSpace<V>>(
         MazarsVariant::Paper => {
             let kt = k1.max(drv[0]).max(p.eps_t0);
             let kc = k2.max(drv[1]).max(p.eps_c0);
-            let s = K::principal_stresses(&mul3(c, eps), nu);
+            let s = K::principal_elastic_stresses(c, &mul3(c, eps), e, nu);
             let den: f64 = s.iter().map(|x| x.abs()).sum();
             let r = if den > 0.0 {
                 s.iter().map(|x| x.max(0.0)).sum::<f64>() / den
@@ -206,7 +206,7 @@ fn damage<const V: usize, K: StrainSpace<V>>(
             let dt = damage_law(kappa, p.eps_t0, a_t, b_t);
             let dc = damage_law(kappa, p.eps_t0, p.a_c, p.b_c);
             // Weights from the strains of the positive / negative effective stresses.
-            let s = K::principal_stresses(&mul3(c, eps), nu);
+            let s = K::principal_elastic_stresses(c, &mul3(c, eps), e, nu);
             let ee = K::young(c, nu);
             let (sp, sn): (f64, f64) = (
                 s.iter().map(|x| x.max(0.0)).sum(),

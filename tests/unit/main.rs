@@ -10,6 +10,7 @@ mod workload;
 mod backends;
 mod damage_plasticity;
 mod extension;
+mod gauss_point_pass;
 mod identification;
 mod material_point;
 mod nodal_fields;

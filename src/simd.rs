@@ -1,0 +1,58 @@
+//! The instruction set the Gauss-point kernels run with, chosen once per process
+//! from what the CPU reports.
+//!
+//! The binary is built for the baseline x86-64 (SSE2), so that it runs on any such
+//! machine; the element loop of the Gauss-point pass is compiled a second time with
+//! AVX2 and the faster copy is taken where the CPU has it. The AVX2 copy performs
+//! the same operations in the same order (no fused multiply-add is written in the
+//! pass, and the compiler never contracts a product and a sum into one), so its
+//! results are the baseline's bit for bit; `tests/regression/reproducible.rs`
+//! compares the two on the machine that runs the tests.
+//!
+//! `ROTHE_SIMD=baseline` in the environment keeps the baseline copy (to compare, or
+//! to time, the two on one machine).
+
+use std::sync::OnceLock;
+
+/// An instruction set of the Gauss-point kernels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Simd {
+    /// The baseline of the target (SSE2 on x86-64).
+    Baseline,
+    /// AVX2 (x86-64 only).
+    Avx2,
+}
+
+impl Simd {
+    /// The fastest set this CPU runs, unless `ROTHE_SIMD=baseline` asks for the
+    /// baseline; read once per process.
+    pub fn detected() -> Simd {
+        static CHOSEN: OnceLock<Simd> = OnceLock::new();
+        *CHOSEN.get_or_init(|| {
+            let asked = std::env::var("ROTHE_SIMD").ok();
+            if asked.as_deref() == Some("baseline") {
+                return Simd::Baseline;
+            }
+            Simd::available()
+        })
+    }
+
+    /// The fastest set the CPU has, whatever the environment asks.
+    pub fn available() -> Simd {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") {
+                return Simd::Avx2;
+            }
+        }
+        Simd::Baseline
+    }
+
+    /// The name `summary.json` and `rothe check` give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Simd::Baseline => "baseline",
+            Simd::Avx2 => "avx2",
+        }
+    }
+}
