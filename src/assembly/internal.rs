@@ -369,14 +369,7 @@ impl<const D: usize, const V: usize, K: Kinematics<D, V>> ElementLeaf<'_, D, V, 
                         });
                     }
                     q += 1;
-                    element::add_point_force::<D, V, K>(
-                        k,
-                        x,
-                        nodes.len(),
-                        w,
-                        &r.sigma,
-                        &mut fe,
-                    );
+                    element::add_point_force::<D, V, K>(k, x, nodes.len(), w, &r.sigma, &mut fe);
                     if self.cx.predict {
                         element::add_point_force::<D, V, K>(
                             k,

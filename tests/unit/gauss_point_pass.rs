@@ -10,12 +10,13 @@ use crate::workload;
 use proptest::prelude::*;
 use rothe::assembly::internal::{new_stores, PointPass};
 use rothe::assembly::Assembler;
-use rothe::fe::{PlaneStress, PlaneStrain, Solid, StrainSpace};
+use rothe::fe::{PlaneStrain, PlaneStress, Solid, StrainSpace};
 use rothe::material::{Material, PointResponse, StrainStep};
 use rothe::simd::Simd;
 
 const RANKINE_HILL: &str = "model = \"rankine_hill\"\ntension = { law = \"linear_softening\", strength = 2.9e6, fracture_energy = 140.0 }\ncompression = { law = \"ec2\", f_cm = 38e6, eps_c1 = 0.0022, eps_cu1 = 0.0035 }";
-const MAZARS: &str = "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
+const MAZARS: &str =
+    "model = \"mazars\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
 const MAZARS_CLASSIC: &str = "model = \"mazars\"\nvariant = \"classic\"\neps_t0 = 1.0e-4\nA_t = 1.0\nB_t = 1.0e4\nA_c = 1.2\nB_c = 1.5e3";
 
 fn material(text: &str) -> Material {
@@ -75,7 +76,9 @@ fn same_without_tangent<const V: usize, K: StrainSpace<V>>(m: &Material, path: &
 fn path<const V: usize>(n: usize, a: f64, seed: u64) -> Vec<[f64; V]> {
     let mut x = seed;
     let mut next = move || {
-        x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
     let dir: [f64; V] = std::array::from_fn(|_| next());
@@ -100,7 +103,7 @@ fn a_point_asked_for_no_tangent_returns_the_same_state_bit_for_bit() {
 }
 
 proptest! {
-    #![proptest_config(crate::common::seeded(256, 0x5eed_41))]
+    #![proptest_config(crate::common::seeded(256, 0x5eed))]
 
     /// Hooke's law on the principal strains against the eigenvalues of `C ε`.
     #[test]
@@ -172,7 +175,13 @@ fn the_avx2_element_loop_gives_the_baselines_bits() {
             .mesh
             .coords
             .iter()
-            .flat_map(|x| [-4e-3 * x[0] * (x[1] - 0.25), -2e-3 * x[0] * x[0], 1e-4 * x[2]])
+            .flat_map(|x| {
+                [
+                    -4e-3 * x[0] * (x[1] - 0.25),
+                    -2e-3 * x[0] * x[0],
+                    1e-4 * x[2],
+                ]
+            })
             .collect();
         let base = Assembler::new(&model.mesh).with_simd(Simd::Baseline);
         let avx2 = Assembler::new(&model.mesh).with_simd(Simd::Avx2);
