@@ -103,62 +103,11 @@ fn main() -> rothe::Result<()> {
     );
     println!("  solves per step      {:.2}", solves as f64 / n as f64);
     println!("  total                {total_s:.3} s");
-    // The machine's bandwidth, measured now (outside the run's total) on one core
-    // and on all (the solve runs on both cores; the bound uses the all-core figure),
-    // and the solve's and the step's shares of it; beside it the bandwidth of
-    // reading one stream per core, which is how a solve reads its factor.
-    let triad_one = workload::triad_bandwidth(1 << 24, 10, false);
-    let triad = workload::triad_bandwidth(1 << 24, 10, true);
-    let read_one = workload::read_bandwidth(1 << 25, 5, false);
-    let read = workload::read_bandwidth(1 << 25, 5, true);
-    let bytes = 2.0 * nnz_l as f64 * 8.0;
-    let bound = bytes / triad;
-    let read_bound = bytes / read;
-    let solve_per = timing.solve_s / solves.max(1) as f64;
-    let step_per = steps_s / n.max(1) as f64;
-    let cores = rayon::current_num_threads();
-    println!(
-        "  triad bandwidth      {:.1} GB/s on one core, {:.1} GB/s on all {cores}",
-        triad_one / 1e9,
-        triad / 1e9,
+    workload::print_stream_bounds(
+        nnz_l,
+        be.factor_lower_entries().unwrap_or(nnz_l),
+        timing.solve_s / solves.max(1) as f64,
+        steps_s / n.max(1) as f64,
     );
-    println!(
-        "  read bandwidth       {:.1} GB/s on one core, {:.1} GB/s on all {cores}",
-        read_one / 1e9,
-        read / 1e9,
-    );
-    println!(
-        "  factor stream bound  {:.2} ms per solve (2 x nnz(L) x 8 B at {:.1} GB/s; {:.2} ms at the read bandwidth)",
-        1e3 * bound,
-        triad / 1e9,
-        1e3 * read_bound
-    );
-    println!(
-        "  solve achieved       {:.2} ms per solve, {:.1} GB/s ({:.2} x the bound, {:.2} x the read bound)",
-        1e3 * solve_per,
-        bytes / solve_per / 1e9,
-        solve_per / bound,
-        solve_per / read_bound
-    );
-    println!(
-        "  step                 {:.2} x the bound, {:.2} x the read bound",
-        step_per / bound,
-        step_per / read_bound
-    );
-    // faer's supernodes store the upper triangles of their diagonal blocks too (the
-    // sweeps stream them with the rest); the bound of the entries on and below the
-    // diagonal alone is the stricter figure.
-    let lower = be.factor_lower_entries().unwrap_or(nnz_l);
-    if lower < nnz_l {
-        let lower_bound = 2.0 * lower as f64 * 8.0 / triad;
-        println!(
-            "  lower entries        {:.2}M of the {:.2}M stored: bound {:.2} ms, solve {:.2} x, step {:.2} x",
-            lower as f64 / 1e6,
-            nnz_l as f64 / 1e6,
-            1e3 * lower_bound,
-            solve_per / lower_bound,
-            step_per / lower_bound
-        );
-    }
     Ok(())
 }

@@ -64,5 +64,13 @@ fn main() -> rothe::Result<()> {
         s.ledger.relative_residual()
     );
     println!("  total                {:.3} s", t0.elapsed().as_secs_f64());
+    let nnz_l = be.factor_nnz().unwrap_or(0);
+    let step_per = steps_s / steps.max(1) as f64;
+    workload::print_stream_bounds(
+        nnz_l,
+        be.factor_lower_entries().unwrap_or(nnz_l),
+        timing.solve_s / steps.max(1) as f64,
+        step_per,
+    );
     Ok(())
 }

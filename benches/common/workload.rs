@@ -254,3 +254,64 @@ fn best_time(reps: usize, mut run: impl FnMut()) -> f64 {
         })
         .fold(f64::INFINITY, f64::min)
 }
+
+/// Prints the machine's bandwidth, measured now on one core and on all, the bound
+/// it puts on a solve that streams a factor of `nnz_l` stored entries (`lower` of
+/// them on and below the diagonal) twice, and how far the measured solve
+/// (`solve_per` seconds) and step (`step_per`) are from it.
+pub fn print_stream_bounds(nnz_l: usize, lower: usize, solve_per: f64, step_per: f64) {
+    // The machine's bandwidth, measured now (outside the run's total) on one core
+    // and on all (the solve runs on both cores; the bound uses the all-core figure),
+    // and the solve's and the step's shares of it; beside it the bandwidth of
+    // reading one stream per core, which is how a solve reads its factor.
+    let triad_one = triad_bandwidth(1 << 24, 10, false);
+    let triad = triad_bandwidth(1 << 24, 10, true);
+    let read_one = read_bandwidth(1 << 25, 5, false);
+    let read = read_bandwidth(1 << 25, 5, true);
+    let bytes = 2.0 * nnz_l as f64 * 8.0;
+    let bound = bytes / triad;
+    let read_bound = bytes / read;
+    let cores = rayon::current_num_threads();
+    println!(
+        "  triad bandwidth      {:.1} GB/s on one core, {:.1} GB/s on all {cores}",
+        triad_one / 1e9,
+        triad / 1e9,
+    );
+    println!(
+        "  read bandwidth       {:.1} GB/s on one core, {:.1} GB/s on all {cores}",
+        read_one / 1e9,
+        read / 1e9,
+    );
+    println!(
+        "  factor stream bound  {:.2} ms per solve (2 x nnz(L) x 8 B at {:.1} GB/s; {:.2} ms at the read bandwidth)",
+        1e3 * bound,
+        triad / 1e9,
+        1e3 * read_bound
+    );
+    println!(
+        "  solve achieved       {:.2} ms per solve, {:.1} GB/s ({:.2} x the bound, {:.2} x the read bound)",
+        1e3 * solve_per,
+        bytes / solve_per / 1e9,
+        solve_per / bound,
+        solve_per / read_bound
+    );
+    println!(
+        "  step                 {:.2} x the bound, {:.2} x the read bound",
+        step_per / bound,
+        step_per / read_bound
+    );
+    // faer's supernodes store the upper triangles of their diagonal blocks too (the
+    // sweeps stream them with the rest); the bound of the entries on and below the
+    // diagonal alone is the stricter figure.
+    if lower < nnz_l {
+        let lower_bound = 2.0 * lower as f64 * 8.0 / triad;
+        println!(
+            "  lower entries        {:.2}M of the {:.2}M stored: bound {:.2} ms, solve {:.2} x, step {:.2} x",
+            lower as f64 / 1e6,
+            nnz_l as f64 / 1e6,
+            1e3 * lower_bound,
+            solve_per / lower_bound,
+            step_per / lower_bound
+        );
+    }
+}

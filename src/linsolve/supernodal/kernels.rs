@@ -268,6 +268,18 @@ pub(super) fn dot_rows_rev<const K: usize, M: MulAdd>(
         unsafe { dot8_rows_rev(l, y, &mut *acc8) };
         return;
     }
+    #[cfg(target_arch = "x86_64")]
+    if K == 1 && M::FUSED {
+        // One column: the four lanes are one vector (LLVM kept them in scalar
+        // registers, one fused multiply-add a row).
+        assert_eq!(y.len(), l.len());
+        let acc1 = acc.as_mut_ptr().cast::<[f64; LANES]>();
+        // SAFETY: `K == 1`, so `acc` is `LANES` single values in a row; `M::FUSED`
+        // is only used inside functions compiled with AVX2 and FMA, after they were
+        // detected; `y` holds a value per row of `l` (asserted).
+        unsafe { dot1_rows_rev(l, y, &mut *acc1) };
+        return;
+    }
     let mut lc = l.rchunks_exact(LANES);
     let mut yc = y.rchunks_exact(LANES * K);
     for (ls, ys) in (&mut lc).zip(&mut yc) {
@@ -281,6 +293,32 @@ pub(super) fn dot_rows_rev<const K: usize, M: MulAdd>(
         for c in 0..K {
             acc[0][c] = M::mul_add(lv, yc.remainder()[r * K + c], acc[0][c]);
         }
+    }
+}
+
+/// [`dot_rows_rev`] for one right-hand side with an AVX2 vector of the four lanes:
+/// lane `q` takes row `r + q` of each chunk of four from the end, as the generic
+/// loop does, and the first `len % LANES` rows, last first, go into lane 0; the same
+/// fused products in the same order per lane (bit-identical).
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA, and `y.len() >= l.len()` (the callers pass
+/// equal lengths, which the generic loop's pairing from the end assumes).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn dot1_rows_rev(l: &[f64], y: &[f64], acc: &mut [f64; LANES]) {
+    use std::arch::x86_64::{_mm256_fmadd_pd, _mm256_loadu_pd, _mm256_storeu_pd};
+    let (lp, yp) = (l.as_ptr(), y.as_ptr());
+    let mut a = _mm256_loadu_pd(acc.as_ptr());
+    let mut r = l.len();
+    while r >= LANES {
+        r -= LANES;
+        a = _mm256_fmadd_pd(_mm256_loadu_pd(lp.add(r)), _mm256_loadu_pd(yp.add(r)), a);
+    }
+    _mm256_storeu_pd(acc.as_mut_ptr(), a);
+    while r > 0 {
+        r -= 1;
+        acc[0] = (*lp.add(r)).mul_add(*yp.add(r), acc[0]);
     }
 }
 
