@@ -1,13 +1,17 @@
-//! The instruction set the Gauss-point kernels run with, chosen once per process
-//! from what the CPU reports.
+//! The instruction set the Gauss-point kernels and the pattern's fused products run
+//! with, chosen once per process from what the CPU reports.
 //!
 //! The binary is built for the baseline x86-64 (SSE2), so that it runs on any such
-//! machine; the element loop of the Gauss-point pass is compiled a second time with
-//! AVX2 and the faster copy is taken where the CPU has it. The AVX2 copy performs
+//! machine; the element loop of the Gauss-point pass and the fused products
+//! `K u`, `M w` of a step (`Pattern::matvec2`) are compiled a second time with AVX2
+//! and the faster copy is taken where the CPU has it. The AVX2 copy performs
 //! the same operations in the same order (no fused multiply-add is written in the
 //! pass, and the compiler never contracts a product and a sum into one), so its
-//! results are the baseline's bit for bit; `tests/regression/reproducible.rs`
-//! compares the two on the machine that runs the tests.
+//! results are the baseline's bit for bit;
+//! `tests/unit/gauss_point_pass.rs::the_avx2_element_loop_gives_the_baselines_bits`
+//! compares the two on the machine that runs the tests, and
+//! `assembly::tests::the_node_pair_mass_gives_the_full_products_bit_for_bit` the
+//! fused products against the separate ones (`theory/gauss_point_pass.md`).
 //!
 //! `ROTHE_SIMD=baseline` in the environment keeps the baseline copy (to compare, or
 //! to time, the two on one machine).

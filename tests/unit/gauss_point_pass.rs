@@ -2,8 +2,8 @@
 //! returns the stress, history, energy and dissipation of one asked for it, bit for
 //! bit; a solid's principal stresses from its principal strains equal the
 //! eigenvalues of `C ε`; and the element loop compiled for AVX2 gives the baseline's
-//! forces, tangent, trial states and totals bit for bit (theory/solids.md, "The
-//! Gauss-point pass").
+//! forces, tangent, trial states and totals bit for bit
+//! (`theory/gauss_point_pass.md`).
 #![allow(clippy::needless_range_loop)]
 
 use crate::workload;
