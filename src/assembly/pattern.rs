@@ -16,6 +16,16 @@ use crate::mesh::Mesh;
 /// Nodes a task of [`Pattern::matvec2`] takes.
 const FUSED_NODES: usize = 256;
 
+/// What both products of [`Pattern::matvec2`] read: `y = A x`, `z = B w` (`B` as
+/// full blocks, or one value per node pair).
+#[derive(Clone, Copy)]
+struct Operands<'a> {
+    a: &'a [f64],
+    x: &'a [f64],
+    b: &'a [f64],
+    w: &'a [f64],
+}
+
 /// Node-blocked symmetric sparsity pattern (see the module docs).
 #[derive(Clone, Debug)]
 pub struct Pattern {
@@ -180,7 +190,6 @@ impl Pattern {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn fused<const D: usize, const PAIRS: bool>(
         &self,
         a: &[f64],
@@ -190,6 +199,7 @@ impl Pattern {
         w: &[f64],
         z: &mut [f64],
     ) {
+        let ops = Operands { a, x, b, w };
         let simd = crate::simd::Simd::detected();
         y.par_chunks_mut(D * FUSED_NODES)
             .zip(z.par_chunks_mut(D * FUSED_NODES))
@@ -200,9 +210,9 @@ impl Pattern {
                     #[cfg(target_arch = "x86_64")]
                     // SAFETY: `Simd::detected` names AVX2 only where the CPU has it.
                     crate::simd::Simd::Avx2 => unsafe {
-                        self.fused_nodes_avx2::<D, PAIRS>(first, a, x, y, b, w, z)
+                        self.fused_nodes_avx2::<D, PAIRS>(first, &ops, y, z)
                     },
-                    _ => self.fused_nodes::<D, PAIRS>(first, a, x, y, b, w, z),
+                    _ => self.fused_nodes::<D, PAIRS>(first, &ops, y, z),
                 }
             });
     }
@@ -214,34 +224,27 @@ impl Pattern {
     /// The CPU must have AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    #[allow(clippy::too_many_arguments)]
     unsafe fn fused_nodes_avx2<const D: usize, const PAIRS: bool>(
         &self,
         first: usize,
-        a: &[f64],
-        x: &[f64],
+        ops: &Operands,
         y: &mut [f64],
-        b: &[f64],
-        w: &[f64],
         z: &mut [f64],
     ) {
-        self.fused_nodes::<D, PAIRS>(first, a, x, y, b, w, z)
+        self.fused_nodes::<D, PAIRS>(first, ops, y, z)
     }
 
     /// The rows of the nodes from `first` on (as many as `y` holds) of both
     /// products of [`Pattern::matvec2`].
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn fused_nodes<const D: usize, const PAIRS: bool>(
         &self,
         first: usize,
-        a: &[f64],
-        x: &[f64],
+        ops: &Operands,
         y: &mut [f64],
-        b: &[f64],
-        w: &[f64],
         z: &mut [f64],
     ) {
+        let Operands { a, x, b, w } = *ops;
         for (i, (yn, zn)) in y.chunks_exact_mut(D).zip(z.chunks_exact_mut(D)).enumerate() {
             let n = first + i;
             let lo = self.adj_ptr[n];
