@@ -61,6 +61,10 @@ pub struct Report {
     pub nnz: (usize, usize),
     /// Whether the ordering is nested dissection.
     pub nested_dissection: bool,
+    /// The backend that analysed the factor.
+    pub backend: Backend,
+    /// A distributed backend's analysis: the factor's size and each rank's memory.
+    pub distributed: Option<crate::linsolve::distributed::DistributedAnalysis>,
     /// The memory estimate with the factor's exact size.
     pub memory: Estimate,
     /// Memory available on this machine.
@@ -166,19 +170,30 @@ pub fn volume(model: &Model) -> Volume {
 /// Analyses `model` (pattern and symbolic factorisation, no numeric work) and
 /// reports; refuses a model whose memory estimate exceeds `memory_limit`.
 pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
+    report_with(model, memory_limit, Backend::Faer)
+}
+
+/// [`report`] with the factor analysed by `backend`: with `mumps`, MUMPS's own
+/// analysis over the MPI ranks, whose estimates of the factor and of each rank's
+/// memory the report gives and the memory check uses (per node).
+pub fn report_with(model: &Model, memory_limit: Option<u64>, backend: Backend) -> Result<Report> {
     let mesh = &model.mesh;
     let pattern = Pattern::new(mesh);
     let dofs = DofMap::new(mesh.n_dofs(), model.constraints.iter().map(|c| c.dof));
     let system = EffectiveSystem::new(
         &pattern,
         dofs,
-        Backend::Faer,
+        backend,
         model.analysis.iteration.ordering,
         &mesh.coords,
     )?;
     let nnz_l = system.factor_nnz().unwrap_or(0);
     let memory = crate::memory::of_model(model, Some(nnz_l));
-    memory.check(memory_limit, "the run")?;
+    let distributed = system.distributed().cloned();
+    match &distributed {
+        Some(d) => crate::memory::check_distributed(model, d, memory_limit, "the run")?,
+        None => memory.check(memory_limit, "the run")?,
+    }
     let a = &model.analysis;
     let steps = a.n_steps();
     let Volume {
@@ -231,6 +246,8 @@ pub fn report(model: &Model, memory_limit: Option<u64>) -> Result<Report> {
         .then_some((a.iteration.method, a.iteration.refactor_rate)),
         nnz: (system.matrix().row_idx.len(), nnz_l),
         nested_dissection: system.nested_dissection(),
+        backend,
+        distributed,
         memory,
         available: memory_limit.or_else(crate::memory::available),
         warnings,
@@ -404,9 +421,15 @@ impl fmt::Display for Report {
         }
         writeln!(
             f,
-            "nnz(K_eff)  {} (lower), nnz(L) {} (faer, {})",
+            "nnz(K_eff)  {} (lower), nnz(L) {} ({}{}, {})",
             self.nnz.0,
             self.nnz.1,
+            self.backend.name(),
+            if self.distributed.is_some() {
+                "'s estimate"
+            } else {
+                ""
+            },
             if self.nested_dissection {
                 "nested dissection"
             } else {
@@ -427,11 +450,62 @@ impl fmt::Display for Report {
             Some(a) => writeln!(f, "; {} available", human(a))?,
             None => writeln!(f)?,
         }
+        if let Some(d) = &self.distributed {
+            distributed_lines(f, d)?;
+        }
         for w in &self.warnings {
             writeln!(f, "warning     {w}")?;
         }
         Ok(())
     }
+}
+
+/// MUMPS's analysis: the factor, each rank's estimate and each node's sum.
+fn distributed_lines(
+    f: &mut fmt::Formatter,
+    d: &crate::linsolve::distributed::DistributedAnalysis,
+) -> fmt::Result {
+    writeln!(
+        f,
+        "mumps       MUMPS {} on {} rank{}: factor about {:.1}M entries, {:.2e} flop; \
+         the factorisation needs about {} per rank at most, {} in all",
+        d.version,
+        d.ranks,
+        if d.ranks == 1 { "" } else { "s" },
+        d.factor_entries as f64 / 1e6,
+        d.flops,
+        human(d.max_rank()),
+        human(d.total())
+    )?;
+    for r in &d.per_rank {
+        writeln!(
+            f,
+            "rank {:<6} {} on {}{}",
+            r.rank,
+            human(r.estimate),
+            r.node,
+            if r.rank == 0 {
+                " (with the run: assembly, materials, contact, output)"
+            } else {
+                ""
+            }
+        )?;
+    }
+    for n in d.nodes() {
+        let ranks: Vec<String> = n.ranks.iter().map(|r| r.to_string()).collect();
+        writeln!(
+            f,
+            "node        {}: ranks {}, {} for the factorisation{}",
+            n.name,
+            ranks.join(", "),
+            human(n.estimate),
+            match n.available {
+                Some(a) => format!(" of {} available", human(a)),
+                None => String::new(),
+            }
+        )?;
+    }
+    Ok(())
 }
 
 /// The lines of Rayleigh's pair from modal targets: the pair, its targets, and the

@@ -33,7 +33,8 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
-        /// Linear solver backend: faer or cholmod.
+        /// Linear solver backend: faer, cholmod or mumps (MPI: `mpirun -n N rothe run
+        /// ... --backend mumps`).
         #[arg(long, default_value = "faer")]
         backend: Backend,
         /// No progress bar.
@@ -125,7 +126,7 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
-        /// Linear solver backend: faer or cholmod.
+        /// Linear solver backend: faer, cholmod or mumps.
         #[arg(long, default_value = "faer")]
         backend: Backend,
     },
@@ -138,6 +139,11 @@ enum Command {
         /// rows G in Matrix Market format into this directory.
         #[arg(long)]
         matrices: Option<PathBuf>,
+        /// The backend whose analysis sizes the factor: faer, cholmod, or mumps
+        /// (MUMPS's own estimates of the factor and of each MPI rank's memory, under
+        /// `mpirun -n N`).
+        #[arg(long, default_value = "faer")]
+        backend: Backend,
     },
 }
 
@@ -385,6 +391,21 @@ fn main() -> ExitCode {
         Command::Plot { dir } => dir.clone(),
         Command::Report { benchmarks, .. } => benchmarks.clone(),
     };
+    let backend = match &cli.command {
+        Command::Run { backend, .. }
+        | Command::Modes { backend, .. }
+        | Command::Check { backend, .. } => *backend,
+        _ => Backend::Faer,
+    };
+    // The MPI backend's ranks other than 0 serve rank 0's solves and stop here.
+    match rothe::linsolve::distributed::start(backend) {
+        Ok(rothe::linsolve::distributed::Role::Served) => return ExitCode::SUCCESS,
+        Ok(_) => {}
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
     let out_dir = match &cli.command {
         Command::Run { out, .. } => Some(out.clone()),
         _ => None,
@@ -502,10 +523,14 @@ fn main() -> ExitCode {
             }
             Ok(())
         }),
-        Command::Check { scenario, matrices } => {
+        Command::Check {
+            scenario,
+            matrices,
+            backend,
+        } => {
             let limit = scenario.options().memory_limit;
             scenario.load().and_then(|model| {
-                let report = rothe::check::report(&model, limit)?;
+                let report = rothe::check::report_with(&model, limit, backend)?;
                 print!("{report}");
                 if let Some(dir) = matrices {
                     for f in rothe::check::write_matrices(&model, &dir)? {
@@ -523,10 +548,11 @@ fn main() -> ExitCode {
             input.display()
         ));
         if let Some(out) = out_dir {
-            mark_failed(&out.join("summary.json"), &e);
+            rothe::output::interrupt::mark_failed(&out.join("summary.json"), &e.to_string());
         }
         Err(e)
     });
+    rothe::linsolve::distributed::finish();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -612,19 +638,4 @@ fn report_command(
     }
     let plan = rothe::study::report::plan(&opts)?;
     sweep.execute(&plan)
-}
-
-/// After a panic outside the run's own guard: marks an existing `summary.json` as
-/// failed with the error (or writes a minimal one).
-fn mark_failed(path: &Path, e: &rothe::Error) {
-    let mut v: serde_json::Value = std::fs::read_to_string(path)
-        .ok()
-        .and_then(|s| serde_json::from_str(&s).ok())
-        .unwrap_or_else(|| serde_json::json!({}));
-    v["status"] = rothe::output::summary::RunStatus::Failed.as_str().into();
-    v["error"] = e.to_string().into();
-    if let Ok(text) = serde_json::to_string_pretty(&v) {
-        let _ = std::fs::create_dir_all(path.parent().unwrap_or(Path::new(".")));
-        let _ = std::fs::write(path, text);
-    }
 }

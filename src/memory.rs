@@ -139,19 +139,72 @@ pub fn human(bytes: u64) -> String {
 /// The memory estimate of a model (the factor's exact nonzeros when known).
 pub fn of_model(model: &Model, factor_nnz: Option<usize>) -> Estimate {
     let mut est = of_mesh(&model.mesh, &model.materials, factor_nnz);
-    let factors = 1
-        + u64::from(
-            model.analysis.time.contact_predictor == crate::model::ContactPredictor::Stabilised,
-        )
-        // An error-controlled run keeps the factors of other rungs of its ladder.
-        + model
-            .analysis
-            .time
-            .adaptive
-            .map_or(0, |a| a.kept_factors() as u64);
-    // The predictor's factor of the mass is on the same pattern and ordering.
-    est.factor *= factors;
+    // An error-controlled run keeps the factors of other rungs of its ladder.
+    let kept = model
+        .analysis
+        .time
+        .adaptive
+        .map_or(0, |a| a.kept_factors() as u64);
+    est.factor *= factorisations(model) + kept;
     est
+}
+
+/// The factorisations a run holds at once: the effective matrix's, and the
+/// predictor's of the mass (on the same pattern and ordering) when it runs.
+fn factorisations(model: &Model) -> u64 {
+    1 + u64::from(
+        model.analysis.time.contact_predictor == crate::model::ContactPredictor::Stabilised,
+    )
+}
+
+/// Refuses a factorisation distributed over MPI ranks that will not fit. On each
+/// node the need is MUMPS's estimate for the ranks there (once per factorisation
+/// the run holds: a distributed backend keeps no factors aside) plus, on rank 0's
+/// node, the rest of the model (`rank0` without its factor); it is set against what
+/// that node has (rank 0's: `available`, which `--ignore-memory` turns off, and
+/// with it the whole check).
+pub fn check_distributed(
+    model: &Model,
+    d: &crate::linsolve::distributed::DistributedAnalysis,
+    available: Option<u64>,
+    what: &str,
+) -> Result<()> {
+    let Some(host_available) = available else {
+        return Ok(());
+    };
+    let rank0 = of_model(model, Some(0));
+    let model_part = rank0.total() - rank0.factor;
+    let factors = factorisations(model);
+    for node in d.nodes() {
+        let host = node.ranks.contains(&0);
+        let need = node.estimate * factors + if host { model_part } else { 0 };
+        let have = if host {
+            Some(host_available)
+        } else {
+            node.available
+        };
+        if let Some(a) = have.filter(|&a| need > a) {
+            let ranks: Vec<String> = node.ranks.iter().map(|r| r.to_string()).collect();
+            return Err(Error::Memory {
+                message: format!(
+                    "{what} needs about {} on node {} (ranks {}: MUMPS's estimate {}{}), but \
+                     only {} is available there; spread the ranks over more nodes, use a \
+                     coarser mesh, or `--ignore-memory` to try anyway",
+                    human(need),
+                    node.name,
+                    ranks.join(", "),
+                    human(node.estimate * factors),
+                    if host {
+                        format!(", and rank 0's model {}", human(model_part))
+                    } else {
+                        String::new()
+                    },
+                    human(a)
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The memory estimate of a model, with the factor's exact nonzeros when known.

@@ -274,6 +274,8 @@ pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
     let summary_path = files.then(|| opts.out.join("summary.json"));
     let summary_path = summary_path.as_deref();
     write_summary(&summary, summary_path)?;
+    // A watchdog or signal that ends the process marks this summary failed.
+    let _registration = summary_path.map(crate::output::interrupt::register);
     // The march runs on a worker of the thread pool, so that its parallel passes
     // hand work to the other workers instead of waking the pool from outside and
     // blocking on it for each pass (which costs a pair of futex calls per pass and

@@ -13,6 +13,7 @@
 //! elimination order proposed with [`SymmetricSolver::set_ordering`] is used by both,
 //! so the two compare factorisation codes on the same factor.
 
+pub mod distributed;
 pub mod faer_backend;
 pub mod ldlt;
 pub mod ordering;
@@ -20,6 +21,9 @@ pub mod supernodal;
 
 #[cfg(feature = "cholmod")]
 pub mod cholmod_backend;
+
+#[cfg(feature = "mumps")]
+pub mod mumps;
 
 use crate::error::{Error, Result};
 
@@ -74,6 +78,8 @@ pub enum Backend {
     Faer,
     /// SuiteSparse CHOLMOD (cargo feature `cholmod`).
     Cholmod,
+    /// MUMPS over MPI, distributed over the ranks (cargo feature `mumps`).
+    Mumps,
 }
 
 impl std::str::FromStr for Backend {
@@ -82,7 +88,10 @@ impl std::str::FromStr for Backend {
         match s {
             "faer" => Ok(Backend::Faer),
             "cholmod" => Ok(Backend::Cholmod),
-            _ => Err(format!("unknown backend `{s}` (expected faer or cholmod)")),
+            "mumps" => Ok(Backend::Mumps),
+            _ => Err(format!(
+                "unknown backend `{s}` (expected faer, cholmod or mumps)"
+            )),
         }
     }
 }
@@ -93,6 +102,7 @@ impl Backend {
         match self {
             Backend::Faer => "faer",
             Backend::Cholmod => "cholmod",
+            Backend::Mumps => "mumps",
         }
     }
 
@@ -108,9 +118,21 @@ impl Backend {
                 message: "this build has no CHOLMOD backend; rebuild with `--features cholmod`"
                     .into(),
             }),
+            #[cfg(feature = "mumps")]
+            Backend::Mumps => Ok(Box::new(mumps::MumpsCholesky::new()?)),
+            #[cfg(not(feature = "mumps"))]
+            Backend::Mumps => Err(Error::Solver {
+                backend: "mumps",
+                message: NO_MUMPS.into(),
+            }),
         }
     }
 }
+
+/// Why a build without the `mumps` feature refuses `--backend mumps`, and how to run it.
+pub const NO_MUMPS: &str = "this build has no MUMPS backend; install libmumps-dev and \
+    libopenmpi-dev, rebuild with `cargo build --release --features mumps`, and run \
+    `mpirun -n N target/release/rothe run SCENARIO --backend mumps`";
 
 /// `out` zeroed, then the sparse entries (repeated indices summed) added.
 pub fn scatter_entries(entries: &[(usize, f64)], out: &mut [f64]) {
@@ -167,6 +189,11 @@ pub trait SymmetricSolver: Send {
     /// analysis, the factor again.
     fn put_numeric(&mut self, values: Vec<f64>) {
         let _ = values;
+    }
+    /// A distributed backend's analysis: the factor's size and each rank's share of
+    /// the memory; `None` for a backend in this process alone.
+    fn distributed(&self) -> Option<&distributed::DistributedAnalysis> {
+        None
     }
 }
 

@@ -174,6 +174,7 @@ impl History {
                 p.force, p.active, p.tangential_force, p.sticking, p.slipping
             ));
         }
+        let _hold = super::interrupt::hold();
         writeln!(out, "{line}").map_err(|e| Error::io(&self.path, e))?;
         self.flush()
     }

@@ -6,6 +6,7 @@
 pub mod checks;
 pub mod fields;
 pub mod history;
+pub mod interrupt;
 pub mod modes;
 pub mod post;
 pub mod recorder;

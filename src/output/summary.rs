@@ -331,6 +331,7 @@ impl Summary {
         let text = serde_json::to_string_pretty(self)
             .map_err(|e| Error::io(path, std::io::Error::other(e.to_string())))?;
         let tmp = path.with_extension("json.tmp");
+        let _hold = super::interrupt::hold();
         std::fs::write(&tmp, text).map_err(|e| Error::io(&tmp, e))?;
         std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e))
     }

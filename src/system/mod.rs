@@ -296,6 +296,11 @@ impl EffectiveSystem {
         self.solver.factor_nnz()
     }
 
+    /// A distributed backend's analysis (each rank's share of the memory).
+    pub fn distributed(&self) -> Option<&crate::linsolve::distributed::DistributedAnalysis> {
+        self.solver.distributed()
+    }
+
     /// Entries of the factor on and below the diagonal (faer's supernodes also store
     /// the upper triangles of their diagonal blocks, which [`Self::factor_nnz`] counts).
     pub fn factor_lower_entries(&self) -> Option<usize> {

@@ -286,8 +286,13 @@ impl Operators {
     ) -> Result<(EffectiveSystem, Factored, Option<Vec<f64>>)> {
         let mut sys = self.analysed_system(model, backend)?;
         // The analysis knows the factor's size: refuse before it is allocated.
-        crate::memory::of_model(model, sys.factor_nnz())
-            .check(memory_limit, "the factorisation")?;
+        match sys.distributed() {
+            Some(d) => {
+                crate::memory::check_distributed(model, d, memory_limit, "the factorisation")?
+            }
+            None => crate::memory::of_model(model, sys.factor_nnz())
+                .check(memory_limit, "the factorisation")?,
+        }
         let factored = match self.response {
             Response::StateDependent(_) => {
                 let f = self.refactor(&mut sys, &self.kt)?;
