@@ -325,13 +325,17 @@ impl SymmetricSolver for MumpsCholesky {
         let negative = self.infog(12);
         if negative > 0 {
             return Err(self.not_positive_definite(format!(
-                "numeric factorisation: {negative} negative pivots: the matrix is not positive definite"
+                "numeric factorisation: {negative} negative pivot{}: the matrix is not positive \
+                 definite",
+                if negative == 1 { "" } else { "s" }
             )));
         }
         let null = self.infog(28);
         if null > 0 {
             return Err(self.not_positive_definite(format!(
-                "numeric factorisation: {null} null pivots: the matrix is singular to working precision"
+                "numeric factorisation: {null} null pivot{}: the matrix is singular to working \
+                 precision",
+                if null == 1 { "" } else { "s" }
             )));
         }
         self.factorized = true;
