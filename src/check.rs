@@ -460,6 +460,18 @@ impl fmt::Display for Report {
     }
 }
 
+/// A count of entries for people: `5.55G`, `97.0M`, `22220`.
+fn entries(n: u64) -> String {
+    let x = n as f64;
+    if x >= 1e9 {
+        format!("{:.2}G", x / 1e9)
+    } else if x >= 1e6 {
+        format!("{:.1}M", x / 1e6)
+    } else {
+        n.to_string()
+    }
+}
+
 /// MUMPS's analysis: the factor, each rank's estimate and each node's sum.
 fn distributed_lines(
     f: &mut fmt::Formatter,
@@ -467,12 +479,12 @@ fn distributed_lines(
 ) -> fmt::Result {
     writeln!(
         f,
-        "mumps       MUMPS {} on {} rank{}: factor about {:.1}M entries, {:.2e} flop; \
+        "mumps       MUMPS {} on {} rank{}: factor about {} entries, {:.2e} flop; \
          the factorisation needs about {} per rank at most, {} in all",
         d.version,
         d.ranks,
         if d.ranks == 1 { "" } else { "s" },
-        d.factor_entries as f64 / 1e6,
+        entries(d.factor_entries),
         d.flops,
         human(d.max_rank()),
         human(d.total())

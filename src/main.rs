@@ -320,6 +320,23 @@ impl ScenarioArgs {
         opts
     }
 
+    /// [`Self::options`] for a run on `backend`: a distributed factor is left out of
+    /// the checks while loading (MUMPS's analysis checks it per node).
+    fn options_for(&self, backend: Backend) -> LoadOptions {
+        let mut opts = self.options();
+        opts.distributed_factor = backend == Backend::Mumps;
+        opts
+    }
+
+    /// The model, loaded for a run on `backend`.
+    fn load_for(&self, backend: Backend) -> rothe::Result<rothe::model::Model> {
+        rothe::config::load_with_overrides(
+            &self.scenario,
+            &self.options_for(backend),
+            &self.overrides()?,
+        )
+    }
+
     fn overrides(&self) -> rothe::Result<Overrides> {
         let mut ov = Overrides::none();
         for v in &self.variants {
@@ -333,10 +350,6 @@ impl ScenarioArgs {
         }
         Ok(ov)
     }
-
-    fn load(&self) -> rothe::Result<rothe::model::Model> {
-        rothe::config::load_with_overrides(&self.scenario, &self.options(), &self.overrides()?)
-    }
 }
 
 fn run_command(
@@ -347,7 +360,7 @@ fn run_command(
     record_fields: bool,
     overwrite: bool,
 ) -> rothe::Result<()> {
-    let model = scenario.load()?;
+    let model = scenario.load_for(backend)?;
     let summary = run(
         &model,
         &RunOptions {
@@ -474,7 +487,7 @@ fn main() -> ExitCode {
             around,
             out,
             backend,
-        } => scenario.load().and_then(|model| {
+        } => scenario.load_for(backend).and_then(|model| {
             let opts = rothe::modal::ModalOptions {
                 count,
                 shift,
@@ -529,7 +542,7 @@ fn main() -> ExitCode {
             backend,
         } => {
             let limit = scenario.options().memory_limit;
-            scenario.load().and_then(|model| {
+            scenario.load_for(backend).and_then(|model| {
                 let report = rothe::check::report_with(&model, limit, backend)?;
                 print!("{report}");
                 if let Some(dir) = matrices {

@@ -173,7 +173,7 @@ pub fn check_distributed(
         return Ok(());
     };
     let rank0 = of_model(model, Some(0));
-    let model_part = rank0.total() - rank0.factor;
+    let model_part = rank0.total() - rank0.factor + d.host_input;
     let factors = factorisations(model);
     for node in d.nodes() {
         let host = node.ranks.contains(&0);
@@ -185,21 +185,33 @@ pub fn check_distributed(
         };
         if let Some(a) = have.filter(|&a| need > a) {
             let ranks: Vec<String> = node.ranks.iter().map(|r| r.to_string()).collect();
+            let per_rank: Vec<String> = d
+                .per_rank
+                .iter()
+                .map(|r| format!("{} {}", r.rank, human(r.estimate)))
+                .collect();
             return Err(Error::Memory {
                 message: format!(
                     "{what} needs about {} on node {} (ranks {}: MUMPS's estimate {}{}), but \
                      only {} is available there; spread the ranks over more nodes, use a \
-                     coarser mesh, or `--ignore-memory` to try anyway",
+                     coarser mesh, or `--ignore-memory` to try anyway. MUMPS's estimate per \
+                     rank{}: {}",
                     human(need),
                     node.name,
                     ranks.join(", "),
                     human(node.estimate * factors),
                     if host {
-                        format!(", and rank 0's model {}", human(model_part))
+                        format!(", and rank 0's model and matrix {}", human(model_part))
                     } else {
                         String::new()
                     },
-                    human(a)
+                    human(a),
+                    if factors > 1 {
+                        format!(" and factorisation (the run holds {factors})")
+                    } else {
+                        String::new()
+                    },
+                    per_rank.join(", ")
                 ),
             });
         }

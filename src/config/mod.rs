@@ -25,6 +25,10 @@ pub struct LoadOptions {
     /// Accept an explicit step above the critical step (`--allow-unstable`, for
     /// stability studies). Default false: such a step is refused.
     pub allow_unstable: bool,
+    /// The factor will be distributed over MPI ranks (`--backend mumps`): the
+    /// checks while loading leave it out of this process's estimate, and the
+    /// backend's own analysis checks it per node before the factorisation.
+    pub distributed_factor: bool,
 }
 
 impl Default for LoadOptions {
@@ -32,6 +36,7 @@ impl Default for LoadOptions {
         LoadOptions {
             memory_limit: crate::memory::available(),
             allow_unstable: false,
+            distributed_factor: false,
         }
     }
 }
@@ -42,6 +47,7 @@ impl LoadOptions {
         LoadOptions {
             memory_limit: None,
             allow_unstable: false,
+            distributed_factor: false,
         }
     }
 }

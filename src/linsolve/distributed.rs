@@ -30,6 +30,9 @@ pub struct DistributedAnalysis {
     pub flops: f64,
     /// Each rank's share.
     pub per_rank: Vec<RankMemory>,
+    /// What rank 0 holds besides its share: the matrix as handed to the backend
+    /// (indices and values), in bytes.
+    pub host_input: u64,
 }
 
 impl DistributedAnalysis {

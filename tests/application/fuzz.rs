@@ -180,6 +180,7 @@ fn exercise_scenario(text: &str, dir: &Path) -> Result<(), String> {
     let opts = LoadOptions {
         memory_limit: Some(LIMIT),
         allow_unstable: false,
+        distributed_factor: false,
     };
     let model = match rothe::config::from_str_with(text, dir, &opts) {
         Ok(m) => m,
@@ -738,6 +739,7 @@ fn command_line_overrides_give_a_model_or_an_error() {
                 let opts = LoadOptions {
                     memory_limit: Some(LIMIT),
                     allow_unstable: false,
+                    distributed_factor: false,
                 };
                 rothe::config::load_with_overrides(path, &opts, &ov).map(|_| ())
             }));

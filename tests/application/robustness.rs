@@ -191,6 +191,7 @@ fn memory_is_estimated_before_it_is_taken() {
         &rothe::config::LoadOptions {
             memory_limit: Some(10_000),
             allow_unstable: false,
+            distributed_factor: false,
         },
     )
     .unwrap_err()

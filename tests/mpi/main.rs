@@ -10,10 +10,6 @@
 //! set for the launches here.
 #![cfg(feature = "mumps")]
 
-#[path = "../common/mod.rs"]
-#[allow(dead_code)]
-mod common;
-
 mod agreement;
 mod faults;
 

@@ -624,3 +624,74 @@ fn timing_report() {
         assert!(rel_diff(&xs[1], &xs[0]) < 1e-9);
     }
 }
+
+/// The memory check of a factorisation distributed over MPI ranks sums the ranks of
+/// each node against that node's memory, adds rank 0's model on its node, and is off
+/// under `--ignore-memory`.
+#[test]
+fn a_distributed_factor_is_checked_node_by_node() {
+    use rothe::linsolve::distributed::{DistributedAnalysis, RankMemory};
+    const GB: u64 = 1_000_000_000;
+    let model = cantilever("dynamic", [8, 2], 1e-4);
+    let rank = |rank: usize, node: &str, estimate: u64, available: u64| RankMemory {
+        rank,
+        node: node.into(),
+        estimate,
+        available: Some(available),
+    };
+    let analysis = |per_rank: Vec<RankMemory>| DistributedAnalysis {
+        version: "test".into(),
+        ranks: per_rank.len(),
+        per_rank,
+        ..Default::default()
+    };
+    let check = |d: &DistributedAnalysis, host: Option<u64>| {
+        rothe::memory::check_distributed(&model, d, host, "the run")
+    };
+    // Each rank on a node of its own, each share fits.
+    let spread = analysis(vec![
+        rank(0, "a", GB, 100 * GB),
+        rank(1, "b", 3 * GB, 4 * GB),
+    ]);
+    assert!(check(&spread, Some(100 * GB)).is_ok());
+    // Node b too small for rank 1's share: refused, naming the node and the rank.
+    let small = analysis(vec![
+        rank(0, "a", GB, 100 * GB),
+        rank(1, "b", 3 * GB, 2 * GB),
+    ]);
+    let e = check(&small, Some(100 * GB)).unwrap_err().to_string();
+    assert!(e.contains("node b (ranks 1"), "{e}");
+    assert!(e.contains("1 3.0 GB"), "{e}");
+    // Two ranks sharing node b: each share fits, their sum does not.
+    let shared = analysis(vec![
+        rank(0, "a", GB, 100 * GB),
+        rank(1, "b", 3 * GB / 2, 5 * GB / 2),
+        rank(2, "b", 3 * GB / 2, 5 * GB / 2),
+    ]);
+    let e = check(&shared, Some(100 * GB)).unwrap_err().to_string();
+    assert!(e.contains("node b (ranks 1, 2"), "{e}");
+    // Rank 0's node: its share and the model against the limit given for it.
+    let host = analysis(vec![rank(0, "a", 2 * GB, 100 * GB)]);
+    assert!(check(&host, Some(3 * GB)).is_ok());
+    let e = check(&host, Some(2 * GB)).unwrap_err().to_string();
+    assert!(e.contains("rank 0's model"), "{e}");
+    // `--ignore-memory`: no check.
+    assert!(check(&small, None).is_ok());
+}
+
+/// `--backend mumps` in a build without the feature says how to get and run it.
+#[cfg(not(feature = "mumps"))]
+#[test]
+fn mumps_without_the_feature_says_how_to_run_it() {
+    let e = Backend::Mumps
+        .solver()
+        .err()
+        .expect("no mumps in this build")
+        .to_string();
+    assert!(e.contains("--features mumps"), "{e}");
+    assert!(e.contains("mpirun -n N"), "{e}");
+    let e = rothe::linsolve::distributed::start(Backend::Mumps)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("libmumps-dev"), "{e}");
+}

@@ -17,6 +17,7 @@ fn load(text: &str, allow_unstable: bool) -> rothe::Result<Model> {
     let opts = LoadOptions {
         memory_limit: None,
         allow_unstable,
+        distributed_factor: false,
     };
     rothe::config::from_str_with(text, Path::new("."), &opts)
 }

@@ -293,7 +293,11 @@ pub(super) fn check_generated_size(
         elements,
         points,
         history,
-        factor_nnz_estimate(dofs, dim),
+        if opts.distributed_factor {
+            0
+        } else {
+            factor_nnz_estimate(dofs, dim)
+        },
         tangent,
     );
     est.check(
@@ -306,7 +310,8 @@ pub(super) fn check_generated_size(
 /// The memory estimate of the built mesh (the factor from its size: the exact
 /// figure is checked again after the symbolic analysis, before the factorisation).
 pub(super) fn check_memory(mesh: &Mesh, materials: &[Material], opts: &LoadOptions) -> Result<()> {
-    let est = crate::memory::of_mesh(mesh, materials, None);
+    let factor = opts.distributed_factor.then_some(0);
+    let est = crate::memory::of_mesh(mesh, materials, factor);
     est.check(
         opts.memory_limit,
         &format!(

@@ -254,6 +254,7 @@ impl SymmetricSolver for MumpsCholesky {
             // SAFETY: a live instance.
             flops: unsafe { ffi::rothe_mumps_rinfog(h, 1) },
             per_rank,
+            host_input: (nnz * (2 * 4 + 8) + n * 4) as u64,
         });
         let mut order = vec![usize::MAX; n];
         let mut complete = true;

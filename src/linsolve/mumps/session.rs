@@ -528,6 +528,10 @@ mod watchdog {
                 .name("rothe-mpi-signals".into())
                 .spawn(move || {
                     if let Some(sig) = signals.forever().next() {
+                        if rank != 0 {
+                            // A serving rank has no files, and rank 0 says why.
+                            std::process::exit(1);
+                        }
                         end(
                             rank,
                             format!(
