@@ -1,5 +1,5 @@
 //! Histories with the MUMPS backend on one and two ranks against faer's, and a run
-//! against its repeat.
+//! against its repeat: to the last bit on one rank, to round-off on two.
 
 use super::*;
 
@@ -59,8 +59,9 @@ fn worst_difference(a: &Path, b: &Path) -> (f64, String) {
     worst
 }
 
-/// Runs `args` with faer alone, and with mumps on one and two ranks; asserts the
-/// histories agree to 1e-10 and that a repeat on two ranks is the same file.
+/// Runs `args` with faer alone, and with mumps twice on one rank and twice on two;
+/// asserts the histories agree with faer's to 1e-10, that the repeat on one rank is
+/// the same file and the repeat on two agrees to 1e-13.
 fn agrees(name: &str, args: &[&str]) {
     let _machine = exclusive();
     let dir = tempfile::tempdir().unwrap();
@@ -83,7 +84,12 @@ fn agrees(name: &str, args: &[&str]) {
     let f = strs(&with("faer", "faer"));
     let faer = alone(&f.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(faer.status.success(), "{name} faer: {}", stderr(&faer));
-    for (ranks, tag) in [(1, "mumps1"), (2, "mumps2"), (2, "mumps2-again")] {
+    for (ranks, tag) in [
+        (1, "mumps1"),
+        (1, "mumps1-again"),
+        (2, "mumps2"),
+        (2, "mumps2-again"),
+    ] {
         let a = with(tag, "mumps");
         let o = launch(ranks, &a.iter().map(String::as_str).collect::<Vec<_>>());
         assert!(
@@ -101,11 +107,20 @@ fn agrees(name: &str, args: &[&str]) {
             "{name} on {ranks} ranks: {column} differs by {d:e}"
         );
     }
-    let first = std::fs::read(out("mumps2").join("history.csv")).unwrap();
-    let again = std::fs::read(out("mumps2-again").join("history.csv")).unwrap();
+    // One rank: the same file to the last bit.
+    let first = std::fs::read(out("mumps1").join("history.csv")).unwrap();
+    let again = std::fs::read(out("mumps1-again").join("history.csv")).unwrap();
     assert!(
         first == again,
-        "{name}: a repeat on 2 ranks changed the history"
+        "{name}: a repeat on 1 rank changed the history"
+    );
+    // Two ranks: MUMPS sums some contributions in the order they arrive, so a
+    // repeat may move the last bits (theory/solves.md); every printed value of the
+    // ledger, the probes and the forces stays within 1e-13 of its scale.
+    let (d, column) = worst_difference(&out("mumps2"), &out("mumps2-again"));
+    assert!(
+        d < 1e-13,
+        "{name}: a repeat on 2 ranks moved {column} by {d:e}"
     );
 }
 

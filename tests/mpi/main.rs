@@ -1,9 +1,9 @@
 //! The MUMPS backend over MPI, as a user runs it: `mpirun -n N rothe run SCENARIO
 //! --backend mumps`. Its histories equal faer's on one and two ranks, a run repeats
-//! to the last bit, `rothe check` gives MUMPS's estimates per rank, and faults end
-//! the run as failed with its files valid: a rank killed mid-run, a rank that stops
-//! answering (the collectives' timeout), a single-process backend launched on
-//! several ranks.
+//! to the last bit on one rank and to round-off on two, `rothe check` gives MUMPS's
+//! estimates per rank, and faults end the run as failed with its files valid: a
+//! rank killed mid-run, a rank that stops answering (the collectives' timeout), a
+//! single-process backend launched on several ranks.
 //!
 //! Built with the `mumps` feature only (Debian's libmumps-dev and libopenmpi-dev,
 //! and `mpirun` on the path); as root, OpenMPI's `OMPI_ALLOW_RUN_AS_ROOT` pair is
@@ -19,11 +19,8 @@ use std::sync::{Mutex, MutexGuard};
 
 static MACHINE: Mutex<()> = Mutex::new(());
 
-/// Held by each test for its whole length: one MPI job at a time, each rank on a
-/// core of its own. MUMPS assembles the contribution blocks of a front in the order
-/// they arrive; with more ranks than cores that order, and the last bits of a run
-/// with it, can change from run to run (theory/solves.md), which the repeat checks
-/// here must not see.
+/// Held by each test for its whole length: one MPI job at a time, so that the
+/// timeouts and the interrupted runs' timing are the test's own.
 fn exclusive() -> MutexGuard<'static, ()> {
     MACHINE.lock().unwrap_or_else(|e| e.into_inner())
 }
