@@ -1,8 +1,11 @@
 //! Workload W3, the solid counterpart of W1, end to end as a user runs it:
-//! `cargo run --release --example w3 -- [N] [faer|cholmod]` (default 20: 107k
+//! `cargo run --release --example w3 -- [N] [faer|cholmod|mumps]` (default 20: 107k
 //! dofs; 34 gives 503k). Prints setup, assembly, factorisation, the mean step, the
 //! tip deflection and the total wall time (the figure `benches/peers/w3_fenicsx.py`
-//! prints for FEniCSx on the same problem).
+//! prints for FEniCSx on the same problem). MUMPS on two ranks beside faer on two
+//! threads: `cargo build --release --features mumps --example w3`, then
+//! `mpirun -n 2 target/release/examples/w3 20 mumps` and
+//! `target/release/examples/w3 20 faer`.
 
 #[path = "../benches/common/workload.rs"]
 mod workload;
@@ -22,8 +25,12 @@ fn main() -> rothe::Result<()> {
         .unwrap_or(20);
     let backend: Backend = args
         .get(1)
-        .map(|s| s.parse().expect("backend is faer or cholmod"))
+        .map(|s| s.parse().expect("backend is faer, cholmod or mumps"))
         .unwrap_or_default();
+    // Under mpirun with mumps, the ranks other than 0 serve rank 0's solves.
+    if rothe::linsolve::distributed::start(backend)? == rothe::linsolve::distributed::Role::Served {
+        return Ok(());
+    }
     let t0 = Instant::now();
     let model = workload::w3(n)?;
     let setup_s = t0.elapsed().as_secs_f64();
@@ -72,5 +79,7 @@ fn main() -> rothe::Result<()> {
         timing.solve_s / steps.max(1) as f64,
         step_per,
     );
+    drop(be);
+    rothe::linsolve::distributed::finish();
     Ok(())
 }
