@@ -153,8 +153,24 @@ fn check_gives_mumps_estimates_per_rank() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("on 2 ranks"), "{text}");
-    let per_rank: Vec<f64> = text
-        .lines()
+    let per_rank = rank_estimates(&text);
+    assert_eq!(per_rank.len(), 2, "{text}");
+    // Both ranks take a share of a solid's factor.
+    assert!(per_rank.iter().all(|&b| b > 1e6), "{text}");
+    // On one rank the whole factor is rank 0's, more than either share.
+    let one = launch(1, &args);
+    assert!(one.status.success(), "{}", stderr(&one));
+    let whole = rank_estimates(&String::from_utf8_lossy(&one.stdout));
+    assert_eq!(whole.len(), 1);
+    assert!(
+        per_rank.iter().all(|&b| b < whole[0]),
+        "one rank {whole:?}, two ranks {per_rank:?}"
+    );
+}
+
+/// Each rank's estimate, in bytes, from the `rank K  X GB on NODE` lines of `check`.
+fn rank_estimates(text: &str) -> Vec<f64> {
+    text.lines()
         .filter(|l| l.starts_with("rank "))
         .map(|l| {
             let w: Vec<&str> = l.split_whitespace().collect();
@@ -166,16 +182,5 @@ fn check_gives_mumps_estimates_per_rank() {
                 _ => 1.0,
             }
         })
-        .collect();
-    assert_eq!(per_rank.len(), 2, "{text}");
-    // Both ranks take a share of a solid's factor.
-    assert!(per_rank.iter().all(|&b| b > 1e6), "{text}");
-    // On one rank the whole factor is rank 0's, more than either share.
-    let one = launch(1, &args);
-    let text1 = String::from_utf8_lossy(&one.stdout);
-    let whole = text1
-        .lines()
-        .find(|l| l.starts_with("rank 0"))
-        .unwrap_or_else(|| panic!("{text1}"));
-    eprintln!("one rank: {whole}; two ranks: {per_rank:?}");
+        .collect()
 }
