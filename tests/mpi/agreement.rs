@@ -80,8 +80,7 @@ fn agrees(name: &str, args: &[&str]) {
         );
         v
     };
-    let strs = |v: &[String]| -> Vec<String> { v.to_vec() };
-    let f = strs(&with("faer", "faer"));
+    let f = with("faer", "faer");
     let faer = alone(&f.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(faer.status.success(), "{name} faer: {}", stderr(&faer));
     for (ranks, tag) in [

@@ -161,11 +161,6 @@ impl MumpsCholesky {
             message,
         }
     }
-
-    /// MUMPS's view of the last analysis: its factor estimate and each rank's share.
-    pub fn analysis(&self) -> Option<&DistributedAnalysis> {
-        self.analysis.as_ref()
-    }
 }
 
 impl Drop for MumpsCholesky {

@@ -159,11 +159,6 @@ impl Session {
         self.size
     }
 
-    /// The timeout of one collective.
-    pub fn timeout(&self) -> Duration {
-        self.timeout
-    }
-
     /// Runs `host` on rank 0 after broadcasting `cmd`, so that the other ranks run
     /// their side of the same MUMPS call; the whole is timed by the watchdog.
     fn collective<T>(
@@ -263,7 +258,7 @@ impl Session {
             all[0] = local;
         } else {
             let root = self.world.0.process_at_rank(0);
-            let mut numbers = vec![0i64; n * 3];
+            let mut numbers = vec![0i64; n * 2];
             let mut names = vec![0u8; n * NODE_NAME];
             if self.rank == 0 {
                 root.gather_into_root(&local.numbers[..], &mut numbers[..]);
@@ -273,7 +268,7 @@ impl Session {
                 root.gather_into(&local.name[..]);
             }
             for (r, f) in all.iter_mut().enumerate() {
-                f.numbers.copy_from_slice(&numbers[3 * r..3 * r + 3]);
+                f.numbers.copy_from_slice(&numbers[2 * r..2 * r + 2]);
                 f.name
                     .copy_from_slice(&names[r * NODE_NAME..(r + 1) * NODE_NAME]);
             }
@@ -431,17 +426,17 @@ fn new_handle(fortran: i32) -> Option<*mut Handle> {
 const NODE_NAME: usize = 64;
 
 /// One rank's memory figures: MUMPS's estimate in MB (`INFO(15)`), the bytes the
-/// node has available (−1 when unknown), its rank; and the node's name.
+/// node has available (−1 when unknown); and the node's name.
 #[derive(Clone)]
 struct Figures {
-    numbers: [i64; 3],
+    numbers: [i64; 2],
     name: [u8; NODE_NAME],
 }
 
 impl Default for Figures {
     fn default() -> Self {
         Figures {
-            numbers: [0; 3],
+            numbers: [0; 2],
             name: [0; NODE_NAME],
         }
     }
