@@ -50,6 +50,10 @@ pub enum Error {
     /// The time integration could not continue.
     #[error("time stepping: {0}")]
     Stepping(String),
+    /// A modal analysis (eigenpairs, the mesh's stable step) could not find what
+    /// was asked.
+    #[error("modal analysis: {0}")]
+    Modal(String),
     /// The model would not fit in the memory available.
     #[error("memory: {message}")]
     Memory {
@@ -87,6 +91,19 @@ pub enum Error {
         step: usize,
         /// Its time.
         t: f64,
+    },
+    /// The ledger broke one of its own inequalities (energy created, or more
+    /// dissipated than the work put in) at `step`: the numbers cannot be right.
+    #[error("energy check failed at step {step} (t = {t:.6e} s): {check}; {cause}")]
+    Energy {
+        /// The step whose ledger broke the check.
+        step: usize,
+        /// Its time.
+        t: f64,
+        /// The check, as `name: lhs > rhs`.
+        check: String,
+        /// What makes a run break it and what to change.
+        cause: String,
     },
     /// A bug: something that must not happen did (a panic caught at the top).
     #[error("internal error (please report it with the input file): {0}")]

@@ -126,6 +126,10 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
+        /// Replace an earlier run's or modal analysis's files in the output
+        /// directory (refused otherwise).
+        #[arg(long)]
+        overwrite: bool,
         /// Linear solver backend: faer, cholmod or mumps.
         #[arg(long, default_value = "faer")]
         backend: Backend,
@@ -389,6 +393,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // A panic is reported below as an internal error, not printed by the default hook.
     std::panic::set_hook(Box::new(|_| {}));
+    // An environment variable out of range is refused by name before any work.
+    if let Err(e) = rothe::simd::Simd::asked() {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     let input = match &cli.command {
         Command::Run { scenario, .. }
         | Command::Check { scenario, .. }
@@ -486,8 +495,11 @@ fn main() -> ExitCode {
             shift,
             around,
             out,
+            overwrite,
             backend,
         } => scenario.load_for(backend).and_then(|model| {
+            // Held while the modes are found and written: one writer per directory.
+            let _lock = rothe::output::prepare(&out, overwrite)?;
             let opts = rothe::modal::ModalOptions {
                 count,
                 shift,

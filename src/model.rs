@@ -242,6 +242,9 @@ pub struct TimeSettings {
     pub contact_predictor: ContactPredictor,
     /// Step size `h`.
     pub dt: f64,
+    /// Central differences: the stable step the step was chosen and checked
+    /// against, with the damping the run uses (s); `None` for the implicit schemes.
+    pub stable_dt: Option<f64>,
     /// End time `T`.
     pub t_end: f64,
     /// Lumped (row-sum) instead of consistent mass.

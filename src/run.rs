@@ -205,9 +205,12 @@ fn write_summary(summary: &Summary, path: Option<&Path>) -> Result<()> {
 pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
     let start = Instant::now();
     let files = !opts.hooks.no_files;
-    if files {
-        crate::output::prepare(&opts.out, opts.overwrite)?;
-    }
+    // Held to the end of the run: one writer per directory.
+    let _lock = if files {
+        Some(crate::output::prepare(&opts.out, opts.overwrite)?)
+    } else {
+        None
+    };
     let mut rec =
         Recorder::with_sinks(model, files.then_some(opts.out.as_path()), opts.hooks.keep)?;
     if opts.record_fields {
@@ -306,14 +309,42 @@ pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
     kept.columns = columns;
     kept.fields = fields;
     match result {
-        Ok(()) => {
-            summary.status = RunStatus::Completed;
-            write_summary(&summary, summary_path)?;
-            for f in summary.checks.failures() {
-                eprintln!("warning: {}: energy check failed: {f}", opts.out.display());
+        Ok(()) => match summary
+            .checks
+            .first_failure(a.time.dt, true, energy_check_binds(model))
+        {
+            // A ledger that breaks the paper's checks over the whole run is no
+            // completed run (theory/energy.md).
+            Some((check, mut cause)) => {
+                if a.time.kind == AnalysisKind::Static {
+                    cause.push_str(
+                        "; in statics a local softening band may have no equilibrium path \
+                         under this control (a snap-back) at any step: make the damage \
+                         nonlocal, or run it as dynamics",
+                    );
+                }
+                let e = Error::Energy {
+                    step: summary.steps,
+                    t: summary.t_end,
+                    check,
+                    cause,
+                };
+                summary.status = RunStatus::Failed;
+                summary.error = Some(e.to_string());
+                write_summary(&summary, summary_path)?;
+                Err(e)
             }
-            Ok((summary, kept))
-        }
+            None => {
+                summary.status = RunStatus::Completed;
+                for f in summary.checks.failures() {
+                    let w = format!("energy check failed: {f} (theory/energy.md)");
+                    eprintln!("warning: {}: {w}", opts.out.display());
+                    summary.warnings.push(w);
+                }
+                write_summary(&summary, summary_path)?;
+                Ok((summary, kept))
+            }
+        },
         Err(e @ Error::Stopped { .. }) => {
             summary.status = RunStatus::Stopped;
             summary.error = Some(e.to_string());
@@ -336,7 +367,11 @@ fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I
     summary.steps = s.step;
     summary.t_end = s.t;
     summary.energy = EnergySummary::from(&s.ledger);
-    summary.checks = Checks::of(&s.ledger);
+    summary.checks = checks_of(
+        integrator.model(),
+        s,
+        f64::EPSILON * crate::output::checks::reference_energy(integrator.model()),
+    );
     summary.probes = rec.probes().clone();
     summary.contact = rec.contact().clone();
     summary.timing.assembly_s = timing.assembly_s;
@@ -347,6 +382,20 @@ fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I
     summary.solver.reused_factors = facts.reused_factors;
     summary.solver.fallbacks = facts.fallbacks;
     summary.solver.factor_nnz = facts.factor_nnz;
+}
+
+/// Whether the check that no energy is created ends a run of `model` (central
+/// differences) or is only reported ([`Checks::first_failure`]).
+fn energy_check_binds(model: &Model) -> bool {
+    let t = &model.analysis.time;
+    t.kind == AnalysisKind::Dynamic && t.scheme == TimeScheme::CentralDifference
+}
+
+/// The energy checks of state `s` with the scheme's allowance and the model's
+/// round-off `floor` (J).
+fn checks_of(model: &Model, s: &State, floor: f64) -> Checks {
+    let allowance = crate::output::checks::energy_allowance(model, s.step);
+    Checks::with(&s.ledger, allowance, floor)
 }
 
 /// Steps between refreshes of the progress line's solver counts.
@@ -422,6 +471,8 @@ fn integrate<I: Integrator>(
     let mut counts = Counts::default();
     let mut step_cuts = 0;
     let adaptive = AdaptiveControl::of(model);
+    let floor = f64::EPSILON * crate::output::checks::reference_energy(model);
+    let energy_binds = energy_check_binds(model);
     let adapted = std::cell::Cell::new(crate::time::adaptive::AdaptiveReport::default());
     let observe = |integrator: &I, s: &State, m: Marched| {
         match m {
@@ -443,6 +494,18 @@ fn integrate<I: Integrator>(
                 let on_cadence = rec.vtk_due(s.step, s.t);
                 let snap = snapshot(s, built.as_deref(), report.iterations, report.nl_residual);
                 rec.record(model, &snap)?;
+                // A ledger that breaks its own inequalities ends the run failed at the
+                // step that broke it, its rows kept (theory/energy.md).
+                if let Some((check, cause)) =
+                    checks_of(model, s, floor).first_failure(integrator.h(), false, energy_binds)
+                {
+                    return Err(Error::Energy {
+                        step: s.step,
+                        t: s.t,
+                        check,
+                        cause,
+                    });
+                }
                 pb.set_position(((s.t / t_end) * n_steps as f64) as u64);
                 if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {
                     fill(summary, s, integrator, rec);

@@ -32,13 +32,27 @@ impl Simd {
     /// baseline; read once per process.
     pub fn detected() -> Simd {
         static CHOSEN: OnceLock<Simd> = OnceLock::new();
-        *CHOSEN.get_or_init(|| {
-            let asked = std::env::var("ROTHE_SIMD").ok();
-            if asked.as_deref() == Some("baseline") {
-                return Simd::Baseline;
-            }
-            Simd::available()
+        *CHOSEN.get_or_init(|| match Simd::asked() {
+            Ok(Some(Simd::Baseline)) => Simd::Baseline,
+            _ => Simd::available(),
         })
+    }
+
+    /// What `ROTHE_SIMD` asks for: `baseline`, `avx2` (the default where the CPU has
+    /// it), unset or empty (`None`); any other value is an error naming the
+    /// variable, which the command line and the Python module report at start.
+    pub fn asked() -> Result<Option<Simd>, String> {
+        match std::env::var("ROTHE_SIMD") {
+            Err(std::env::VarError::NotPresent) => Ok(None),
+            Ok(v) if v.trim().is_empty() => Ok(None),
+            Ok(v) if v.trim() == "baseline" => Ok(Some(Simd::Baseline)),
+            Ok(v) if v.trim() == "avx2" => Ok(Some(Simd::Avx2)),
+            Ok(v) => Err(format!(
+                "ROTHE_SIMD = `{v}`: expected `baseline` or `avx2` (or unset, for the \
+                 fastest set the CPU has)"
+            )),
+            Err(e) => Err(format!("ROTHE_SIMD: {e}")),
+        }
     }
 
     /// The fastest set the CPU has, whatever the environment asks.

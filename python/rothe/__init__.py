@@ -26,6 +26,7 @@ import csv
 import json
 import math
 import os
+import shutil
 import tempfile
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Union
@@ -162,6 +163,7 @@ class Scenario:
         around: Optional[float] = None,
         out: Optional[PathLike] = None,
         backend: str = "faer",
+        overwrite: bool = False,
     ) -> "Modes":
         """The ``count`` lowest eigenfrequencies and mode shapes of ``K x = ω² M x``
         (``rothe modes``): shift-invert Lanczos on the runs' factor at the initial,
@@ -169,7 +171,9 @@ class Scenario:
         negative) moves the Cholesky's shift; ``around`` (Hz) gives the ``count``
         modes nearest that frequency instead (an LDLᵀ inside the spectrum).
         ``out`` also writes ``modes.csv``, ``modes.json``, ``modes.pvd`` and the
-        charts there. Bad input raises :class:`Error` naming the option.
+        charts there; a directory holding an earlier run's or modal analysis's
+        files is refused unless ``overwrite``, as ``rothe modes --overwrite``. Bad
+        input raises :class:`Error` naming the option.
         """
         if not isinstance(count, int) or isinstance(count, bool):
             raise Error(f"count: {count!r} is not a whole number of modes")
@@ -181,6 +185,7 @@ class Scenario:
             None if around is None else float(around),
             None if out is None else os.fspath(out),
             str(backend),
+            bool(overwrite),
         )
         return Modes(json.loads(info), shapes, [Path(f) for f in files])
 
@@ -417,26 +422,38 @@ def _tables(out: Path) -> Dict[str, Dict[str, np.ndarray]]:
 def material(spec: Union[PathLike, Mapping[str, Any]], out: Optional[PathLike] = None) -> Dict[str, np.ndarray]:
     """The material-point driver (``rothe material``): a file or a dict with
     ``[material]`` and ``[path]``; returns ``material.csv``'s columns as arrays
-    (written into ``out`` when given)."""
-    tmp = None
-    try:
-        if out is None:
-            tmp = tempfile.TemporaryDirectory(prefix="rothe-material-")
-            out_dir = Path(tmp.name)
-        else:
-            out_dir = Path(out)
+    (written into ``out`` when given). A dict is kept beside the output as
+    ``material.rothe.toml`` (a name rothe owns) once the driver accepted it; no
+    file of the user's is replaced."""
+    with tempfile.TemporaryDirectory(prefix="rothe-material-") as tmp:
+        out_dir = Path(tmp) if out is None else _output_dir(out, "out")
         if isinstance(spec, Mapping):
-            # The driver reads a file: the dict is written as TOML beside the output.
-            file = out_dir / "material.toml"
-            out_dir.mkdir(parents=True, exist_ok=True)
+            # The driver reads a file: the dict is written as TOML in a directory of
+            # rothe's own, and copied beside the output only once it ran.
+            file = Path(tmp) / MATERIAL_COPY
             file.write_text(_dict_to_toml(_jsonable(spec, "material")))
         else:
             file = Path(spec)
         _rothe.material(os.fspath(file), os.fspath(out_dir))
+        if isinstance(spec, Mapping) and out is not None:
+            shutil.copyfile(file, out_dir / MATERIAL_COPY)
         return _read_table(out_dir / "material.csv")
-    finally:
-        if tmp is not None:
-            tmp.cleanup()
+
+
+#: The name under which :func:`material` keeps a dict given as the material file.
+MATERIAL_COPY = "material.rothe.toml"
+
+#: The name under which a study keeps a scenario given as text or a dict.
+SCENARIO_COPY = "scenario.rothe.toml"
+
+
+def _output_dir(out: PathLike, name: str) -> Path:
+    """An output directory as given, refusing the empty path (which would write
+    into the working directory)."""
+    text = os.fspath(out)
+    if text == "" or (isinstance(text, bytes) and text == b""):
+        raise Error(f"{name}: an empty path; name the output directory ('.' for the working directory)")
+    return Path(text)
 
 
 def _dict_to_toml(d: Mapping[str, Any]) -> str:
@@ -457,14 +474,15 @@ def _dict_to_toml(d: Mapping[str, Any]) -> str:
 
 def _study_source(scenario: Union[PathLike, Scenario], variants, set, unset, out: Path):
     """A file and overrides for a study: a Scenario read from a file keeps its
-    file and overrides; one from text or a dict is written to ``out/scenario.toml``
-    (its mesh files must then be given by absolute paths)."""
+    file and overrides; one from text or a dict is written to
+    ``out/scenario.rothe.toml``, a name rothe owns (its mesh files must then be
+    given by absolute paths)."""
     v, u, s = _overrides(variants, set, unset)
     if isinstance(scenario, Scenario):
         path, _dir, _text, sv, su, ss = scenario._native.source()
         if path is None:
             out.mkdir(parents=True, exist_ok=True)
-            path = out / "scenario.toml"
+            path = out / SCENARIO_COPY
             Path(path).write_text(scenario.to_toml())
             sv, su, ss = [], [], []
         return os.fspath(path), list(sv) + v, list(su) + u, list(ss) + s
@@ -472,7 +490,7 @@ def _study_source(scenario: Union[PathLike, Scenario], variants, set, unset, out
 
 
 def _study(kind, scenario, variants, set, unset, out, values, halvings, option, jobs, backend):
-    out = Path(out)
+    out = _output_dir(out, "out")
     path, v, u, s = _study_source(scenario, variants, set, unset, out)
     markdown, incomplete = _rothe.study(
         kind, path, v, u, s, os.fspath(out), [float(x) for x in values], halvings, option, jobs, backend

@@ -25,6 +25,7 @@ class NativeScenario:
         around: Optional[float],
         out: Optional[str],
         backend_name: str,
+        overwrite: bool,
     ) -> Tuple[str, np.ndarray, List[str]]: ...
     def run(
         self,

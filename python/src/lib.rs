@@ -290,8 +290,8 @@ impl NativeScenario {
     /// The lowest `count` modes (or the `count` nearest `around` Hz): `modes.json`'s
     /// value as JSON text, the `M`-normalised shapes `(modes, dofs)`, and the files
     /// written into `out` (none without it).
-    #[pyo3(signature = (count, shift, around, out, backend_name))]
-    #[allow(clippy::type_complexity)]
+    #[pyo3(signature = (count, shift, around, out, backend_name, overwrite))]
+    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
     fn modes<'py>(
         &self,
         py: Python<'py>,
@@ -300,11 +300,17 @@ impl NativeScenario {
         around: Option<f64>,
         out: Option<PathBuf>,
         backend_name: &str,
+        overwrite: bool,
     ) -> PyResult<(String, Bound<'py, PyArray2<f64>>, Vec<PathBuf>)> {
         let model = self.model.clone();
         let backend = backend(backend_name)?;
         let (json, shapes, k, files) = py
             .detach(move || -> rothe::Result<_> {
+                // One writer per directory, as for a run.
+                let _lock = match &out {
+                    Some(dir) => Some(rothe::output::prepare(dir, overwrite)?),
+                    None => None,
+                };
                 let opts = rothe::modal::ModalOptions {
                     count,
                     shift,
@@ -666,6 +672,8 @@ fn study(
 #[pymodule]
 fn _rothe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("Error", m.py().get_type::<Error>())?;
+    // An environment variable out of range is refused by name at import.
+    rothe::simd::Simd::asked().map_err(Error::new_err)?;
     m.add_class::<NativeScenario>()?;
     m.add_class::<NativeRun>()?;
     m.add_function(wrap_pyfunction!(scenario, m)?)?;

@@ -428,6 +428,10 @@ pub struct AnalysisSpec {
     /// VTK output).
     #[serde(default)]
     pub viscoelastic_state: Option<crate::model::ViscoelasticState>,
+    /// The keys the `[analysis]` table gave (after variants and `--set`): a key the
+    /// run will not read is a warning naming it, defaults or not.
+    #[serde(skip)]
+    pub given: std::collections::BTreeSet<String>,
 }
 
 fn default_displacement_tolerance() -> f64 {
@@ -736,11 +740,13 @@ pub fn merged_table(path: &Path, ov: &Overrides) -> Result<toml::Table> {
 pub fn parse_with(text: &str, ov: &Overrides) -> Result<Scenario> {
     let table: toml::Table = toml::from_str(text).map_err(|e| toml_error(text, e))?;
     if ov.is_empty() && !table.contains_key("variants") {
-        return parse(text);
+        let mut s: Scenario = parse_located(text)?;
+        s.analysis.given = analysis_keys(&table);
+        return Ok(s);
     }
     let merged = overrides::apply(table, ov)?;
-    serde_path_to_error::deserialize(toml::Value::Table(merged.clone())).map_err(
-        |e: serde_path_to_error::Error<toml::de::Error>| {
+    let mut s: Scenario = serde_path_to_error::deserialize(toml::Value::Table(merged.clone()))
+        .map_err(|e: serde_path_to_error::Error<toml::de::Error>| {
             let path = within_material(field_path(e.path()), e.inner().message(), || {
                 Some(merged.clone())
             });
@@ -748,14 +754,23 @@ pub fn parse_with(text: &str, ov: &Overrides) -> Result<Scenario> {
                 format!("{path} (after variants and --set)"),
                 e.inner().message().to_string(),
             )
-        },
-    )
+        })?;
+    s.analysis.given = analysis_keys(&merged);
+    Ok(s)
+}
+
+/// The keys of a scenario table's `[analysis]`.
+fn analysis_keys(table: &toml::Table) -> std::collections::BTreeSet<String> {
+    match table.get("analysis") {
+        Some(toml::Value::Table(a)) => a.keys().cloned().collect(),
+        _ => Default::default(),
+    }
 }
 
 /// Parses scenario text (no validation). A value of the wrong type or length is
 /// named by its field path and its line and column.
 pub fn parse(text: &str) -> Result<Scenario> {
-    parse_located(text)
+    parse_with(text, &Overrides::none())
 }
 
 /// Parses TOML text into any of the file types (a scenario, a material-point

@@ -439,7 +439,7 @@ impl Mesh {
     }
 
     /// The node coordinates of element `e` of `block`.
-    fn element_points(&self, block: usize, e: usize) -> Vec<Point> {
+    pub(crate) fn element_points(&self, block: usize, e: usize) -> Vec<Point> {
         self.blocks[block]
             .elements
             .element(e)

@@ -150,7 +150,7 @@ impl Top {
         };
         let r = lanczos::lanczos(free.len(), &wanted, &[], op, mass).map_err(|e| match e {
             lanczos::Shortfall::Operator(e) => e,
-            lanczos::Shortfall::NotConverged { steps, .. } => Error::Stepping(format!(
+            lanczos::Shortfall::NotConverged { steps, .. } => Error::Modal(format!(
                 "the largest frequency did not converge in {steps} Lanczos steps"
             )),
         })?;

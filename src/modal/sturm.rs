@@ -54,7 +54,7 @@ pub(super) fn search(
     let max_steps = (20 * s.count + 60).min(n);
     let shortfall = |e: Shortfall| match e {
         Shortfall::Operator(e) => e,
-        Shortfall::NotConverged { converged, steps } => Error::Stepping(format!(
+        Shortfall::NotConverged { converged, steps } => Error::Modal(format!(
             "modal analysis: {converged} of {} modes converged in {steps} Lanczos steps; \
              ask for fewer, or give a shift nearer the wanted ones (--shift, --around)",
             s.count
@@ -91,7 +91,7 @@ pub(super) fn search(
     };
     let counted = below_above.saturating_sub(below_below);
     if counted < pairs.len() {
-        return Err(Error::Stepping(format!(
+        return Err(Error::Modal(format!(
             "modal analysis: the inertia counts {counted} eigenvalues in [{below:e}, \
              {above:e}) rad²/s², Lanczos returned {}; the shift is too near an eigenvalue \
              for its factor (give another)",
@@ -112,7 +112,7 @@ pub(super) fn search(
             }
         }
         if missing == before {
-            return Err(Error::Stepping(format!(
+            return Err(Error::Modal(format!(
                 "modal analysis: the inertia counts {counted} eigenvalues in [{below:e}, \
                  {above:e}) rad²/s², Lanczos found {} of them",
                 counted - missing

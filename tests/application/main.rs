@@ -10,3 +10,4 @@ mod workload;
 mod cli;
 mod fuzz;
 mod robustness;
+mod settings;

@@ -41,6 +41,7 @@ pub fn model_of(
                 rho_inf: 0.8,
                 contact_predictor: Default::default(),
                 dt: 1.0,
+                stable_dt: None,
                 t_end: 1.0,
                 lumped_mass: false,
                 viscoelastic_state: rothe::model::ViscoelasticState::Nodal,

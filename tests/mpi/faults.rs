@@ -48,7 +48,9 @@ fn interrupt_rank_1(
         let rows = std::fs::read_to_string(out.join("history.csv"))
             .map(|t| t.lines().count())
             .unwrap_or(0);
-        if rows > 20 {
+        // The header and more than 20 steps: the files checked after the fault
+        // hold more than 20 rows whatever the machine's load.
+        if rows > 21 {
             break;
         }
         assert!(

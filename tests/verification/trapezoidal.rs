@@ -451,9 +451,18 @@ fn the_contact_predictor_is_refused_where_there_is_nothing_to_stabilise() {
 fn benchmark_1_as_solids_runs_by_both_new_schemes_on_every_backend() {
     // The solid two blocks (elastic, 0.1 m, 2 µs, through the impact at 2.6 ms): the
     // ledger closes, the trapezoidal rule books no D_num, and the backends give the
-    // same run. Node to face: with mortar's rows the second-order schemes' contact
-    // phase amplifies round-off (the backends' forces part by 1.5 % by 3 ms,
-    // theory/trapezoidal.md), so the backends are compared where the run is not.
+    // same run to within what the problem makes of round-off. Node to face: with
+    // mortar's rows the second-order schemes' contact phase amplifies round-off
+    // much more (theory/contact3d.md).
+    //
+    // The tolerance is measured on the problem, not taken from one machine: two
+    // faer runs that differ only in their elimination order (AMD against nested
+    // dissection) differ by the round-off of the solves as the scheme and the contact
+    // amplify it, `spread`. Another backend, or OpenBLAS's kernels for another CPU,
+    // changes the solves' round-off by the same kind of reordering of the same sums,
+    // so it moves the answer by a like amount: the backends must agree within
+    // `AMPLIFICATION_MARGIN × spread` (theory/trapezoidal.md gives the figures
+    // under every kernel set).
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/benchmarks/two_blocks_solid.toml"),
     )
@@ -462,11 +471,13 @@ fn benchmark_1_as_solids_runs_by_both_new_schemes_on_every_backend() {
         "master = \"concrete.top\"",
         "master = \"concrete.top\"\nformulation = \"node_to_face\"",
     );
-    let backends: &[Backend] = if cfg!(feature = "cholmod") {
-        &[Backend::Faer, Backend::Cholmod]
-    } else {
-        &[Backend::Faer]
-    };
+    let mut backends: Vec<(Backend, rothe::model::Ordering)> = vec![
+        (Backend::Faer, rothe::model::Ordering::NestedDissection),
+        (Backend::Faer, rothe::model::Ordering::Amd),
+    ];
+    if cfg!(feature = "cholmod") {
+        backends.push((Backend::Cholmod, rothe::model::Ordering::NestedDissection));
+    }
     for scheme in ["trapezoidal", "generalized_alpha"] {
         let ov = rothe::config::Overrides::none()
             .variant("concrete=elastic")
@@ -483,15 +494,17 @@ fn benchmark_1_as_solids_runs_by_both_new_schemes_on_every_backend() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("b1.toml");
         std::fs::write(&path, &text).unwrap();
-        let m = rothe::config::load_with_overrides(
+        let base = rothe::config::load_with_overrides(
             &path,
             &rothe::config::LoadOptions::unlimited(),
             &ov,
         )
         .unwrap();
-        assert_eq!(m.mesh.dim, 3);
+        assert_eq!(base.mesh.dim, 3);
         let mut runs = Vec::new();
-        for &b in backends {
+        for &(b, ordering) in &backends {
+            let mut m = base.clone();
+            m.analysis.iteration.ordering = ordering;
             let mut i = BackwardEuler::new(&m, b).unwrap();
             let mut s = i.initial_state();
             for _ in 0..m.analysis.n_steps() {
@@ -509,16 +522,37 @@ fn benchmark_1_as_solids_runs_by_both_new_schemes_on_every_backend() {
             }
             runs.push(s.u);
         }
-        for u in &runs[1..] {
-            let scale = runs[0].iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            let d = u
-                .iter()
-                .zip(&runs[0])
-                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        let scale = runs[0].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let apart = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        };
+        // The spread of the orderings, floored at the round-off of one solve of the
+        // answer (a run whose orderings happened to agree to the bit).
+        let spread = apart(&runs[1], &runs[0]).max(64.0 * f64::EPSILON * scale);
+        for u in &runs[2..] {
+            let d = apart(u, &runs[0]);
+            println!(
+                "{scheme}: backends {d:.3e}, orderings {spread:.3e}, of {scale:.3e} \
+                 (ratio {:.2})",
+                d / spread
+            );
             assert!(
-                d < 1e-8 * scale,
-                "{scheme}: backends differ by {d:e} of {scale:e}"
+                d <= AMPLIFICATION_MARGIN * spread,
+                "{scheme}: backends differ by {d:e} of {scale:e}, {:.1}x the orderings' \
+                 {spread:e}",
+                d / spread
             );
         }
     }
 }
+
+/// How far another backend's (or kernel set's) answer may lie from faer's, in
+/// multiples of the spread of faer's two orderings on the same problem
+/// (theory/trapezoidal.md): the largest ratio measured under every OpenBLAS kernel
+/// set, the baseline SIMD and 1 to 3 threads is 4.35 (the trapezoidal rule; 1.71
+/// for generalized-α), so 50 leaves a factor of 11 for kernels not measured, while
+/// a backend that solved to 1e-9 instead of round-off (a ratio in the thousands)
+/// still fails.
+const AMPLIFICATION_MARGIN: f64 = 50.0;

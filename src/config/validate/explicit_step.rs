@@ -42,6 +42,7 @@ pub(super) fn explicit_step(model: &mut Model, dt: Option<f64>, opts: &LoadOptio
         ),
         None => (stable.dt, format!("2/ω_max of {where_}")),
     };
+    a.time.stable_dt = Some(limit);
     match dt {
         None => {
             a.time.dt = a.time.omega

@@ -213,6 +213,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 rho_inf: a.rho_inf.unwrap_or(DEFAULT_RHO_INF),
                 contact_predictor: a.contact_predictor.unwrap_or_default(),
                 dt: a.dt.unwrap_or(f64::NAN),
+                stable_dt: None,
                 t_end: a.t_end,
                 lumped_mass: explicit || a.mass == Some(super::MassKind::Lumped),
                 viscoelastic_state: a.viscoelastic_state.unwrap_or_default(),
@@ -253,13 +254,12 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
                 vtk_every_time: adaptive::vtk_every_time(a)?,
             },
         },
-        warnings: unread_keys(a),
+        warnings: Vec::new(),
     };
-    if explicit {
-        explicit_step::explicit_step(&mut model, a.dt, opts)?;
-    }
-    chatter_warning(&mut model);
-    adaptive::impact_warning(&mut model);
+    model.warnings = unread_keys(s, &model);
+    // Rayleigh's pair from modal targets before the explicit step is chosen and
+    // checked: the stable step of central differences depends on the damping that
+    // will be used (theory/explicit.md).
     if let Some(DampingSpec {
         ratio,
         modes: Some([i, j]),
@@ -268,6 +268,11 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
     {
         damping::modal_targets(&mut model, *ratio, [*i, *j])?;
     }
+    if explicit {
+        explicit_step::explicit_step(&mut model, a.dt, opts)?;
+    }
+    chatter_warning(&mut model);
+    adaptive::impact_warning(&mut model);
     initial_overlap(&model)?;
     Ok(model)
 }
@@ -515,30 +520,76 @@ fn rayleigh_is_finite(
 }
 
 /// Keys the analysis will not read, each as a warning naming it: those only the
-/// other time scheme reads (kept, so that `compare` can run one file both ways), and
-/// `omega` beside a given explicit step.
-fn unread_keys(a: &super::AnalysisSpec) -> Vec<String> {
+/// other time scheme reads (kept, so that `compare` can run one file both ways),
+/// `omega` beside a given explicit step, the dynamic keys of a static analysis, the
+/// fixed-step keys of an error-controlled run, the contact keys of a model without
+/// contact and the iteration keys of a model whose step is one linear solve. A key
+/// counts as given when the `[analysis]` table holds it (after variants and `--set`),
+/// whatever its value.
+fn unread_keys(s: &super::Scenario, model: &Model) -> Vec<String> {
+    let a = &s.analysis;
     let mut w = Vec::new();
+    let unread = |w: &mut Vec<String>, keys: &[&str], why: &str| {
+        for key in keys {
+            if a.given.contains(*key) {
+                w.push(format!("analysis.{key} is not read: {why}"));
+            }
+        }
+    };
     let explicit = a.scheme == TimeScheme::CentralDifference;
-    if explicit {
-        let implicit_only = [
-            ("analysis.contact_qp", a.contact_qp.is_some()),
-            ("analysis.friction_guess", a.friction_guess.is_some()),
-            ("analysis.iteration", a.iteration.is_some()),
-            ("analysis.keep_factor", a.keep_factor.is_some()),
-            ("analysis.refactor_rate", a.refactor_rate.is_some()),
-            (
-                "analysis.viscoelastic_state",
-                a.viscoelastic_state.is_some(),
-            ),
-        ];
-        for (key, given) in implicit_only {
-            if given {
+    let statics = a.kind == AnalysisKind::Static;
+    if statics {
+        unread(
+            &mut w,
+            &[
+                "scheme",
+                "rho_inf",
+                "zeta",
+                "rayleigh",
+                "damping",
+                "contact_predictor",
+                "critical_step",
+                "omega",
+                "viscoelastic_state",
+            ],
+            "a static analysis has no time scheme, inertia or damping",
+        );
+        if model.gravity.is_none() {
+            unread(
+                &mut w,
+                &["mass"],
+                "a static analysis uses the mass only for gravity, and there is none",
+            );
+        }
+        for b in &s.bodies {
+            if b.velocity.len > 0 && b.velocity.xyz != [0.0; 3] {
                 w.push(format!(
-                    "{key} is read by the implicit schemes only; central differences ignore it"
+                    "bodies `{}`.velocity is not read: a static analysis has no initial \
+                     velocity",
+                    b.name
                 ));
             }
         }
+    } else if explicit {
+        unread(
+            &mut w,
+            &[
+                "contact_qp",
+                "friction_guess",
+                "iteration",
+                "keep_factor",
+                "refactor_rate",
+                "viscoelastic_state",
+                "tolerance",
+                "max_iterations",
+                "displacement_tolerance",
+                "max_cuts",
+                "dt_min",
+                "ordering",
+            ],
+            "central differences solve nothing and iterate nothing (lumped mass, one \
+             explicit update per step)",
+        );
         if a.omega.is_some() && a.dt.is_some() {
             w.push(
                 "analysis.omega sets the default explicit step only; the given analysis.dt \
@@ -546,11 +597,56 @@ fn unread_keys(a: &super::AnalysisSpec) -> Vec<String> {
                     .into(),
             );
         }
-    } else if a.critical_step.is_some() {
-        w.push(
-            "analysis.critical_step is read by central differences only; the implicit \
-             schemes ignore it"
-                .into(),
+    } else {
+        unread(
+            &mut w,
+            &["critical_step", "omega"],
+            "central differences read it; the implicit schemes do not",
+        );
+        if a.adaptive.is_some() {
+            unread(
+                &mut w,
+                &["dt_min", "max_cuts"],
+                "error-controlled steps go down their own ladder (analysis.adaptive.dt_min)",
+            );
+        }
+    }
+    if !explicit && model.contacts.is_empty() {
+        unread(
+            &mut w,
+            &[
+                "contact_tolerance",
+                "contact_qp",
+                "friction_guess",
+                "contact_predictor",
+            ],
+            "the model has no contact pair",
+        );
+    }
+    if !explicit
+        && !statics
+        && !model
+            .materials
+            .iter()
+            .any(|m| m.has_constant_tangent() && !m.is_linear_elastic())
+    {
+        unread(
+            &mut w,
+            &["viscoelastic_state"],
+            "no material of the model is linear viscoelastic",
+        );
+    }
+    if !explicit && model.materials.iter().all(|m| m.has_constant_tangent()) {
+        unread(
+            &mut w,
+            &[
+                "iteration",
+                "displacement_tolerance",
+                "keep_factor",
+                "refactor_rate",
+            ],
+            "every material of the model has a constant tangent, so a step is one linear \
+             solve on a factor kept from step to step",
         );
     }
     w

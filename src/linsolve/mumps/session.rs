@@ -103,6 +103,10 @@ pub fn current() -> Option<&'static Session> {
     SESSION.get().and_then(|s| s.as_ref().ok())
 }
 
+/// The longest watchdog timeout `ROTHE_MPI_TIMEOUT` may give (s): a deadline
+/// beyond it would overflow the clock's arithmetic.
+const MAX_TIMEOUT_S: f64 = 1e9;
+
 impl Session {
     fn init() -> std::result::Result<Session, String> {
         // SAFETY: a function of the shim without arguments.
@@ -116,10 +120,13 @@ impl Session {
         }
         let timeout = match std::env::var(TIMEOUT_ENV) {
             Ok(v) => match v.trim().parse::<f64>() {
-                Ok(s) if s.is_finite() && s > 0.0 => Duration::from_secs_f64(s),
+                Ok(s) if s.is_finite() && s > 0.0 && s <= MAX_TIMEOUT_S => {
+                    Duration::from_secs_f64(s)
+                }
                 _ => {
                     return Err(format!(
-                        "{TIMEOUT_ENV} = `{v}`: expected a positive number of seconds"
+                        "{TIMEOUT_ENV} = `{v}`: expected a positive number of seconds, at \
+                         most {MAX_TIMEOUT_S:e} (about 30 years)"
                     ))
                 }
             },
