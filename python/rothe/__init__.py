@@ -179,6 +179,7 @@ class Scenario:
             raise Error(f"count: {count!r} is not a whole number of modes")
         if count < 1:
             raise Error("--count: ask for at least one mode")
+        _count("count", count, 1)
         info, shapes, files = self._native.modes(
             count,
             None if shift is None else float(shift),
@@ -216,6 +217,7 @@ class Scenario:
         bar = progress is True
         if threads is not None and (not isinstance(threads, int) or threads < 1):
             raise Error(f"threads: {threads!r} is not a positive count")
+        _count("threads", threads, 1)
         native = self._native.run(
             None if out is None else os.fspath(out),
             bool(overwrite),
@@ -489,7 +491,26 @@ def _study_source(scenario: Union[PathLike, Scenario], variants, set, unset, out
     return os.fspath(scenario), v, u, s
 
 
+#: The largest count the native module takes (a 64-bit unsigned integer).
+_MAX_COUNT = 2**64 - 1
+
+
+def _count(name: str, value: Any, least: int = 0) -> Any:
+    """A whole-number argument checked by name before the native module sees it:
+    ``None`` passes; a bool, a float, a negative or an overflowing number raises
+    :class:`Error` naming ``name`` (not Python's nameless ``OverflowError``)."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise Error(f"{name}: {value!r} is not a whole number")
+    if value < least or value > _MAX_COUNT:
+        raise Error(f"{name}: {value} is out of range (at least {least}, at most 2^64 - 1)")
+    return value
+
+
 def _study(kind, scenario, variants, set, unset, out, values, halvings, option, jobs, backend):
+    halvings = _count("halvings", halvings)
+    jobs = _count("jobs", jobs, 1)
     out = _output_dir(out, "out")
     path, v, u, s = _study_source(scenario, variants, set, unset, out)
     markdown, incomplete = _rothe.study(
@@ -521,7 +542,7 @@ def study_time(
         raise Error("study_time: give either h (a list of steps) or halvings (a count)")
     return _study(
         "time", scenario, variants, set, unset, out, h or [], halvings,
-        None if reference_halvings is None else str(int(reference_halvings)), jobs, backend,
+        None if reference_halvings is None else str(_count("reference_halvings", reference_halvings)), jobs, backend,
     )
 
 
@@ -543,7 +564,7 @@ def study_tolerance(
     default the ladder's bottom rung); the errors against the steps are in
     ``tables["study"]``; see :func:`study_time` for the rest."""
     return _study(
-        "tolerance", scenario, variants, set, unset, out, list(tolerances), fixed_halvings,
+        "tolerance", scenario, variants, set, unset, out, list(tolerances), _count("fixed_halvings", fixed_halvings),
         None if reference_dt is None else repr(float(reference_dt)), jobs, backend,
     )
 

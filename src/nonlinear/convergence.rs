@@ -56,4 +56,13 @@ impl Convergence {
             && c.complementarity <= self.complementarity_tolerance
             && !c.active_set_changed
     }
+
+    /// Whether the constraints of an iterate whose residual is at round-off are
+    /// met: no penetration and complementarity within the tolerances, whatever the
+    /// active set did (it changes there only by constraints at zero gap and zero
+    /// force).
+    pub fn constraints_hold_at_floor(&self, c: &ConstraintStatus) -> bool {
+        c.penetration <= self.penetration_tolerance
+            && c.complementarity <= self.complementarity_tolerance
+    }
 }
