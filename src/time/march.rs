@@ -61,6 +61,15 @@ impl StepControl {
 /// Accepted steps at a reduced size before the step doubles back.
 const EASY_STEPS_TO_GROW: usize = 4;
 
+/// Accepted steps in a row below the requested size after which a run whose rest
+/// would take more than [`STALL_FACTOR`] times its planned step count at their mean
+/// size stops as stalled: it crawls at its floor (theory/equilibrium.md).
+const STALL_STRETCH: usize = 1000;
+
+/// How many times its planned step count a crawling run may project before it is
+/// stopped as stalled.
+const STALL_FACTOR: f64 = 100.0;
+
 /// Integrates `s` to `control.t_end` (see the module docs). `observe` sees the
 /// integrator (for its timings and solver facts), the state and every accepted step
 /// and every cut; an error from it stops the march. On failure the error names the
@@ -83,6 +92,11 @@ where
     } = control;
     let mut h = h0;
     let (mut cuts_in_row, mut easy) = (0usize, 0usize);
+    // The stretch of accepted steps below h0: their count and summed size, and why
+    // the last step before it was cut.
+    let (mut stretch, mut stretch_time) = (0usize, 0.0f64);
+    let mut last_cut = String::new();
+    let planned = (t_end / h0).ceil().max(1.0);
     // Summing the steps leaves the time a few ulps from t_end (6000 steps of 5e-7
     // s end 1.2e-15 s short): what is left below a millionth of a step is that
     // drift, not a step to take (one of 1e-15 s would only test the solver).
@@ -95,6 +109,29 @@ where
             StepOutcome::Accepted(report) => {
                 observe(integrator, s, Marched::Step(&report))?;
                 cuts_in_row = 0;
+                if h_try < h0 * (1.0 - 1e-9) && s.t < t_end - 1e-6 * h0 {
+                    stretch += 1;
+                    stretch_time += h_try;
+                    if stretch >= STALL_STRETCH {
+                        let mean = stretch_time / stretch as f64;
+                        let projected = (t_end - s.t) / mean;
+                        if projected > STALL_FACTOR * planned {
+                            return Err(Error::Stepping(format!(
+                                "stalled at step {} (t = {:.6e} of {t_end:.6e}): the last \
+                                 {stretch} steps averaged h = {mean:.3e} s ({:.1e} of dt) \
+                                 and the rest would take {projected:.2e} more steps, over \
+                                 {STALL_FACTOR}x the {planned} planned; the steps keep \
+                                 failing: {last_cut}. Try a smaller dt (load step) or, past \
+                                 a softening peak, nonlocal damage or dynamics",
+                                s.step,
+                                s.t,
+                                mean / h0,
+                            )));
+                        }
+                    }
+                } else {
+                    (stretch, stretch_time) = (0, 0.0);
+                }
                 if h < h0 {
                     easy += 1;
                     if easy >= EASY_STEPS_TO_GROW {
@@ -131,6 +168,7 @@ where
             }
             StepOutcome::Rejected(r) if cuts_in_row < max_cuts => {
                 cuts_in_row += 1;
+                last_cut.clone_from(&r.message);
                 easy = 0;
                 h *= 0.5;
                 observe(
@@ -183,4 +221,96 @@ pub fn march_steps<I: Integrator + ?Sized>(
         solves += integrator.step_accepted(s)?.iterations;
     }
     Ok(solves)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::time::{SolverFacts, Timing};
+
+    /// A static elastic bar whose steps converge only below `limit`: a run that
+    /// can only crawl.
+    struct Crawling<'m> {
+        inner: crate::time::statics::Statics<'m>,
+        limit: f64,
+    }
+
+    impl Integrator for Crawling<'_> {
+        fn model(&self) -> &crate::model::Model {
+            self.inner.model()
+        }
+        fn h(&self) -> f64 {
+            self.inner.h()
+        }
+        fn set_step(&mut self, h: f64) -> Result<()> {
+            self.inner.set_step(h)
+        }
+        fn initial_state(&mut self) -> Result<State> {
+            Integrator::initial_state(&mut self.inner)
+        }
+        fn step(&mut self, s: &mut State) -> Result<StepOutcome> {
+            if self.inner.h() > self.limit {
+                return Ok(StepOutcome::Rejected(Rejection {
+                    outcome: Outcome::NotConverged {
+                        iterations: 30,
+                        history: vec![1.0; 31],
+                        worst: None,
+                    },
+                    message: "no convergence (a step above the crawl's limit)".into(),
+                }));
+            }
+            self.inner.step(s)
+        }
+        fn timing(&self) -> Timing {
+            self.inner.timing()
+        }
+        fn solver(&self) -> SolverFacts {
+            self.inner.solver()
+        }
+    }
+
+    fn bar() -> crate::model::Model {
+        crate::config::from_str(
+            "[analysis]\nkind = \"static\"\nt_end = 1.0\ndt = 0.01\nvtk_every = 0\n\
+             dt_min = 1e-12\nmax_cuts = 40\n\
+             [materials.steel]\nmodel = \"elastic\"\nE = 210e9\nnu = 0.3\nrho = 7850.0\n\
+             [[bodies]]\nname = \"bar\"\nmaterial = \"steel\"\nthickness = 0.1\n\
+             mesh = { kind = \"rectangle\", size = [1.0, 0.1], divisions = [4, 1] }\n\
+             [[supports]]\nset = \"bar.left\"\nfix = [\"x\", \"y\"]\n\
+             [[prescribed]]\nset = \"bar.right\"\ncomponent = \"x\"\nvalue = 1e-4\n\
+             function = { kind = \"ramp\", t0 = 0.0, t1 = 1.0 }\n",
+            std::path::Path::new("."),
+        )
+        .unwrap()
+    }
+
+    fn run(limit: f64) -> (Result<()>, State) {
+        let model = bar();
+        let mut i = Crawling {
+            inner: crate::time::statics::Statics::new(&model, crate::linsolve::Backend::Faer)
+                .unwrap(),
+            limit,
+        };
+        let mut s = Integrator::initial_state(&mut i).unwrap();
+        let r = march(&mut i, &mut s, StepControl::of(&model), |_, _, _| Ok(()));
+        (r, s)
+    }
+
+    #[test]
+    fn a_run_that_crawls_at_its_floor_stops_as_stalled() {
+        // Steps converge only below 1e-7 of the load: the rest would take 1e7 steps
+        // against 100 planned. The run stops after the stretch, naming why.
+        let (r, s) = run(1e-9);
+        let e = r.unwrap_err().to_string();
+        assert!(
+            e.contains("stalled") && e.contains("above the crawl's limit"),
+            "{e}"
+        );
+        assert!(s.step < 2 * STALL_STRETCH, "{} steps", s.step);
+        // A run held at a quarter of its step for the whole way is slow, not
+        // stalled: 400 steps, 4x the plan, and it completes.
+        let (r, s) = run(0.0026);
+        r.unwrap();
+        assert!((s.t - 1.0).abs() < 1e-9 && s.step > 300, "{} steps", s.step);
+    }
 }
