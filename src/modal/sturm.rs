@@ -120,6 +120,7 @@ pub(super) fn search(
         }
     }
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let all = pairs.clone();
     if s.nearest {
         // The `count` nearest σ: an interval of the spectrum around it.
         while pairs.len() > s.count {
@@ -132,6 +133,15 @@ pub(super) fn search(
         }
     } else {
         pairs.truncate(s.count);
+    }
+    // A count that cuts between the copies of a repeated eigenvalue keeps them all:
+    // which copy would be dropped is round-off, and a repeated mode is one mode
+    // shape space (a square section's two bending modes), not one of its vectors.
+    if let (Some(lo), Some(hi)) = (pairs.first().map(|p| p.0), pairs.last().map(|p| p.0)) {
+        pairs = all
+            .into_iter()
+            .filter(|p| p.0 >= lo - margin(lo) && p.0 <= hi + margin(hi))
+            .collect();
     }
     let first_number = if s.nearest {
         s.below_sigma + 1 - pairs.iter().filter(|p| p.0 < s.sigma).count()
