@@ -61,6 +61,13 @@ pub fn mark_failed(path: &Path, message: &str) {
         .unwrap_or_else(|| serde_json::json!({}));
     v["status"] = super::summary::RunStatus::Failed.as_str().into();
     v["error"] = message.into();
+    // The counters of the last refresh may lag the history by thousands of steps:
+    // the summary describes the history's last row (whole: its writes hold the
+    // lock the caller holds or that no other writer takes any more).
+    if let Some((steps, t)) = last_row(&path.with_file_name("history.csv")) {
+        v["steps"] = steps.into();
+        v["t_end"] = t.into();
+    }
     if let Ok(text) = serde_json::to_string_pretty(&v) {
         let _ = std::fs::create_dir_all(path.parent().unwrap_or(Path::new(".")));
         let tmp = path.with_extension("json.failed");
@@ -68,4 +75,22 @@ pub fn mark_failed(path: &Path, message: &str) {
             let _ = std::fs::rename(&tmp, path);
         }
     }
+}
+
+/// The step count and time of a `history.csv`'s last row (rows after the header and
+/// the initial state's), if it has one.
+fn last_row(path: &Path) -> Option<(usize, f64)> {
+    use std::io::BufRead;
+    let file = std::fs::File::open(path).ok()?;
+    let mut rows = 0usize;
+    let mut last = String::new();
+    for line in std::io::BufReader::new(file).lines() {
+        let line = line.ok()?;
+        if !line.is_empty() {
+            rows += 1;
+            last = line;
+        }
+    }
+    let t: f64 = last.split(',').next()?.trim().parse().ok()?;
+    Some((rows.checked_sub(2)?, t))
 }

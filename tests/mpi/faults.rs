@@ -89,6 +89,9 @@ fn failed_with_valid_files(out: &Path, reason: &str) {
     assert!(error.contains(reason), "{error}");
     let (_, rows) = history(out);
     assert!(rows.len() > 20 && rows.len() < 2001, "{} rows", rows.len());
+    // The summary describes the history's last row, not its last refresh.
+    assert_eq!(s["steps"].as_u64(), Some(rows.len() as u64 - 1), "{s}");
+    assert_eq!(s["t_end"].as_f64(), Some(rows[rows.len() - 1][0]), "{s}");
     // The times are the steps' in order: nothing was cut or repeated.
     for (k, r) in rows.iter().enumerate() {
         assert!(
@@ -185,4 +188,22 @@ fn rank_estimates(text: &str) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+#[test]
+fn a_watchdog_timeout_out_of_range_is_refused_by_name() {
+    // 1.85e19 s overflowed the deadline's arithmetic: the process exited 101 and
+    // printed nothing. Every value out of range is refused, naming the variable.
+    let _machine = exclusive();
+    let sc = examples("scenarios/cantilever.toml");
+    for t in ["1.85e19", "1e300", "-1", "0", "nan", "soon"] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_rothe"))
+            .args(["check", sc.to_str().unwrap(), "--backend", "mumps"])
+            .env("ROTHE_MPI_TIMEOUT", t)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{t}: {e}");
+        assert!(e.contains("ROTHE_MPI_TIMEOUT") && e.contains(t), "{t}: {e}");
+    }
 }
