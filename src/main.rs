@@ -449,6 +449,13 @@ fn main() -> ExitCode {
         } => scenario
             .overrides()
             .and_then(|base| {
+                if let Some(w) = rothe::study::compare::replaced_scheme(
+                    &scenario.scenario,
+                    &base,
+                    &implicit_scheme,
+                )? {
+                    eprintln!("warning: {w}");
+                }
                 rothe::study::compare::plan(&scenario.scenario, &base, &implicit_scheme)
             })
             .and_then(|plan| sweep.execute(&plan)),

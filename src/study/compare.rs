@@ -37,6 +37,31 @@ pub fn plan(scenario: &Path, base: &Overrides, implicit_scheme: &str) -> Result<
     })
 }
 
+/// What `rothe compare` replaces of the scenario, as a warning: the implicit run
+/// takes `implicit_scheme` (the `--implicit-scheme` option) whatever scheme the
+/// scenario (with `base`) gives, and the explicit run central differences.
+pub fn replaced_scheme(
+    scenario: &Path,
+    base: &Overrides,
+    implicit_scheme: &str,
+) -> Result<Option<String>> {
+    let table = crate::config::merged_table(scenario, base)?;
+    let given = table
+        .get("analysis")
+        .and_then(|a| a.get("scheme"))
+        .and_then(|s| s.as_str())
+        .map(str::to_string);
+    Ok(given
+        .filter(|g| g != implicit_scheme && g != "central_difference")
+        .map(|g| {
+            format!(
+                "analysis.scheme = \"{g}\" is replaced: compare runs the implicit side by \
+             --implicit-scheme ({implicit_scheme}) and the explicit side by central \
+             differences; pass --implicit-scheme {g} to keep it"
+            )
+        }))
+}
+
 /// The implicit and explicit runs of `scenario` with ids `<prefix>implicit`,
 /// `<prefix>explicit` and labels `<label>implicit`, `<label>explicit`.
 pub fn pair(

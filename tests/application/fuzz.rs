@@ -764,3 +764,153 @@ fn command_line_overrides_give_a_model_or_an_error() {
             panic!("the override campaign failed: {e}")
         });
 }
+
+/// An override of the keys the last rounds added (schemes, predictor, error-controlled
+/// steps, Rayleigh targets, explicit step rules) with good and bad values.
+fn settings_case() -> impl Strategy<Value = String> {
+    prop_oneof![
+        prop_oneof![
+            Just("\"backward_euler\""),
+            Just("\"trapezoidal\""),
+            Just("\"generalized_alpha\""),
+            Just("\"central_difference\""),
+        ]
+        .prop_map(|v| format!("analysis.scheme={v}")),
+        prop_oneof![Just("\"none\""), Just("\"stabilised\"")]
+            .prop_map(|v| format!("analysis.contact_predictor={v}")),
+        prop_oneof![
+            Just("0.0"),
+            Just("0.5"),
+            Just("0.8"),
+            Just("1.0"),
+            Just("2.0")
+        ]
+        .prop_map(|v| format!("analysis.rho_inf={v}")),
+        prop_oneof![
+            Just("{ tolerance = 1e-3 }"),
+            Just("{ tolerance = 1e-5, dt_min = 1e-9 }"),
+            Just("{ tolerance = 0.0 }"),
+            Just("{ tolerance = 1e-4, dt_max = 1e-300 }"),
+        ]
+        .prop_map(|v| format!("analysis.adaptive={v}")),
+        prop_oneof![
+            Just("{ ratio = 0.02, modes = [1, 2] }"),
+            Just("{ ratio = 0.05, modes = [1, 3] }"),
+            Just("{ ratio = 0.02, frequencies = [100.0, 2000.0] }"),
+            Just("{ ratio = 0.02, frequencies = [1e300, 1e300] }"),
+            Just("{ ratio = 0.02, modes = [0, 2] }"),
+            Just("{ ratio = 2.0, modes = [1, 2] }"),
+        ]
+        .prop_map(|v| format!("analysis.damping={v}")),
+        prop_oneof![Just("\"element\""), Just("\"eigen\"")]
+            .prop_map(|v| format!("analysis.critical_step={v}")),
+        prop_oneof![Just("1e-6"), Just("5e-6"), Just("1e-5"), Just("1e-3")]
+            .prop_map(|v| format!("analysis.dt={v}")),
+        prop_oneof![Just("\"lumped\""), Just("\"consistent\"")]
+            .prop_map(|v| format!("analysis.mass={v}")),
+    ]
+}
+
+#[test]
+fn the_last_rounds_settings_run_right_or_are_refused() {
+    // Whole runs (in memory, 2e-4 s of the scenario) under random combinations of
+    // the settings above: each is refused with a message, fails with a message, or
+    // completes with a finite ledger that passes the checks that bind it. Never a
+    // panic, never a `completed` run with E_kin + E_el beyond its supply under
+    // central differences, never a material dissipation above the internal work.
+    std::panic::set_hook(Box::new(|_| {}));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scenarios = [
+        "examples/scenarios/cantilever.toml",
+        "examples/contact/block_resting.toml",
+        "examples/contact/bars_impact.toml",
+        "examples/solid/cantilever.toml",
+    ];
+    let mut config = Config {
+        cases: 60,
+        failure_persistence: None,
+        ..Config::default()
+    };
+    if std::env::var_os("PROPTEST_RNG_SEED").is_none() {
+        config.rng_seed = proptest::test_runner::RngSeed::Fixed(0x5eed_0006);
+    }
+    let mut runner = TestRunner::new(config);
+    let strategy = (
+        0..scenarios.len(),
+        proptest::collection::vec(settings_case(), 1..4),
+    );
+    let outcomes = std::sync::Mutex::new([0usize; 3]);
+    runner
+        .run(&strategy, |(file, sets)| {
+            let path = root.join(scenarios[file]);
+            let outcome = catch_unwind(AssertUnwindSafe(|| -> Result<usize, String> {
+                let mut ov = rothe::config::Overrides::none()
+                    .set("analysis.t_end=2e-4")
+                    .and_then(|o| o.set("analysis.vtk_every=0"))
+                    .map_err(|e| e.to_string())?;
+                for spec in &sets {
+                    ov = ov.set(spec).map_err(|e| e.to_string())?;
+                }
+                let opts = LoadOptions {
+                    memory_limit: Some(LIMIT),
+                    allow_unstable: false,
+                    distributed_factor: false,
+                };
+                let model = match rothe::config::load_with_overrides(&path, &opts, &ov) {
+                    Ok(m) => m,
+                    Err(e) if !e.to_string().is_empty() => return Ok(0),
+                    Err(_) => return Err("an empty refusal".into()),
+                };
+                let mut run = rothe::run::RunOptions::new("", Backend::Faer);
+                run.memory_limit = Some(LIMIT);
+                run.hooks.no_files = true;
+                match rothe::run::run_kept(&model, &run) {
+                    Err(e) if !e.to_string().is_empty() => Ok(1),
+                    Err(_) => Err("an empty error".into()),
+                    Ok((s, _)) => {
+                        let e = &s.energy;
+                        if !(e.kinetic.is_finite() && e.elastic.is_finite()) {
+                            return Err(format!("completed with a non-finite ledger: {e:?}"));
+                        }
+                        if !s.checks.dissipation_within_internal_work.holds
+                            || !s.checks.dissipation_within_supplied_energy.holds
+                        {
+                            return Err(format!("completed past its checks: {:?}", s.checks));
+                        }
+                        if model.analysis.time.scheme == TimeScheme::CentralDifference
+                            && model.analysis.time.kind == AnalysisKind::Dynamic
+                            && !s.checks.energy_within_supplied_energy.holds
+                        {
+                            return Err(format!("explicit run gained energy: {:?}", s.checks));
+                        }
+                        Ok(2)
+                    }
+                }
+            }));
+            match outcome {
+                Ok(Ok(k)) => {
+                    outcomes.lock().unwrap()[k] += 1;
+                    Ok(())
+                }
+                Ok(Err(why)) => Err(TestCaseError::fail(format!(
+                    "{}: {sets:?}: {why}",
+                    scenarios[file]
+                ))),
+                Err(p) => Err(TestCaseError::fail(format!(
+                    "{}: {sets:?}: panic: {}",
+                    scenarios[file],
+                    rothe::run::panic_message(p.as_ref())
+                ))),
+            }
+        })
+        .unwrap_or_else(|e| {
+            eprintln!("{e}");
+            panic!("the campaign failed: {e}")
+        });
+    let [refused, failed, completed] = *outcomes.lock().unwrap();
+    eprintln!("refused {refused}, failed {failed}, completed {completed}");
+    assert!(
+        refused > 0 && completed > 0,
+        "the campaign reaches both outcomes"
+    );
+}

@@ -339,3 +339,39 @@ fn steps_at_round_off_converge_whatever_the_active_set_does() {
         assert_eq!(summary(&out)["status"], "completed");
     }
 }
+
+#[test]
+fn compare_says_which_scheme_it_replaces() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(
+        dir.path(),
+        "c.toml",
+        &cantilever("dt = 1.0e-5\nscheme = \"trapezoidal\"\n")
+            .replace("t_end = 2.0e-3", "t_end = 1.0e-4"),
+    );
+    let out = dir.path().join("cmp");
+    let (ok, _, err) = rothe(&[
+        "compare",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: analysis.scheme = \"trapezoidal\" is replaced")
+            && err.contains("--implicit-scheme trapezoidal"),
+        "{err}"
+    );
+    let out = dir.path().join("kept");
+    let (ok, _, err) = rothe(&[
+        "compare",
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--implicit-scheme",
+        "trapezoidal",
+    ]);
+    assert!(ok && !err.contains("is replaced"), "{err}");
+}
