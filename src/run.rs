@@ -478,7 +478,7 @@ fn integrate<I: Integrator>(
         match m {
             Marched::Step(report) => {
                 counts.add(report.iterations);
-                if s.step % PROGRESS_EVERY == 0 {
+                if s.step.is_multiple_of(PROGRESS_EVERY) {
                     let mut line = counts.progress(&integrator.solver());
                     if adaptive.is_some() {
                         let r = adapted.get();

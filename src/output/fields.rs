@@ -94,7 +94,7 @@ impl FieldReader {
     pub fn records(&self) -> (u64, bool) {
         let record = 8 * (self.n as u64 + 1);
         let body = self.len.saturating_sub(16);
-        (body / record, body % record == 0)
+        (body / record, body.is_multiple_of(record))
     }
 
     /// For the file of a run that completed: whole records only, as many as `states`,

@@ -66,7 +66,7 @@ impl Cadence {
     /// Whether the state of `step` at `t` gets a frame.
     pub fn due(&self, step: usize, t: f64) -> bool {
         match *self {
-            Cadence::Steps(k) => k > 0 && step % k == 0,
+            Cadence::Steps(k) => k > 0 && step.is_multiple_of(k),
             Cadence::Time { every, next } => t >= next - 1e-9 * every,
         }
     }

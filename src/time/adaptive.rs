@@ -157,7 +157,7 @@ impl std::fmt::Display for AdaptivePlan {
 /// multiple of its size and not longer than `room` ticks (`room ≥ 1`).
 fn nested(n: u64, want: u32, room: u64) -> u32 {
     let mut j = want;
-    while j > 0 && (n % (1u64 << j) != 0 || (1u64 << j) > room) {
+    while j > 0 && (!n.is_multiple_of(1u64 << j) || (1u64 << j) > room) {
         j -= 1;
     }
     j
