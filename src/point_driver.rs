@@ -176,6 +176,23 @@ fn check(p: &PathSpec) -> Result<()> {
     crate::config::finite("path.amplitude", &[p.amplitude])?;
     crate::config::finite("path.ratio", &[p.ratio])?;
     crate::config::check_function("path.function", &p.function)?;
+    if p.kind != PathKind::Table {
+        // The other kinds drive one component by `amplitude` and `function`: a table
+        // given beside them would be ignored.
+        for (k, given) in [
+            ("times", !p.times.is_empty()),
+            ("strains", !p.strains.is_empty()),
+        ] {
+            if given {
+                return Err(Error::config(
+                    format!("path.{k}"),
+                    "is read by a table path only (`kind = \"table\"`); this path is \
+                     driven by `amplitude` and `function`: remove the key, or make the \
+                     path a table",
+                ));
+            }
+        }
+    }
     if p.kind == PathKind::Table {
         // The table prescribes every component itself: the keys of the other kinds
         // would be ignored.

@@ -113,7 +113,7 @@ def _jsonable(v: Any, field: str = "scenario") -> Any:
     if isinstance(v, Mapping):
         return {str(k): _jsonable(x, f"{field}.{k}") for k, x in v.items()}
     if isinstance(v, (list, tuple)):
-        return [_jsonable(x, field) for x in v]
+        return [_jsonable(x, f"{field}[{i}]") for i, x in enumerate(v)]
     if isinstance(v, np.ndarray):
         return _jsonable(v.tolist(), field)
     if isinstance(v, (bool, np.bool_)):
@@ -121,7 +121,12 @@ def _jsonable(v: Any, field: str = "scenario") -> Any:
     if isinstance(v, (int, np.integer)):
         return int(v)
     if isinstance(v, (float, np.floating)):
-        return float(v)
+        x = float(v)
+        if not math.isfinite(x):
+            # JSON, which carries the dict to the validation, has no NaN or
+            # infinity; no number of a scenario may be one anyway.
+            raise Error(f"{field}: {x} is not a finite number")
+        return x
     if isinstance(v, (str, os.PathLike)):
         return os.fspath(v)
     raise Error(f"{field}: a value of type {type(v).__name__} has no TOML form")

@@ -8,28 +8,10 @@ import pytest
 
 import rothe
 
-BAR = """
-[analysis]
-t_end = 2.0e-5
-dt = 1.0e-6
-vtk_every = 0
-[materials.steel]
-model = "elastic"
-E = 210e9
-nu = 0.0
-rho = 7850.0
-[[bodies]]
-name = "bar"
-material = "steel"
-thickness = 0.05
-mesh = { kind = "rectangle", size = [1.0, 0.05], divisions = [20, 1] }
-[[supports]]
-set = "bar.left"
-fix = ["x"]
-[[supports]]
-set = "bar.all"
-fix = ["y"]
-"""
+from test_rothe import AXIAL_BAR
+
+# The axial bar of the modes test, 20 steps.
+BAR = AXIAL_BAR.replace("t_end = 1.0e-4", "t_end = 2.0e-5\nvtk_every = 0")
 
 
 def test_an_empty_output_path_is_refused_and_writes_nothing(tmp_path, monkeypatch):
@@ -101,3 +83,14 @@ def test_two_threads_into_one_directory_do_not_mix(tmp_path):
 def test_counts_out_of_range_name_their_argument(tmp_path, call, name):
     with pytest.raises(rothe.Error, match=name):
         call(rothe.loads(BAR), tmp_path / "o")
+
+
+def test_a_non_finite_number_in_a_dict_is_named_by_its_field():
+    d = rothe.loads(BAR).to_dict()
+    d["materials"]["steel"]["E"] = float("nan")
+    with pytest.raises(rothe.Error, match=r"materials\.steel\.E: nan"):
+        rothe.from_dict(d)
+    d = rothe.loads(BAR).to_dict()
+    d["bodies"][0]["mesh"]["size"] = [1.0, float("inf")]
+    with pytest.raises(rothe.Error, match=r"bodies\[0\]\.mesh\.size\[1\]: inf"):
+        rothe.from_dict(d)

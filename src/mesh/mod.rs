@@ -88,6 +88,8 @@ pub enum Shape {
     Degenerate,
     /// The Jacobian changes sign: a non-convex or self-intersecting quadrilateral.
     Distorted,
+    /// Coordinates so large that its area (volume) overflows double precision.
+    OutOfRange,
 }
 
 impl Shape {
@@ -98,6 +100,11 @@ impl Shape {
             .iter()
             .map(|&[a, b]| distance(x[a], x[b]))
             .fold(0.0, f64::max);
+        // An edge whose square (cube, in a solid) overflows: no area, Jacobian or
+        // matrix of the element is a number (coordinates of 1e200 m).
+        if !size.is_finite() || !size.powi(kind.dim().max(2) as i32).is_finite() {
+            return Shape::OutOfRange;
+        }
         if kind == ElementKind::Bar2 {
             return if size > 0.0 {
                 Shape::Valid
@@ -139,6 +146,10 @@ impl Shape {
             }
             Shape::Distorted => {
                 "distorted: its Jacobian changes sign (a non-convex or self-intersecting element)"
+            }
+            Shape::OutOfRange => {
+                "out of range: its coordinates are so large that its area (volume) \
+                 overflows double precision (are the coordinates in metres?)"
             }
         }
     }

@@ -327,6 +327,17 @@ fn mesh_errors_name_the_file_the_body_and_the_element() {
         err.contains("supports[0].set") && err.contains("node set `beam.empty` is empty"),
         "{err}"
     );
+    // Coordinates of 1e200 m: the square's area overflows, which is said as such
+    // (it was called "degenerate").
+    let huge = gmsh().replace("\n1 0 0\n", "\n1e200 0 0\n");
+    assert_ne!(huge, gmsh());
+    std::fs::write(dir.path().join("sq.msh"), huge).unwrap();
+    let sc = scenario(dir.path(), "h.toml", &text);
+    let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("out of range") && !err.contains("degenerate"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -385,6 +396,15 @@ fn a_material_path_with_bad_numbers_is_refused_and_a_good_one_streams() {
         (
             text.replace("dt = 1.0e-3", "dt = 1.0e-300"),
             vec!["path.dt", "steps"],
+        ),
+        // A uniaxial path given a table: refused, not ignored.
+        (
+            text.replace("dt = 1.0e-3", "dt = 1.0e-3\ntimes = [0.0, 1.0]"),
+            vec!["path.times", "table path only"],
+        ),
+        (
+            text.replace("dt = 1.0e-3", "dt = 1.0e-3\nstrains = [[0.0, 0.0, 0.0]]"),
+            vec!["path.strains", "table path only"],
         ),
     ] {
         let f = dir.path().join("bad.toml");

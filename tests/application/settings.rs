@@ -8,6 +8,21 @@ use std::path::Path;
 
 use crate::common::{rothe, scenario};
 
+/// `rothe CMD SCENARIO --out OUT --quiet EXTRA…`: whether it succeeded, and its
+/// standard error.
+fn quiet(cmd: &str, sc: &Path, out: &Path, extra: &[&str]) -> (bool, String) {
+    let mut args = vec![
+        cmd,
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    let (ok, _, err) = rothe(&args);
+    (ok, err)
+}
+
 fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
@@ -88,15 +103,7 @@ fn an_unstable_explicit_run_is_never_completed() {
         "{err}"
     );
     let out = dir.path().join("default");
-    let (ok, _, err) = rothe(&[
-        "run",
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--set",
-        "analysis.t_end=2e-4",
-    ]);
+    let (ok, err) = quiet("run", &sc, &out, &["--set", "analysis.t_end=2e-4"]);
     assert!(ok, "{err}");
     let s = summary(&out);
     assert_eq!(s["status"], "completed");
@@ -104,16 +111,12 @@ fn an_unstable_explicit_run_is_never_completed() {
     // Above the stable step on purpose: the energy grows past the supply and the
     // run ends failed at that step (before: `completed` with E_kin = 4e206 J).
     let out = dir.path().join("unstable");
-    let (ok, _, err) = rothe(&[
+    let (ok, err) = quiet(
         "run",
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--allow-unstable",
-        "--set",
-        "analysis.dt=7e-6",
-    ]);
+        &sc,
+        &out,
+        &["--allow-unstable", "--set", "analysis.dt=7e-6"],
+    );
     assert!(!ok, "{err}");
     assert!(
         err.contains("energy_within_supplied_energy") && err.contains("unstable"),
@@ -295,13 +298,7 @@ fn steps_at_round_off_converge_whatever_the_active_set_does() {
         for scheme in ["trapezoidal", "generalized_alpha"] {
             let sc = scenario(dir.path(), "cube.toml", &cube_on_a_plane(v, scheme));
             let out = dir.path().join(format!("{scheme}_{v}"));
-            let (ok, _, err) = rothe(&[
-                "run",
-                sc.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-                "--quiet",
-            ]);
+            let (ok, err) = quiet("run", &sc, &out, &[]);
             assert!(ok, "{v} m/s, {scheme}: {err}");
             let s = summary(&out);
             assert_eq!(s["steps"], 200, "{v} m/s, {scheme}");
@@ -350,13 +347,7 @@ fn compare_says_which_scheme_it_replaces() {
             .replace("t_end = 2.0e-3", "t_end = 1.0e-4"),
     );
     let out = dir.path().join("cmp");
-    let (ok, _, err) = rothe(&[
-        "compare",
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let (ok, err) = quiet("compare", &sc, &out, &[]);
     assert!(ok, "{err}");
     assert!(
         err.contains("warning: analysis.scheme = \"trapezoidal\" is replaced")
@@ -364,14 +355,6 @@ fn compare_says_which_scheme_it_replaces() {
         "{err}"
     );
     let out = dir.path().join("kept");
-    let (ok, _, err) = rothe(&[
-        "compare",
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-        "--implicit-scheme",
-        "trapezoidal",
-    ]);
+    let (ok, err) = quiet("compare", &sc, &out, &["--implicit-scheme", "trapezoidal"]);
     assert!(ok && !err.contains("is replaced"), "{err}");
 }
