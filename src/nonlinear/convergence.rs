@@ -10,6 +10,9 @@ pub struct ConstraintStatus {
     pub complementarity: f64,
     /// Whether the active set differs from the previous iterate's.
     pub active_set_changed: bool,
+    /// A constraint that entered or left the active set, as `(pair, slave node)`,
+    /// for the message of a step whose contact did not settle.
+    pub changed_at: Option<(usize, usize)>,
 }
 
 impl ConstraintStatus {
@@ -18,6 +21,7 @@ impl ConstraintStatus {
         penetration: 0.0,
         complementarity: 0.0,
         active_set_changed: false,
+        changed_at: None,
     };
 }
 

@@ -119,6 +119,8 @@ pub enum Outcome {
         history: Vec<f64>,
         /// The free dof with the largest residual and that residual (N).
         worst: Option<(usize, f64)>,
+        /// What the constraints reported at the last evaluation.
+        constraints: ConstraintStatus,
     },
     /// The effective matrix lost positive definiteness.
     NotPositiveDefinite {
@@ -293,6 +295,7 @@ where
                     iterations,
                     history: scratch.history.clone(),
                     worst,
+                    constraints,
                 });
             }
             // The contraction of the residual itself: its relative value can stay

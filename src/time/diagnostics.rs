@@ -18,6 +18,7 @@ pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> Str
             iterations,
             history,
             worst,
+            constraints,
         } => {
             let worst_text = worst
                 .map(|(d, r)| {
@@ -33,8 +34,9 @@ pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> Str
                 .and_then(|&(d, _)| unheld_load(model, d))
                 .unwrap_or_default();
             format!(
-                "no convergence {when} after {iterations} iterations; relative residuals {}{worst_text}{unheld}",
-                residuals(history)
+                "no convergence {when} after {iterations} iterations; relative residuals {}{worst_text}{unheld}{}",
+                residuals(history),
+                contact_note(model, constraints)
             )
         }
         Outcome::NotPositiveDefinite { dof, message } => format!(
@@ -56,6 +58,34 @@ pub(crate) fn describe(model: &Model, outcome: &Outcome, t1: f64, h: f64) -> Str
             dof.map(|d| format!(" at {}", model.describe_dof(d)))
                 .unwrap_or_default()
         ),
+    }
+}
+
+/// What the contact reported at the last evaluation of a failed loop: the
+/// constraint whose membership kept changing (pair, node), the penetration and the
+/// open gap under force.
+fn contact_note(model: &Model, c: &crate::nonlinear::ConstraintStatus) -> String {
+    let mut parts = Vec::new();
+    if let Some((pair, node)) = c.changed_at {
+        let name = model.contacts.get(pair).map_or("?", |p| p.name.as_str());
+        parts.push(format!(
+            "the active set of pair `{name}` still changed at its slave {}",
+            model.describe_node(node)
+        ));
+    }
+    if c.penetration > 0.0 {
+        parts.push(format!("penetration {:.3e} m", c.penetration));
+    }
+    if c.complementarity > 0.0 {
+        parts.push(format!(
+            "a force across an open gap of {:.3e} m",
+            c.complementarity
+        ));
+    }
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!("; contact: {}", parts.join(", "))
     }
 }
 

@@ -255,6 +255,7 @@ mod tests {
                         iterations: 30,
                         history: vec![1.0; 31],
                         worst: None,
+                        constraints: Default::default(),
                     },
                     message: "no convergence (a step above the crawl's limit)".into(),
                 }));

@@ -250,6 +250,28 @@ fn every_key_a_run_does_not_read_is_named() {
 }
 
 #[test]
+fn a_floor_below_what_the_time_resolves_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(
+        dir.path(),
+        "c.toml",
+        &cantilever("dt = 1.0e-5\ndt_min = 1.0e-25\n"),
+    );
+    let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("analysis.dt_min") && err.contains("leaves t unchanged"),
+        "{err}"
+    );
+    let sc = scenario(
+        dir.path(),
+        "ok.toml",
+        &cantilever("dt = 1.0e-5\ndt_min = 1.0e-15\n"),
+    );
+    let (ok, _, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(ok, "{err}");
+}
+
+#[test]
 fn environment_variables_out_of_range_are_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let sc = scenario(dir.path(), "c.toml", &cantilever("dt = 1.0e-5\n"));

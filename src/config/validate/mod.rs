@@ -806,6 +806,19 @@ fn analysis(a: &super::AnalysisSpec) -> Result<()> {
                 format!("{m:?} s exceeds the step dt = {h:?} s: no step could be taken"),
             ));
         }
+        // A floor below the resolution of the time itself: near t_end a step of it
+        // leaves t unchanged, so a run cut to it could never get on.
+        if a.t_end / m > 2f64.powi(53) {
+            return Err(Error::config(
+                "analysis.dt_min",
+                format!(
+                    "{m:?} s is below what the time can resolve near t_end = {:?} s (a \
+                     step of it leaves t unchanged); give at least {:.1e} s",
+                    a.t_end,
+                    a.t_end * 2f64.powi(-52)
+                ),
+            ));
+        }
     }
 
     Ok(())

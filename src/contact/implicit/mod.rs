@@ -56,6 +56,23 @@ fn slaves(keys: &[Key]) -> impl Iterator<Item = Slave> + '_ {
     })
 }
 
+/// The first slave (in key order) pressed in one of two active sets and not in the
+/// other.
+fn first_change(previous: &[Key], current: &[Key]) -> Option<Slave> {
+    let (mut a, mut b) = (slaves(previous).peekable(), slaves(current).peekable());
+    loop {
+        match (a.peek().copied(), b.peek().copied()) {
+            (None, None) => return None,
+            (Some(x), None) | (None, Some(x)) => return Some(x),
+            (Some(x), Some(y)) if x == y => {
+                a.next();
+                b.next();
+            }
+            (Some(x), Some(y)) => return Some(if x < y { x } else { y }),
+        }
+    }
+}
+
 /// How far (relative to the largest predicted gap) a row left out of an active-set
 /// guess may end up penetrating for the guess to stand: Clarabel's own tolerance.
 const GUESS_GAP_TOLERANCE: f64 = 1e-9;
@@ -559,11 +576,13 @@ impl Correction for ContactCorrection<'_> {
                 open_under_force = open_under_force.max(c.gap);
             }
         }
+        let changed_at =
+            first_change(&self.active.previous, &self.active.current).map(|s| (s.pair, s.node));
         ConstraintStatus {
             penetration,
             complementarity: open_under_force,
-            active_set_changed: !slaves(&self.active.previous).eq(slaves(&self.active.current))
-                || dropped,
+            active_set_changed: changed_at.is_some() || dropped,
+            changed_at,
         }
     }
 
@@ -713,5 +732,33 @@ impl Correction for ContactCorrection<'_> {
         self.active.current.sort_unstable();
         rhs.copy_from_slice(&self.work.delta0);
         Ok(Corrected::Ok)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::state::Target;
+
+    fn key(pair: usize, node: usize, facet: usize) -> Key {
+        Key {
+            slave: Slave::new(pair, 0, node),
+            target: Target::Facet(facet),
+        }
+    }
+
+    #[test]
+    fn the_first_change_of_an_active_set_names_its_slave() {
+        let a = [key(0, 3, 1), key(0, 5, 2), key(1, 2, 0)];
+        // The same slaves on other facets: no change of membership.
+        let moved = [key(0, 3, 2), key(0, 5, 2), key(1, 2, 4)];
+        assert_eq!(first_change(&a, &moved), None);
+        // Node 5 left; node 4 of pair 0 entered; one added at the end.
+        let left = [key(0, 3, 1), key(1, 2, 0)];
+        assert_eq!(first_change(&a, &left), Some(Slave::new(0, 0, 5)));
+        let entered = [key(0, 3, 1), key(0, 4, 1), key(0, 5, 2), key(1, 2, 0)];
+        assert_eq!(first_change(&a, &entered), Some(Slave::new(0, 0, 4)));
+        let added = [key(0, 3, 1), key(0, 5, 2), key(1, 2, 0), key(1, 7, 0)];
+        assert_eq!(first_change(&a, &added), Some(Slave::new(1, 0, 7)));
     }
 }
