@@ -136,7 +136,16 @@ pub fn volume(model: &Model) -> Volume {
     let row_bytes = (16 + 2 * probes) as u64 * 20;
     let history = (steps + 1, (steps as u64 + 1) * row_bytes);
     let vtk_files = match a.output.vtk_every_time {
-        Some(every) => (a.time.t_end / every + 1e-9).floor() as usize + 1,
+        // At most one file per step: frames closer than the steps are written at the
+        // steps (an error-controlled run lands its steps on them, down to dt_min).
+        Some(every) => {
+            let frames = (a.time.t_end / every + 1e-9).floor() + 1.0;
+            let most_steps = match a.time.adaptive {
+                Some(ad) => (a.time.t_end / ad.dt_min).ceil(),
+                None => steps as f64,
+            };
+            frames.min(most_steps + 1.0) as usize
+        }
         None => steps.checked_div(a.output.vtk_every).map_or(0, |k| k + 1),
     };
     // Points (3 doubles), connectivity, two vector fields, cell fields, as ASCII.

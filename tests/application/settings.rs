@@ -272,6 +272,21 @@ fn a_floor_below_what_the_time_resolves_is_refused() {
 }
 
 #[test]
+fn the_plan_counts_one_vtk_file_per_step_at_most() {
+    // Frames every 1e-9 s on steps of 1e-5 s: the run writes one file per step
+    // (201), which the plan now says (it said 2 000 001).
+    let dir = tempfile::tempdir().unwrap();
+    let sc = scenario(
+        dir.path(),
+        "c.toml",
+        &cantilever("dt = 1.0e-5\nvtk_every_time = 1.0e-9\n"),
+    );
+    let (ok, out, err) = rothe(&["check", sc.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.contains("201 VTK files"), "{out}");
+}
+
+#[test]
 fn environment_variables_out_of_range_are_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let sc = scenario(dir.path(), "c.toml", &cantilever("dt = 1.0e-5\n"));
