@@ -361,17 +361,19 @@ pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
 }
 
 /// The summary's view of a state and an integrator.
-fn fill<I: Integrator + ?Sized>(summary: &mut Summary, s: &State, integrator: &I, rec: &Recorder) {
+/// `floor` is the energy checks' round-off floor (J), computed once per run.
+fn fill<I: Integrator + ?Sized>(
+    summary: &mut Summary,
+    s: &State,
+    (integrator, floor): (&I, f64),
+    rec: &Recorder,
+) {
     let facts = integrator.solver();
     let timing = integrator.timing();
     summary.steps = s.step;
     summary.t_end = s.t;
     summary.energy = EnergySummary::from(&s.ledger);
-    summary.checks = checks_of(
-        integrator.model(),
-        s,
-        f64::EPSILON * crate::output::checks::reference_energy(integrator.model()),
-    );
+    summary.checks = checks_of(integrator.model(), s, floor);
     summary.probes = rec.probes().clone();
     summary.contact = rec.contact().clone();
     summary.timing.assembly_s = timing.assembly_s;
@@ -451,6 +453,8 @@ fn integrate<I: Integrator>(
     kept: &mut Kept,
 ) -> Result<()> {
     let mut s = integrator.initial_state()?;
+    // The energy checks' round-off floor, once per run (a pass over the elements).
+    let floor = f64::EPSILON * crate::output::checks::reference_energy(model);
     // The Gauss-point state of a step the VTK series writes, when `s` keeps it in
     // nodal fields.
     let output_points = |integrator: &I, s: &State, rec: &Recorder| {
@@ -462,7 +466,7 @@ fn integrate<I: Integrator>(
     rec.record(model, &snapshot(&s, built.as_deref(), 0, 0.0))?;
     let summary_path = (!opts.hooks.no_files).then(|| opts.out.join("summary.json"));
     let summary_path = summary_path.as_deref();
-    fill(summary, &s, integrator, rec);
+    fill(summary, &s, (integrator, floor), rec);
     write_summary(summary, summary_path)?;
     let mut last_write = Instant::now();
     let n_steps = model.analysis.n_steps();
@@ -471,7 +475,6 @@ fn integrate<I: Integrator>(
     let mut counts = Counts::default();
     let mut step_cuts = 0;
     let adaptive = AdaptiveControl::of(model);
-    let floor = f64::EPSILON * crate::output::checks::reference_energy(model);
     let energy_binds = energy_check_binds(model);
     let adapted = std::cell::Cell::new(crate::time::adaptive::AdaptiveReport::default());
     let observe = |integrator: &I, s: &State, m: Marched| {
@@ -508,7 +511,7 @@ fn integrate<I: Integrator>(
                 }
                 pb.set_position(((s.t / t_end) * n_steps as f64) as u64);
                 if on_cadence || last_write.elapsed() >= SUMMARY_EVERY {
-                    fill(summary, s, integrator, rec);
+                    fill(summary, s, (integrator, floor), rec);
                     counts.fill(summary, step_cuts);
                     if adaptive.is_some() {
                         summary.adaptive = Some(adapted.get());
@@ -571,7 +574,7 @@ fn integrate<I: Integrator>(
         }
     };
     pb.finish_and_clear();
-    fill(summary, &s, integrator, rec);
+    fill(summary, &s, (integrator, floor), rec);
     counts.fill(summary, step_cuts);
     if opts.hooks.keep {
         // The last state's fields, for the caller to read back.
