@@ -91,6 +91,9 @@ pub fn prepare(out: &Path, overwrite: bool) -> Result<OutputLock> {
                 ),
             ))
         }
+        // A file system without locks (some network mounts): the run goes on
+        // unguarded rather than not at all.
+        Err(std::fs::TryLockError::Error(e)) if e.kind() == std::io::ErrorKind::Unsupported => {}
         Err(std::fs::TryLockError::Error(e)) => return Err(Error::io(&lock_path, e)),
     }
     let lock = OutputLock { _file: file };
