@@ -183,7 +183,7 @@ impl Checks {
             let allowance = (TRAPEZOIDAL_ALLOWANCE * c.rhs.abs()).max(f64::MIN_POSITIVE);
             let suggested = h * allowance / excess.max(allowance);
             return Some((
-                self.failures().remove(0),
+                self.line(0),
                 format!(
                     "the materials dissipate more than the work of the internal forces, \
                      which no material can: the step ({h:.3e} s) is too coarse for the \
@@ -193,21 +193,9 @@ impl Checks {
                 ),
             ));
         }
-        let name = |c: &Check| {
-            let i = [
-                &self.dissipation_within_internal_work,
-                &self.dissipation_within_supplied_energy,
-                &self.energy_within_supplied_energy,
-            ]
-            .iter()
-            .take_while(|x| !std::ptr::eq(**x, c))
-            .filter(|x| !x.holds)
-            .count();
-            self.failures()[i].clone()
-        };
         if !self.dissipation_within_supplied_energy.holds {
             return Some((
-                name(&self.dissipation_within_supplied_energy),
+                self.line(1),
                 "more energy was dissipated than was supplied: the ledger's lines are \
                  inconsistent at this step (theory/energy.md)"
                     .into(),
@@ -215,7 +203,7 @@ impl Checks {
         }
         if energy_binds && !self.energy_within_supplied_energy.holds {
             return Some((
-                name(&self.energy_within_supplied_energy),
+                self.line(2),
                 format!(
                     "the bodies hold more energy than they were given: the scheme is \
                      unstable at this step ({h:.3e} s; an explicit step above the stable \
@@ -226,8 +214,8 @@ impl Checks {
         None
     }
 
-    /// The failed checks as `name: lhs > rhs` lines.
-    pub fn failures(&self) -> Vec<String> {
+    /// The checks in order with their names.
+    fn named(&self) -> [(&'static str, &Check); 3] {
         [
             (
                 "dissipation_within_internal_work (material dissipation <= E_int)",
@@ -242,10 +230,20 @@ impl Checks {
                 &self.energy_within_supplied_energy,
             ),
         ]
-        .iter()
-        .filter(|(_, c)| !c.holds)
-        .map(|(n, c)| format!("{n}: {:.6e} J > {:.6e} J", c.lhs, c.rhs))
-        .collect()
+    }
+
+    /// Check `i` (in [`Checks::named`]'s order) as a `name: lhs > rhs` line.
+    fn line(&self, i: usize) -> String {
+        let (n, c) = self.named()[i];
+        format!("{n}: {:.6e} J > {:.6e} J", c.lhs, c.rhs)
+    }
+
+    /// The failed checks as `name: lhs > rhs` lines.
+    pub fn failures(&self) -> Vec<String> {
+        (0..3)
+            .filter(|&i| !self.named()[i].1.holds)
+            .map(|i| self.line(i))
+            .collect()
     }
 }
 

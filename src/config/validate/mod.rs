@@ -529,10 +529,12 @@ fn rayleigh_is_finite(
 fn unread_keys(s: &super::Scenario, model: &Model) -> Vec<String> {
     let a = &s.analysis;
     let mut w = Vec::new();
+    // One warning per key, with the first reason found.
     let unread = |w: &mut Vec<String>, keys: &[&str], why: &str| {
         for key in keys {
-            if a.given.contains(*key) {
-                w.push(format!("analysis.{key} is not read: {why}"));
+            let head = format!("analysis.{key} is not read: ");
+            if a.given.contains(*key) && !w.iter().any(|x| x.starts_with(&head)) {
+                w.push(format!("{head}{why}"));
             }
         }
     };
@@ -550,7 +552,6 @@ fn unread_keys(s: &super::Scenario, model: &Model) -> Vec<String> {
                 "contact_predictor",
                 "critical_step",
                 "omega",
-                "viscoelastic_state",
             ],
             "a static analysis has no time scheme, inertia or damping",
         );
@@ -624,7 +625,6 @@ fn unread_keys(s: &super::Scenario, model: &Model) -> Vec<String> {
         );
     }
     if !explicit
-        && !statics
         && !model
             .materials
             .iter()
