@@ -1206,15 +1206,7 @@ fn run_history_and_summary(
     let dir = tempfile::tempdir().unwrap();
     let sc = scenario(dir.path(), "s.toml", text);
     let out = dir.path().join("out");
-    let mut args = vec![
-        "run",
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ];
-    args.extend_from_slice(extra);
-    let (ok, _, err) = rothe(&args);
+    let (ok, err) = crate::common::rothe_quiet("run", &sc, &out, extra);
     let columns = std::fs::read_to_string(out.join("history.csv"))
         .map(|h| columns(&h))
         .unwrap_or_default();

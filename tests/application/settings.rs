@@ -6,22 +6,7 @@
 
 use std::path::Path;
 
-use crate::common::{rothe, scenario};
-
-/// `rothe CMD SCENARIO --out OUT --quiet EXTRA…`: whether it succeeded, and its
-/// standard error.
-fn quiet(cmd: &str, sc: &Path, out: &Path, extra: &[&str]) -> (bool, String) {
-    let mut args = vec![
-        cmd,
-        sc.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ];
-    args.extend_from_slice(extra);
-    let (ok, _, err) = rothe(&args);
-    (ok, err)
-}
+use crate::common::{rothe, rothe_quiet as quiet, scenario};
 
 fn summary(out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()

@@ -227,6 +227,26 @@ pub fn rothe(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// `rothe CMD SCENARIO --out OUT --quiet EXTRA…`: whether it succeeded, and its
+/// standard error.
+pub fn rothe_quiet(
+    cmd: &str,
+    sc: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> (bool, String) {
+    let mut args = vec![
+        cmd,
+        sc.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    let (ok, _, err) = rothe(&args);
+    (ok, err)
+}
+
 /// Writes the scenario `text` to `dir/name` and returns its path.
 pub fn scenario(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
     let p = dir.join(name);
