@@ -563,6 +563,21 @@ pub enum Formulation {
     NodeToSegment,
 }
 
+/// The test functions of mortar's weighted gaps on the slave side
+/// (`contact.mortar_basis`, `theory/contact.md`, "The dual basis").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MortarBasis {
+    /// Biorthogonal to the slave's shape functions over each facet's covered part:
+    /// each weighted gap holds one slave node, so the rows of neighbouring slave
+    /// nodes do not couple through the slave side.
+    Dual,
+    /// The slave's own (linear, bilinear) shape functions (the default: every
+    /// figure of the theory's tables was measured with it).
+    #[default]
+    Standard,
+}
+
 /// A named contact pair: one side, or two (both ways), or a unilateral support.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactPair {
@@ -579,6 +594,8 @@ pub struct ContactPair {
     pub mu: f64,
     /// How the gaps are written.
     pub formulation: Formulation,
+    /// Mortar's slave-side test functions (read by mortar pairs only).
+    pub mortar_basis: MortarBasis,
     /// Central differences: weight `w` of the pre-impact velocity in the position
     /// update over the time to impact.
     pub position_weight: f64,

@@ -153,6 +153,11 @@ pub struct ContactSpec {
     /// or `node_to_segment`. Rigid lines and the explicit path are node to segment.
     #[serde(default)]
     pub formulation: Option<crate::model::Formulation>,
+    /// A mortar pair's slave-side test functions: `standard` (default, the slave's
+    /// shape functions) or `dual` (biorthogonal: each weighted gap holds one slave
+    /// node). Read by mortar pairs only.
+    #[serde(default)]
+    pub mortar_basis: Option<crate::model::MortarBasis>,
 }
 
 /// `analysis.damping`: Rayleigh's pair from a damping ratio at two frequencies.

@@ -81,6 +81,7 @@ pub fn detect(
                             slave_segments,
                             segments,
                             pair.radius,
+                            pair.mortar_basis,
                             &|n| x.at::<2>(n),
                             out,
                         );
@@ -102,6 +103,7 @@ pub fn detect(
                             faces,
                             tree,
                             pair.radius,
+                            pair.mortar_basis,
                             x,
                             out,
                         );

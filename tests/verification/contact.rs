@@ -464,6 +464,19 @@ fn friction_and_formulation_keys_are_validated() {
         (
             base.replace(
                 pair,
+                &format!("{pair}\nformulation = \"node_to_segment\"\nmortar_basis = \"dual\""),
+            ),
+            "contact[0].mortar_basis",
+            "mortar pairs only",
+        ),
+        (
+            explicit(&base.replace(pair, &format!("{pair}\nmortar_basis = \"standard\""))),
+            "contact[0].mortar_basis",
+            "mortar pairs only",
+        ),
+        (
+            base.replace(
+                pair,
                 "rigid_line = [[0.0, 0.0], [1.2, 0.0]]\nformulation = \"mortar\"",
             ),
             "contact[0].formulation",

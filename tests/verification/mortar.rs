@@ -72,6 +72,12 @@ formulation = "{formulation}"
 
 const P: f64 = 3.0e6;
 
+/// The value of a pair's `formulation` key that asks for mortar with the slave
+/// test functions `basis` (it closes the key's string and adds `mortar_basis`).
+pub(crate) fn mortar_with(basis: &str) -> String {
+    format!("mortar\"\nmortar_basis = \"{basis}")
+}
+
 /// The largest error of the element stresses against `σ_yy = −P`, `σ_xx = σ_xy =
 /// 0`, and of the interface pressures against `P`, both relative to `P`.
 fn patch(lower: usize, upper: usize, formulation: &str) -> (f64, f64) {
@@ -110,22 +116,28 @@ fn mortar_passes_the_contact_patch_test_on_non_matching_meshes() {
     // stresses are wrong where the meshes do not match: its error is reported and
     // must be far larger, which shows the test can fail.
     let mut worst_nts: f64 = 0.0;
-    for (lower, upper) in [(4, 3), (3, 4), (7, 3), (2, 5), (5, 5)] {
-        let (stress, pressure) = patch(lower, upper, "mortar");
+    for ((lower, upper), basis) in [(4, 3), (3, 4), (7, 3), (2, 5), (5, 5)]
+        .into_iter()
+        .flat_map(|c| ["standard", "dual"].map(|b| (c, b)))
+    {
+        let (stress, pressure) = patch(lower, upper, &mortar_with(basis));
         let (nts_stress, nts_pressure) = patch(lower, upper, "node_to_segment");
         eprintln!(
-            "lower {lower} / upper {upper}: mortar stress {stress:.2e} pressure {pressure:.2e}; \
+            "lower {lower} / upper {upper}: mortar ({basis}) stress {stress:.2e} pressure {pressure:.2e}; \
              node-to-segment stress {nts_stress:.2e} pressure {nts_pressure:.2e}"
         );
+        // The step stops at the iteration's relative tolerance (1e-8); the residual
+        // left reaches the stresses amplified by up to 3.4 on these meshes
+        // (theory/contact.md, "The dual basis"): 5 × the tolerance.
         assert!(
-            stress < 1e-8,
-            "mortar {lower}/{upper}: stress error {stress:e}"
+            stress < 5e-8,
+            "mortar ({basis}) {lower}/{upper}: stress error {stress:e}"
         );
         // The pressure is the force over the current covered length, which the
         // sideways expansion (ν P / E = 2e-5) lengthens.
         assert!(
             (pressure - 2.0e-5).abs() < 5e-8,
-            "mortar {lower}/{upper}: pressure error {pressure:e}"
+            "mortar ({basis}) {lower}/{upper}: pressure error {pressure:e}"
         );
         if lower != upper {
             worst_nts = worst_nts.max(nts_stress);

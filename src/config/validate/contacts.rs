@@ -11,7 +11,9 @@ use crate::config::{ContactSpec, MasterSpec, RigidPlaneSpec, Scenario};
 use crate::error::{Error, Result};
 use crate::geometry::distance;
 use crate::mesh::{Face, Mesh};
-use crate::model::{ContactPair, ContactSide, Formulation, Master, SlaveSurface, TimeScheme};
+use crate::model::{
+    ContactPair, ContactSide, Formulation, Master, MortarBasis, SlaveSurface, TimeScheme,
+};
 
 /// The facets a deformable contact surface is made of in a mesh of one dimension.
 trait Facets: Clone + Sized {
@@ -193,6 +195,7 @@ fn mortar_reach(
     slaves: &[usize],
     (surface, master): (&SlaveSurface, &Master),
     radius: f64,
+    basis: MortarBasis,
 ) -> Result<()> {
     let mut rows = Vec::new();
     let needed = match (surface, master) {
@@ -202,6 +205,7 @@ fn mortar_reach(
             s,
             m,
             radius,
+            basis,
             &|n| mesh.xy(n),
             &mut rows,
         ),
@@ -213,7 +217,17 @@ fn mortar_reach(
                 .collect();
             let x = crate::contact::master::Positions::new(&x, 3);
             let kept = crate::contact::master::face_tree::KeptFaces::new(faces, x, 0.0);
-            crate::contact::mortar::face_rows((0, 0), slaves, s, faces, &kept, radius, x, &mut rows)
+            crate::contact::mortar::face_rows(
+                (0, 0),
+                slaves,
+                s,
+                faces,
+                &kept,
+                radius,
+                basis,
+                x,
+                &mut rows,
+            )
         }
         _ => 0,
     };
@@ -313,6 +327,7 @@ fn deformable<F: Facets>(
             &slaves,
             (&surface, &master),
             radius,
+            c.mortar_basis.unwrap_or_default(),
         )?;
     }
     let mut sides = vec![ContactSide {
@@ -553,6 +568,13 @@ pub(super) fn contacts(
             rigid_master => rigid(mesh, fields, c, rigid_master)?,
         };
         shortest = shortest.min(sides.shortest);
+        if c.mortar_basis.is_some() && sides.formulation != Formulation::Mortar {
+            return Err(Error::config(
+                format!("{field}.mortar_basis"),
+                "is read by mortar pairs only (a deformable master in the implicit \
+                 schemes, `formulation = \"mortar\"`); this pair is node to segment",
+            ));
+        }
         pairs.push(ContactPair {
             name: name.clone(),
             sides: sides.sides,
@@ -560,6 +582,7 @@ pub(super) fn contacts(
             friction,
             mu,
             formulation: sides.formulation,
+            mortar_basis: c.mortar_basis.unwrap_or_default(),
             position_weight,
         });
     }

@@ -328,6 +328,7 @@ mod tests {
             friction: 0.0,
             mu: 0.0,
             formulation: crate::model::Formulation::NodeToSegment,
+            mortar_basis: crate::model::MortarBasis::Dual,
             position_weight: 0.5,
         };
         let mut out = Vec::new();

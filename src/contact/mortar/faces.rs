@@ -17,12 +17,13 @@
 //! on the tree's order.
 
 use super::clip::{shape_at, triangle_rule, Polygon};
-use super::{finish, Gathered};
+use super::{finish, Facet, Gathered};
 use crate::contact::master::face_tree::KeptFaces;
 use crate::contact::master::Positions;
 use crate::contact::rows::Candidate;
 use crate::geometry::{cross, dot, sub, tangents, unit};
 use crate::mesh::Face;
+use crate::model::MortarBasis;
 
 type V3 = [f64; 3];
 
@@ -76,7 +77,8 @@ impl Placed {
 
 /// The mortar rows of one side (`key`: pair and side) against the master `faces` at
 /// the geometry `x`, appended to `out` in slave order. `slaves` are the side's slave
-/// nodes (sorted), `slave_faces` its slave surface; `kept` the master's kept tree
+/// nodes (sorted), `slave_faces` its slave surface, `basis` its test functions;
+/// `kept` the master's kept tree
 /// (its broad phase); master faces farther than `radius` from a slave face (along
 /// its normal at the overlap's corners) are not integrated. Returns the most nodes a
 /// row needed (more than [`crate::contact::rows::ROW_NODES`] means rows were cut:
@@ -89,6 +91,7 @@ pub fn rows(
     faces: &[Face],
     kept: &KeptFaces,
     radius: f64,
+    basis: MortarBasis,
     x: Positions,
     out: &mut Vec<Candidate>,
 ) -> usize {
@@ -123,6 +126,9 @@ pub fn rows(
         for &j in &slots[..s.k] {
             gathered[j].total += area / s.k as f64;
         }
+        let mut nodes = [0; 4];
+        nodes[..s.k].copy_from_slice(sf.corners());
+        let mut facet = Facet::new(basis, nodes, slots, s.k);
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in &s.x[..s.k] {
             for i in 0..3 {
@@ -189,20 +195,17 @@ pub fn rows(
                     }
                 }
             }
-            for (j, &gj) in slots[..s.k].iter().enumerate() {
-                let g = &mut gathered[gj];
-                g.covered += covered[j];
-                for i in 0..3 {
-                    g.master_normal[i] += covered[j] * m.normal[i];
+            for j in 0..s.k {
+                facet.cover(&mut gathered, j, covered[j], m.normal);
+                for (k, &dk) in d[j][..s.k].iter().enumerate() {
+                    facet.slave(&mut gathered, j, k, dk);
                 }
-                for (k, &node) in sf.corners().iter().enumerate() {
-                    g.overflow += usize::from(!g.weights.add(node, d[j][k]));
-                }
-                for (l, &node) in mf.corners().iter().enumerate() {
-                    g.overflow += usize::from(!g.weights.add(node, -mm[j][l]));
+                for (&node, &ml) in mf.corners().iter().zip(&mm[j]) {
+                    facet.master(&mut gathered, j, node, ml);
                 }
             }
         }
+        facet.close(&mut gathered);
     }
     finish(key, slaves, &mut gathered, unit, &|n| x.at::<3>(n), out)
 }
@@ -253,6 +256,7 @@ mod tests {
         master: (usize, usize),
         gap: f64,
         tri: [bool; 2],
+        basis: MortarBasis,
         moved: impl Fn(V3) -> V3,
     ) -> (Vec<f64>, usize, Vec<Candidate>) {
         let (mut xs, sf) = grid(slave, gap, 0, true, tri[0]);
@@ -264,7 +268,7 @@ mod tests {
         let kept = KeptFaces::new(&mf, x, 0.0);
         let slaves: Vec<usize> = (0..ns).collect();
         let mut out = Vec::new();
-        rows((0, 0), &slaves, &sf, &mf, &kept, 0.5, x, &mut out);
+        rows((0, 0), &slaves, &sf, &mf, &kept, 0.5, basis, x, &mut out);
         (flat, ns, out)
     }
 
@@ -276,8 +280,11 @@ mod tests {
             ((4, 2), (3, 3), [true, false]),
             ((2, 2), (5, 3), [true, true]),
         ];
-        for (slave, master, tri) in cases {
-            let (flat, ns, out) = rows_of(slave, master, 0.01, tri, |p| p);
+        for ((slave, master, tri), basis) in cases
+            .into_iter()
+            .flat_map(|c| [MortarBasis::Standard, MortarBasis::Dual].map(|b| (c, b)))
+        {
+            let (flat, ns, out) = rows_of(slave, master, 0.01, tri, basis, |p| p);
             assert_eq!(out.len(), ns, "{slave:?} on {master:?}");
             let mut load = vec![0.0; flat.len() / 3];
             let pos = |n: usize| [flat[3 * n], flat[3 * n + 1], flat[3 * n + 2]];
@@ -343,9 +350,14 @@ mod tests {
         // along the master's normal, so a slide of the slave along the master changes
         // no row's linearised gap.
         let tilt: f64 = 0.1;
-        let (_, ns, out) = rows_of((3, 2), (4, 3), 0.2, [false, false], |p| {
-            [p[0], p[0] * tilt.tan(), p[2]]
-        });
+        let (_, ns, out) = rows_of(
+            (3, 2),
+            (4, 3),
+            0.2,
+            [false, false],
+            MortarBasis::Dual,
+            |p| [p[0], p[0] * tilt.tan(), p[2]],
+        );
         assert_eq!(out.len(), ns);
         for c in &out {
             let n = [-tilt.sin(), tilt.cos(), 0.0];
@@ -367,9 +379,14 @@ mod tests {
     fn a_master_under_part_of_the_slave_weights_what_it_covers() {
         // The master grid shifted by 0.3 in x: slave nodes at x = 0 and 1/3 see it
         // over part of their support only, and a node beyond its end gets no row.
-        let (flat, _, out) = rows_of((3, 1), (2, 2), 0.1, [false, false], |p| {
-            [p[0] + 0.5, p[1], p[2]]
-        });
+        let (flat, _, out) = rows_of(
+            (3, 1),
+            (2, 2),
+            0.1,
+            [false, false],
+            MortarBasis::Standard,
+            |p| [p[0] + 0.5, p[1], p[2]],
+        );
         // Nodes at x = 0 get none; at x = 1/3 the master covers [0.5, 2/3] of the
         // support [0, 2/3] of a hat 3x: ∫ over the cover of (2 − 3x) in x, times ½ in
         // z (the slave's one row of cells, its nodes on z = 0 and 1: ½ each).
@@ -390,5 +407,34 @@ mod tests {
             third.length,
             0.5 * hat
         );
+    }
+
+    #[test]
+    fn a_dual_row_holds_its_own_slave_node_and_reproduces_a_linear_gap() {
+        // Slave grids (quadrilaterals, triangles) over a master plane tilted about z
+        // so that the vertical gap is 0.1 + 0.2 x: each dual row holds its own slave
+        // node with weight 1 and its gap is the gap at the node, as the dual basis
+        // reproduces linear fields; the standard rows couple neighbours.
+        for tri in [false, true] {
+            for basis in [MortarBasis::Standard, MortarBasis::Dual] {
+                let (flat, ns, out) = rows_of((3, 2), (2, 3), 0.1, [tri, false], basis, |p| {
+                    [p[0], -0.2 * p[0], p[2]]
+                });
+                assert_eq!(out.len(), ns);
+                for c in &out {
+                    let own: Vec<(usize, f64)> =
+                        c.weights.iter().filter(|&(n, _)| n < ns).collect();
+                    let at_node = (0.1 + 0.2 * flat[3 * c.slave]) / 1.04f64.sqrt();
+                    if basis == MortarBasis::Dual {
+                        assert_eq!(own.len(), 1, "{c:?}");
+                        assert_eq!(own[0].0, c.slave);
+                        assert!((own[0].1 - 1.0).abs() < 1e-14, "{c:?}");
+                        assert!((c.gap - at_node).abs() < 1e-13, "{} vs {at_node}", c.gap);
+                    } else {
+                        assert!(own.len() > 1, "{c:?}");
+                    }
+                }
+            }
+        }
     }
 }

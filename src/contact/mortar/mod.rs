@@ -33,6 +33,7 @@ pub use segments::rows as segment_rows;
 
 use super::rows::{Candidate, Contactee, Weights};
 use super::state::Slave;
+use crate::model::MortarBasis;
 
 /// The least covered fraction of a slave node's shape-function integral for the node
 /// to get a row: below it the node sees the master over a sliver of its support
@@ -67,6 +68,166 @@ impl<const D: usize> Gathered<D> {
             };
             n
         ]
+    }
+}
+
+/// The least Hadamard ratio `det G / Π G_ii` of a facet's covered Gram matrix
+/// `G_ik = ∫ N_i N_k` for which the dual basis is built on it. A whole segment has
+/// 0.75, a whole triangle 0.5, a whole rectangle 0.32, and a part that holds a
+/// corner of the facet at least 0.25 (segment); only a cover that is a sliver
+/// inside the facet, away from its corners, drives it to zero, where `G⁻¹` would
+/// amplify round-off. Such a facet keeps the standard basis (theory/contact.md).
+pub const DUAL_CONDITION: f64 = 1e-4;
+
+/// What one slave facet (segment or face, `k ≤ 4` corners) gathers over the master
+/// facets it faces, before its test functions are chosen: with the standard basis
+/// everything goes straight into the nodes' rows; with the dual basis the integrals
+/// of the standard shape functions are kept here and turned into those of the dual
+/// ones, `φ_j = Σ_i a_ji N_i` with `A = diag(c) G⁻¹` (`c_i = ∫ N_i`, `G` the Gram
+/// matrix, both over the facet's covered part), when the facet is done
+/// ([`Facet::close`]). Then `∫ φ_j N_k = δ_jk c_j`: each row holds one slave node.
+struct Facet<const D: usize> {
+    basis: MortarBasis,
+    /// The facet's corners as slots in the side's slave list.
+    slots: [usize; 4],
+    /// Its corners' node numbers.
+    nodes: [usize; 4],
+    k: usize,
+    /// `∫ N_i N_k` over the covered part (dual basis).
+    gram: [[f64; 4]; 4],
+    /// `∫ N_i` over the covered part (dual basis).
+    covered: [f64; 4],
+    /// `∫ N_i n_m` (dual basis).
+    normal: [[f64; D]; 4],
+    /// `∫ N_i N̂_l` per master node `l` (dual basis).
+    master: Vec<(usize, [f64; 4])>,
+}
+
+impl<const D: usize> Facet<D> {
+    /// A facet of corners `nodes` at slots `slots` (first `k` of each).
+    fn new(basis: MortarBasis, nodes: [usize; 4], slots: [usize; 4], k: usize) -> Facet<D> {
+        Facet {
+            basis,
+            slots,
+            nodes,
+            k,
+            gram: [[0.0; 4]; 4],
+            covered: [0.0; 4],
+            normal: [[0.0; D]; 4],
+            master: Vec::new(),
+        }
+    }
+
+    /// Corner `j`'s test function weighs `w` (`∫ N_j` over a piece of cover) where
+    /// the master's outward normal is `n`.
+    fn cover(&mut self, g: &mut [Gathered<D>], j: usize, w: f64, n: [f64; D]) {
+        match self.basis {
+            MortarBasis::Standard => {
+                let gj = &mut g[self.slots[j]];
+                gj.covered += w;
+                for (a, b) in gj.master_normal.iter_mut().zip(n) {
+                    *a += w * b;
+                }
+            }
+            MortarBasis::Dual => {
+                self.covered[j] += w;
+                for (a, b) in self.normal[j].iter_mut().zip(n) {
+                    *a += w * b;
+                }
+            }
+        }
+    }
+
+    /// `∫ N_j N_k` over a piece grows by `w` (`k` a corner of this facet).
+    fn slave(&mut self, g: &mut [Gathered<D>], j: usize, k: usize, w: f64) {
+        match self.basis {
+            MortarBasis::Standard => {
+                let gj = &mut g[self.slots[j]];
+                gj.overflow += usize::from(!gj.weights.add(self.nodes[k], w));
+            }
+            MortarBasis::Dual => self.gram[j][k] += w,
+        }
+    }
+
+    /// `∫ N_j N̂_l` over a piece grows by `w` (`node` the master's node `l`).
+    fn master(&mut self, g: &mut [Gathered<D>], j: usize, node: usize, w: f64) {
+        match self.basis {
+            MortarBasis::Standard => {
+                let gj = &mut g[self.slots[j]];
+                gj.overflow += usize::from(!gj.weights.add(node, -w));
+            }
+            MortarBasis::Dual => match self.master.iter_mut().find(|e| e.0 == node) {
+                Some(e) => e.1[j] += w,
+                None => {
+                    let mut e = (node, [0.0; 4]);
+                    e.1[j] = w;
+                    self.master.push(e);
+                }
+            },
+        }
+    }
+
+    /// The dual basis's coefficients `A = diag(c) G⁻¹`, or `None` where the covered
+    /// Gram matrix is too close to singular ([`DUAL_CONDITION`]) or a corner is not
+    /// covered at all.
+    fn dual(&self) -> Option<[[f64; 4]; 4]> {
+        let k = self.k;
+        if self.covered[..k].iter().any(|&c| c <= 0.0) {
+            return None;
+        }
+        let g = nalgebra::DMatrix::from_fn(k, k, |i, j| self.gram[i][j]);
+        let diagonal: f64 = (0..k).map(|i| g[(i, i)]).product();
+        let det = g.determinant();
+        if !(diagonal > 0.0 && det / diagonal >= DUAL_CONDITION) {
+            return None;
+        }
+        let inv = g.try_inverse()?;
+        let mut a = [[0.0; 4]; 4];
+        for (j, row) in a.iter_mut().enumerate().take(k) {
+            for (i, aji) in row.iter_mut().enumerate().take(k) {
+                *aji = self.covered[j] * inv[(j, i)];
+            }
+        }
+        Some(a)
+    }
+
+    /// Adds the facet's dual rows to the nodes' (nothing left to add for the
+    /// standard basis). A facet whose Gram matrix is near singular adds its
+    /// standard rows.
+    fn close(self, g: &mut [Gathered<D>]) {
+        if self.basis == MortarBasis::Standard {
+            return;
+        }
+        let k = self.k;
+        let a = self.dual();
+        for j in 0..k {
+            let gj = &mut g[self.slots[j]];
+            // The normal stays weighted by the standard shape function: positive
+            // weights, a direction that needs no biorthogonality.
+            gj.covered += self.covered[j];
+            for (n, m) in gj.master_normal.iter_mut().zip(self.normal[j]) {
+                *n += m;
+            }
+            match &a {
+                Some(a) => {
+                    // ∫ φ_j N_k = δ_jk c_j: the node's own weight only.
+                    gj.overflow += usize::from(!gj.weights.add(self.nodes[j], self.covered[j]));
+                    for (node, m) in &self.master {
+                        let w: f64 = (0..k).map(|i| a[j][i] * m[i]).sum();
+                        gj.overflow += usize::from(!gj.weights.add(*node, -w));
+                    }
+                }
+                None => {
+                    for kk in 0..k {
+                        gj.overflow +=
+                            usize::from(!gj.weights.add(self.nodes[kk], self.gram[j][kk]));
+                    }
+                    for (node, m) in &self.master {
+                        gj.overflow += usize::from(!gj.weights.add(*node, -m[j]));
+                    }
+                }
+            }
+        }
     }
 }
 

@@ -10,8 +10,9 @@
 use rstar::primitives::{GeomWithData, Line, Rectangle};
 use rstar::{RTree, RTreeObject};
 
-use super::{finish, Gathered};
+use super::{finish, Facet, Gathered};
 use crate::contact::rows::Candidate;
+use crate::model::MortarBasis;
 
 /// Outward unit normal of a segment with its body on the left, and its length (as
 /// `hypot`, whose last bits the mortar rows have always had; detection's
@@ -28,8 +29,9 @@ fn outward(a: [f64; 2], b: [f64; 2]) -> ([f64; 2], f64) {
 
 /// The mortar rows of one side (`key`: pair and side) against the master
 /// `segments` at the geometry `x`, appended to `out` in slave order. `slaves` are the
-/// side's slave nodes (sorted), `slave_segments` its slave surface; master segments
-/// farther than `radius` from a slave segment are not looked at. Returns the most
+/// side's slave nodes (sorted), `slave_segments` its slave surface, `basis` the
+/// slave's test functions; master segments farther than `radius` from a slave
+/// segment are not looked at. Returns the most
 /// nodes a row needed (more than [`crate::contact::rows::ROW_NODES`] means rows were cut:
 /// validation refuses such a pair at the initial geometry).
 #[allow(clippy::too_many_arguments)]
@@ -39,6 +41,7 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
     slave_segments: &[[usize; 2]],
     segments: &[[usize; 2]],
     radius: f64,
+    basis: MortarBasis,
     x: &X,
     out: &mut Vec<Candidate>,
 ) -> usize {
@@ -66,6 +69,7 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
         for j in [j1, j2] {
             gathered[j].total += 0.5 * len;
         }
+        let mut facet = Facet::new(basis, [s1, s2, 0, 0], [j1, j2, 0, 0], 2);
         let d = [p2[0] - p1[0], p2[1] - p1[1]];
         let along = |q: [f64; 2]| ((q[0] - p1[0]) * d[0] + (q[1] - p1[1]) * d[1]) / (len * len);
         let lo = [p1[0].min(p2[0]) - radius, p1[1].min(p2[1]) - radius];
@@ -108,21 +112,19 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
                 let e = eta(xi);
                 let ns = [1.0 - xi, xi];
                 let nm = [1.0 - e, e];
-                for (jj, &j) in [j1, j2].iter().enumerate() {
-                    let gj = &mut gathered[j];
-                    let wj = w * ns[jj];
-                    gj.covered += wj;
-                    gj.master_normal[0] += wj * m_normal[0];
-                    gj.master_normal[1] += wj * m_normal[1];
-                    for (k, &node) in [s1, s2].iter().enumerate() {
-                        gj.overflow += usize::from(!gj.weights.add(node, wj * ns[k]));
+                for (j, &nj) in ns.iter().enumerate() {
+                    let wj = w * nj;
+                    facet.cover(&mut gathered, j, wj, m_normal);
+                    for (k, &nk) in ns.iter().enumerate() {
+                        facet.slave(&mut gathered, j, k, wj * nk);
                     }
-                    for (l, &node) in [m1, m2].iter().enumerate() {
-                        gj.overflow += usize::from(!gj.weights.add(node, -wj * nm[l]));
+                    for (&node, &nl) in [m1, m2].iter().zip(&nm) {
+                        facet.master(&mut gathered, j, node, wj * nl);
                     }
                 }
             }
         }
+        facet.close(&mut gathered);
     }
     let unit = |m: [f64; 2]| {
         let l = m[0].hypot(m[1]);
@@ -134,6 +136,8 @@ pub fn rows<X: Fn(usize) -> [f64; 2]>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const BASES: [MortarBasis; 2] = [MortarBasis::Standard, MortarBasis::Dual];
 
     /// Nodes, slave nodes, slave segments, master segments.
     type Strips = (Vec<[f64; 2]>, Vec<usize>, Vec<[usize; 2]>, Vec<[usize; 2]>);
@@ -158,10 +162,13 @@ mod tests {
 
     #[test]
     fn weighted_gaps_of_parallel_strips_are_the_gap_and_loads_are_consistent() {
-        for (ns, nm) in [(2, 3), (3, 2), (4, 4), (5, 2)] {
+        for ((ns, nm), basis) in [(2, 3), (3, 2), (4, 4), (5, 2)]
+            .into_iter()
+            .flat_map(|c| BASES.map(|b| (c, b)))
+        {
             let (x, slaves, ss, ms) = strips(ns, nm, 0.01);
             let mut out = Vec::new();
-            rows((0, 0), &slaves, &ss, &ms, 0.5, &|n| x[n], &mut out);
+            rows((0, 0), &slaves, &ss, &ms, 0.5, basis, &|n| x[n], &mut out);
             assert_eq!(out.len(), ns + 1);
             let mut master_load = vec![0.0; x.len()];
             let mut slave_load = vec![0.0; x.len()];
@@ -210,7 +217,16 @@ mod tests {
             p[1] = p[0] * tilt.tan();
         }
         let mut out = Vec::new();
-        rows((0, 0), &slaves, &ss, &ms, 1.0, &|n| x[n], &mut out);
+        rows(
+            (0, 0),
+            &slaves,
+            &ss,
+            &ms,
+            1.0,
+            MortarBasis::Dual,
+            &|n| x[n],
+            &mut out,
+        );
         assert_eq!(out.len(), ns + 1);
         let (nx, ny) = (-tilt.sin(), tilt.cos());
         for c in &out {
@@ -233,6 +249,12 @@ mod tests {
     fn a_tilted_master_gives_the_averaged_gap_and_partial_cover_is_weighted() {
         // The master from x = 0.25 to 1 at height 0, the slave over [0, 1] at 0.1:
         // node 0 is not covered, node 1 (x = 0.5) half of its left segment.
+        for basis in BASES {
+            partial_cover(basis);
+        }
+    }
+
+    fn partial_cover(basis: MortarBasis) {
         let x = [[1.0, 0.1], [0.5, 0.1], [0.0, 0.1], [0.25, 0.0], [1.0, 0.0]];
         let mut out = Vec::new();
         rows(
@@ -241,6 +263,7 @@ mod tests {
             &[[2, 1], [1, 0]],
             &[[4, 3]],
             0.5,
+            basis,
             &|n| x[n],
             &mut out,
         );
@@ -253,5 +276,45 @@ mod tests {
         // shape function is 1 - 2x: its integral 1/16.
         assert!((out[2].length - 1.0 / 16.0).abs() < 1e-14, "{:?}", out[2]);
         assert!((out[0].length - 0.25).abs() < 1e-14);
+    }
+
+    #[test]
+    fn a_dual_row_holds_its_own_slave_node_and_reproduces_a_linear_gap() {
+        // A slave strip of 3 segments over a master of 2 tilted so that the gap is
+        // linear along the slave, 0.1 + 0.2 x. The dual rows hold one slave node each
+        // (weight 1), and as the dual basis reproduces constants, each row's gap is
+        // the gap at its node exactly. The standard rows average the gap over the
+        // node's hat and couple neighbours.
+        let (ns, nm) = (3, 2);
+        let (mut x, slaves, ss, ms) = strips(ns, nm, 0.1);
+        for p in x.iter_mut().skip(ns + 1) {
+            p[1] = -0.2 * p[0];
+        }
+        for basis in BASES {
+            let mut out = Vec::new();
+            rows((0, 0), &slaves, &ss, &ms, 1.0, basis, &|n| x[n], &mut out);
+            assert_eq!(out.len(), ns + 1);
+            for c in &out {
+                let slave_nodes: Vec<(usize, f64)> =
+                    c.weights.iter().filter(|&(n, _)| n <= ns).collect();
+                let xs = x[c.slave][0];
+                // The gap along the master's normal at the node: the vertical gap
+                // 0.1 + 0.2 x times the cosine of the master's slope.
+                let at_node = (0.1 + 0.2 * xs) / (1.0 + 0.04f64).sqrt();
+                match basis {
+                    MortarBasis::Dual => {
+                        assert_eq!(slave_nodes, [(c.slave, 1.0)], "{c:?}");
+                        assert!((c.gap - at_node).abs() < 1e-14, "{} vs {at_node}", c.gap);
+                    }
+                    MortarBasis::Standard => {
+                        let interior = c.slave != 0 && c.slave != ns;
+                        assert!(slave_nodes.len() > 1, "{c:?}");
+                        // The hat's average of a linear gap is the node's value
+                        // inside, off it at the ends.
+                        assert_eq!((c.gap - at_node).abs() < 1e-14, interior, "{c:?}");
+                    }
+                }
+            }
+        }
     }
 }
