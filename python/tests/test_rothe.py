@@ -383,3 +383,16 @@ def test_modes_of_an_axial_bar_match_its_closed_form_and_the_command_line(tmp_pa
                        (dict(shift=5.0), "--shift"), (dict(backend="x"), "backend")]:
         with pytest.raises(rothe.Error, match=field):
             s.modes(**bad)
+
+
+def test_the_summary_says_whether_energy_was_created(examples):
+    # theory/energy.md, "No energy created": backward Euler never gains; the
+    # check's excess is what the history's columns give, E_kin + E_el + the physical
+    # lines - (E_kin0 + E_el0 + W_ext), at its largest over the run.
+    run = two_blocks(examples).run()
+    c = run.summary["checks"]["no_energy_created"]
+    assert c["holds"] and c["lhs"] == 0.0 and run.summary["checks"]["energy_created_at_step"] == 0
+    h = run.history
+    physical = sum(h[k] for k in h if k.startswith("D_") and k != "D_num")
+    excess = (h["E_kin"] - h["E_kin"][0]) + (h["E_el"] - h["E_el"][0]) + physical - h["W_ext"]
+    assert np.max(excess) <= c["tolerance"]

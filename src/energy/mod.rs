@@ -70,6 +70,11 @@ impl Dissipation {
             + self.numerical
     }
 
+    /// Every line but the scheme's own (`numerical`): what the physics booked.
+    pub fn physical(&self) -> f64 {
+        self.total() - self.numerical
+    }
+
     /// Physical material dissipation: viscous + damage + plastic.
     pub fn material(&self) -> f64 {
         self.viscous + self.damage + self.plastic
@@ -161,6 +166,9 @@ pub struct Ledger {
     residual: f64,
     scale: f64,
     max_abs_residual: f64,
+    steps: usize,
+    created: f64,
+    created_step: usize,
 }
 
 impl Ledger {
@@ -199,6 +207,17 @@ impl Ledger {
             .max(self.elastic.abs())
             .max(self.external_work.abs())
             .max(self.internal.abs());
+        // E_kin + E_el + D_physical − (E_kin⁰ + E_el⁰ + W_ext): what the bodies hold
+        // and the physics took, beyond what they were given. 0 at the start.
+        self.steps += 1;
+        let created = (self.kinetic - self.kinetic_0)
+            + (self.elastic - self.elastic_0)
+            + self.dissipated.physical()
+            - self.external_work;
+        if created > self.created || created.is_nan() {
+            self.created = created;
+            self.created_step = self.steps;
+        }
         // A NaN residual must not hide behind `max`.
         self.max_abs_residual = if self.residual.is_nan() {
             f64::NAN
@@ -243,6 +262,15 @@ impl Ledger {
     pub fn scale(&self) -> f64 {
         self.scale
     }
+    /// The largest energy created over the run: the most `E_kin + E_el` plus the
+    /// physical dissipation (every line but the scheme's own) ever stood above
+    /// `E_kin⁰ + E_el⁰ + W_ext`, 0 if never, and the step (counted from 1) where it
+    /// did. Equal to `residual − D_num` at that step: a scheme's negative loss, or
+    /// a booking that does not close, shows here (theory/energy.md).
+    pub fn created(&self) -> (f64, usize) {
+        (self.created, self.created_step)
+    }
+
     /// Largest `|residual|` seen.
     pub fn max_abs_residual(&self) -> f64 {
         self.max_abs_residual

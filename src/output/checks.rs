@@ -58,6 +58,14 @@ pub struct Checks {
     /// bodies hold never exceeds what they were given (no energy created, whatever
     /// the scheme's own line books).
     pub energy_within_supplied_energy: Check,
+    /// No energy created at any step: the largest excess over the run of
+    /// `E_kin + E_el` plus the physical dissipation (every ledger line but the
+    /// scheme's own) over `E_kin⁰ + E_el⁰ + W_ext` ≤ 0. It fails where the scheme's
+    /// own line went negative beyond the allowance (generalized-α at an impact) or a
+    /// booking does not close (theory/energy.md, "No energy created").
+    pub no_energy_created: Check,
+    /// The step (counted from 1) of that largest excess; 0 when it never exceeded 0.
+    pub energy_created_at_step: usize,
 }
 
 /// The energy scale of a model below which an energy is round-off: the kinetic
@@ -136,6 +144,10 @@ impl Checks {
     pub fn with(l: &Ledger, allowance: f64, floor: f64) -> Checks {
         let tol = l.max_abs_residual() + 1e-9 * l.scale() + floor;
         let d = l.dissipated();
+        let supply = (l.kinetic_0() + l.elastic_0() + l.external_work())
+            .abs()
+            .max(l.scale());
+        let (created, step) = l.created();
         Checks {
             dissipation_within_internal_work: Check::of(
                 d.material(),
@@ -150,11 +162,19 @@ impl Checks {
             energy_within_supplied_energy: Check::of(
                 l.kinetic() + l.elastic(),
                 l.kinetic_0() + l.elastic_0() + l.external_work(),
-                tol + allowance
-                    * (l.kinetic_0() + l.elastic_0() + l.external_work())
-                        .abs()
-                        .max(l.scale()),
+                tol + allowance * supply,
             ),
+            // A NaN excess must fail, not vanish behind `max`.
+            no_energy_created: Check::of(
+                if created.is_nan() {
+                    created
+                } else {
+                    created.max(0.0)
+                },
+                0.0,
+                tol + allowance * supply,
+            ),
+            energy_created_at_step: if created > 0.0 { step } else { 0 },
         }
     }
 
@@ -215,7 +235,7 @@ impl Checks {
     }
 
     /// The checks in order with their names.
-    fn named(&self) -> [(&'static str, &Check); 3] {
+    fn named(&self) -> [(&'static str, &Check); 4] {
         [
             (
                 "dissipation_within_internal_work (material dissipation <= E_int)",
@@ -229,6 +249,11 @@ impl Checks {
                 "energy_within_supplied_energy (E_kin + E_el <= E_kin0 + E_el0 + W_ext)",
                 &self.energy_within_supplied_energy,
             ),
+            (
+                "no_energy_created (E_kin + E_el + physical dissipation <= E_kin0 + E_el0 \
+                 + W_ext at every step)",
+                &self.no_energy_created,
+            ),
         ]
     }
 
@@ -238,11 +263,20 @@ impl Checks {
         format!("{n}: {:.6e} J > {:.6e} J", c.lhs, c.rhs)
     }
 
-    /// The failed checks as `name: lhs > rhs` lines.
+    /// The failed checks as `name: lhs > rhs` lines; energy created says where and
+    /// what it means.
     pub fn failures(&self) -> Vec<String> {
-        (0..3)
+        (0..4)
             .filter(|&i| !self.named()[i].1.holds)
-            .map(|i| self.line(i))
+            .map(|i| match i {
+                3 => format!(
+                    "{} at step {}: the run gained energy (the scheme's own line fell below \
+                     zero, as generalized-α's does at impacts, or a booking does not close)",
+                    self.line(i),
+                    self.energy_created_at_step
+                ),
+                _ => self.line(i),
+            })
             .collect()
     }
 }
@@ -260,5 +294,45 @@ mod tests {
         let fresh = Checks::of(&Ledger::new(2.0, 0.0));
         assert!(fresh.failures().is_empty());
         assert_eq!(fresh.dissipation_within_supplied_energy.rhs, 2.0);
+    }
+
+    /// A body of 2 J losing 1 J of kinetic energy in one step to an impact, whose
+    /// contact line books `contact` and the scheme's line closes the balance.
+    fn one_step(contact: f64) -> Ledger {
+        let mut l = Ledger::new(2.0, 0.0);
+        l.record(&crate::energy::StepIncrements {
+            kinetic: 1.0,
+            contact,
+            scheme_loss: 1.0 - contact,
+            ..Default::default()
+        });
+        l
+    }
+
+    #[test]
+    fn a_booking_that_claims_more_than_was_lost_is_energy_created() {
+        // The right booking (1 J to contact) and one that leaves some to the scheme
+        // both close the balance and hold.
+        for contact in [1.0, 0.7] {
+            let c = Checks::of(&one_step(contact));
+            assert!(c.no_energy_created.holds, "{contact}: {c:?}");
+            assert_eq!(c.energy_created_at_step, 0);
+        }
+        // A contact line of 1.5 J where 1 J was lost closes the balance with a scheme
+        // line of −0.5 J: the ledger closes, the energy of the motion is below the
+        // supply, and only this check sees the 0.5 J created.
+        let wrong = Checks::of(&one_step(1.5));
+        assert!(wrong.dissipation_within_supplied_energy.holds);
+        assert!(wrong.energy_within_supplied_energy.holds);
+        assert!(!wrong.no_energy_created.holds, "{wrong:?}");
+        assert!((wrong.no_energy_created.lhs - 0.5).abs() < 1e-15);
+        assert_eq!(wrong.energy_created_at_step, 1);
+        let lines = wrong.failures();
+        assert!(
+            lines.len() == 1
+                && lines[0].contains("no_energy_created")
+                && lines[0].contains("step 1"),
+            "{lines:?}"
+        );
     }
 }
