@@ -267,6 +267,7 @@ pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
             reused_factors: 0,
             keep_factor: a.time.scheme.is_implicit() && a.iteration.refactor_rate.is_some(),
             fallbacks: 0,
+            impact_steps: 0,
             iterations: 0,
             iterations_per_step: 0.0,
             max_step_iterations: 0,
@@ -383,6 +384,7 @@ fn fill<I: Integrator + ?Sized>(
     summary.solver.factorizations = facts.factorizations;
     summary.solver.reused_factors = facts.reused_factors;
     summary.solver.fallbacks = facts.fallbacks;
+    summary.solver.impact_steps = facts.impact_steps;
     summary.solver.factor_nnz = facts.factor_nnz;
 }
 

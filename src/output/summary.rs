@@ -165,6 +165,9 @@ pub struct SolverSummary {
     /// Steps whose iterations on a kept factor failed and were redone refactorising
     /// at every changed tangent.
     pub fallbacks: usize,
+    /// Generalized-α's steps that changed which slaves are held, taken by the
+    /// trapezoidal rule (impact steps, `theory/trapezoidal.md`).
+    pub impact_steps: usize,
     /// Linear solves (iterations) over the run.
     pub iterations: usize,
     /// Iterations per accepted step: mean and largest.

@@ -457,6 +457,7 @@ impl Integrator for CentralDifference<'_> {
             factorizations: 0,
             reused_factors: 0,
             fallbacks: 0,
+            impact_steps: 0,
             factor_nnz: None,
         }
     }

@@ -37,6 +37,22 @@ impl Corrector<'_> {
         }
     }
 
+    /// Whether the converged iterate holds other slaves than the step's start.
+    fn held_changed(&self) -> bool {
+        match self {
+            Corrector::Linear(_) => false,
+            Corrector::Contact(c) => c.held_changed(),
+        }
+    }
+
+    /// The contact forces of the last iterate (none without contact).
+    fn contact_force(&self) -> Option<&[f64]> {
+        match self {
+            Corrector::Linear(_) => None,
+            Corrector::Contact(c) => Some(c.contact_force()),
+        }
+    }
+
     /// The energy the constraints took in the accepted step (`−Δu·f` of the normal
     /// and of the friction forces), with their state written into `s.contact`.
     fn finish(&mut self, du: &[f64], s: &mut State) -> (f64, f64) {
@@ -71,17 +87,29 @@ impl Correction for Corrector<'_> {
     }
 }
 
+/// What [`step`] gave: an outcome, or a converged step that changed which slaves
+/// are held, left uncommitted when the caller asked for that ([`step`]'s
+/// `impacts`).
+enum Stepped {
+    Done(StepOutcome),
+    HeldChanged,
+}
+
 /// Runs one implicit step from `s` to `t + h` with `correction`; on acceptance `s`
-/// holds the new state and its ledger line, on rejection `s` is unchanged.
-pub(crate) fn step(
+/// holds the new state and its ledger line, on rejection `s` is unchanged. With
+/// `impacts`, a step that converged to another set of held slaves is not
+/// committed either (`s` unchanged, [`Stepped::HeldChanged`]).
+#[allow(clippy::too_many_arguments)]
+fn step(
     model: &Model,
     ops: &Operators,
     sys: &mut EffectiveSystem,
     w: &mut Scratch,
     correction: &mut Corrector,
     mut predictor: Option<&mut Predictor>,
+    impacts: bool,
     s: &mut State,
-) -> Result<StepOutcome> {
+) -> Result<Stepped> {
     let h = ops.h();
     let t1 = s.t + h;
     external_force(model, ops.gravity.as_deref(), t1, &mut w.f_ext_np1);
@@ -96,7 +124,10 @@ pub(crate) fn step(
                     "the contact predictor's projection of the free flight: {}",
                     describe(model, &outcome, t1, h)
                 );
-                return Ok(StepOutcome::Rejected(Rejection { outcome, message }));
+                return Ok(Stepped::Done(StepOutcome::Rejected(Rejection {
+                    outcome,
+                    message,
+                })));
             }
         }
     }
@@ -194,19 +225,28 @@ pub(crate) fn step(
             if let Some(p) = predictor {
                 p.restore(s);
             }
-            return Ok(StepOutcome::Rejected(Rejection { outcome, message }));
+            return Ok(Stepped::Done(StepOutcome::Rejected(Rejection {
+                outcome,
+                message,
+            })));
         }
         other => {
             if let Some(p) = predictor {
                 p.restore(s);
             }
             let message = describe(model, &other, t1, h);
-            return Ok(StepOutcome::Rejected(Rejection {
+            return Ok(Stepped::Done(StepOutcome::Rejected(Rejection {
                 outcome: other,
                 message,
-            }));
+            })));
         }
     };
+    if impacts && correction.held_changed() {
+        if let Some(p) = predictor {
+            p.restore(s);
+        }
+        return Ok(Stepped::HeldChanged);
+    }
     let contact = correction.finish(&w.du, s);
     super::booking::finish(ops, sys.dofs(), w, s, t1, contact, predicted);
     if let Some((quantity, value)) = s.ledger.first_non_finite() {
@@ -217,7 +257,7 @@ pub(crate) fn step(
             t: t1,
         });
     }
-    Ok(StepOutcome::Accepted(report))
+    Ok(Stepped::Done(StepOutcome::Accepted(report)))
 }
 
 /// Sets the start of a step's iteration: `u` is `u_n` with the prescribed values of
@@ -261,6 +301,8 @@ pub(crate) struct Core<'m> {
     pub assembly_s: f64,
     /// Time inside steps besides solves and refactorisations.
     pub step_other_s: f64,
+    /// Generalized-α's steps taken by the trapezoidal rule (impact steps).
+    pub impact_steps: usize,
 }
 
 impl<'m> Core<'m> {
@@ -323,6 +365,7 @@ impl<'m> Core<'m> {
             predictor,
             assembly_s,
             step_other_s: 0.0,
+            impact_steps: 0,
         })
     }
 
@@ -330,20 +373,70 @@ impl<'m> Core<'m> {
     pub fn step(&mut self, s: &mut State) -> Result<StepOutcome> {
         let t = Instant::now();
         let before = self.sys.timing();
-        let r = step(
+        // Generalized-α takes a step that changes which slaves are held by the
+        // trapezoidal rule (theory/trapezoidal.md, "Impact steps").
+        let impacts =
+            matches!(self.ops.rule(), Rule::GeneralizedAlpha(_)) && !self.model.contacts.is_empty();
+        let r = match step(
             self.model,
             &self.ops,
             &mut self.sys,
             &mut self.scratch,
             &mut self.correction,
             self.predictor.as_mut(),
+            impacts,
             s,
-        );
+        ) {
+            Ok(Stepped::Done(o)) => Ok(o),
+            Ok(Stepped::HeldChanged) => self.impact_step(s),
+            Err(e) => Err(e),
+        };
         let after = self.sys.timing();
         self.step_other_s += t.elapsed().as_secs_f64()
             - (after.solve_s - before.solve_s)
             - (after.factorization_s - before.factorization_s);
         r
+    }
+
+    /// Generalized-α's impact step: the step from `s` again by the trapezoidal
+    /// rule, whose energy identity holds through a change of the held slaves with
+    /// the contact force at the step's end, and the acceleration the next steps
+    /// carry from the equilibrium of the new state, contact forces included
+    /// (`theory/trapezoidal.md`, "Impact steps"). The rule and its factor are
+    /// generalized-α's again afterwards, whatever the step gave.
+    fn impact_step(&mut self, s: &mut State) -> Result<StepOutcome> {
+        let alpha = self.ops.rule();
+        self.ops.set_rule(Rule::Trapezoidal);
+        let outcome = self.refit().and_then(|()| {
+            let r = step(
+                self.model,
+                &self.ops,
+                &mut self.sys,
+                &mut self.scratch,
+                &mut self.correction,
+                self.predictor.as_mut(),
+                false,
+                s,
+            )?;
+            let Stepped::Done(o) = r else {
+                unreachable!("a step that may change the held slaves is committed")
+            };
+            if matches!(o, StepOutcome::Accepted(_)) {
+                s.a = super::step_start::acceleration(
+                    &self.ops,
+                    &mut self.sys,
+                    s,
+                    self.correction.contact_force(),
+                )?;
+                self.impact_steps += 1;
+            }
+            Ok(o)
+        });
+        self.ops.set_rule(alpha);
+        let back = self.refit();
+        let o = outcome?;
+        back?;
+        Ok(o)
     }
 
     /// Changes the step size; refactorises what depends on it.
@@ -352,6 +445,15 @@ impl<'m> Core<'m> {
             return Ok(());
         }
         self.ops.set_h(self.model, h);
+        self.refit()
+    }
+
+    /// Refactorises what depends on the step size and the rule, after either
+    /// changed. A factor is labelled by the step size's bits, with the sign bit set
+    /// for the trapezoidal rule of generalized-α's impact steps (a step size is
+    /// positive, so the two never meet).
+    fn refit(&mut self) -> Result<()> {
+        let h = self.ops.h();
         let static_elastic = matches!(self.ops.scheme, Scheme::Static { .. })
             && self.ops.response == Response::Elastic;
         let state_dependent = matches!(self.ops.response, Response::StateDependent(_));
@@ -371,7 +473,9 @@ impl<'m> Core<'m> {
         }
         // A size the run had before finds its factor kept (an error-controlled run's
         // ladder); the matrix is refilled all the same, so that it is the factor's.
-        let key = h.to_bits();
+        let impact = self.ops.rule() == Rule::Trapezoidal
+            && self.model.analysis.time.scheme == crate::model::TimeScheme::GeneralizedAlpha;
+        let key = h.to_bits() | if impact { 1 << 63 } else { 0 };
         self.ops.refill(&mut self.sys, &self.ops.kt);
         if self.sys.switch_factor(key) {
             return Ok(());
@@ -452,6 +556,7 @@ impl<'m> Core<'m> {
             factorizations: self.sys.factorizations(),
             reused_factors: self.scratch.factor.reused,
             fallbacks: self.scratch.factor.fallbacks,
+            impact_steps: self.impact_steps,
             factor_nnz: self.sys.factor_nnz(),
         }
     }

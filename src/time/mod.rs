@@ -130,6 +130,9 @@ pub struct SolverFacts {
     /// Steps redone refactorising at every changed tangent after the iterations on a
     /// kept factor failed.
     pub fallbacks: usize,
+    /// Generalized-α's steps that changed which slaves are held, taken by the
+    /// trapezoidal rule (`theory/trapezoidal.md`, "Impact steps").
+    pub impact_steps: usize,
     /// Nonzeros of the factor.
     pub factor_nnz: Option<usize>,
 }

@@ -191,6 +191,14 @@ impl Operators {
         }
     }
 
+    /// Sets the rule of a dynamic step (generalized-α's impact steps take the
+    /// trapezoidal rule's); statics has none.
+    pub fn set_rule(&mut self, new: Rule) {
+        if let Scheme::Dynamic { rule, .. } = &mut self.scheme {
+            *rule = new;
+        }
+    }
+
     /// Sets the step size.
     pub fn set_h(&mut self, model: &Model, h_new: f64) {
         match &mut self.scheme {

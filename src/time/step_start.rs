@@ -70,7 +70,19 @@ pub(crate) fn initial_acceleration(
     ops: &Operators,
     sys: &mut EffectiveSystem,
 ) -> Result<Vec<f64>> {
-    let s = ops.initial_state(model);
+    acceleration(ops, sys, &ops.initial_state(model), None)
+}
+
+/// The acceleration of the state `s` from its equilibrium,
+/// `M a = f_ext − f_int − C v + f_c` on the free dofs (zero on the constrained
+/// ones), `f_c` the contact forces when given: one factorisation of `M` on the
+/// system's pattern, which the caller replaces by its own afterwards.
+pub(crate) fn acceleration(
+    ops: &Operators,
+    sys: &mut EffectiveSystem,
+    s: &State,
+    contact: Option<&[f64]>,
+) -> Result<Vec<f64>> {
     let n = s.v.len();
     let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
     let mut kv = vec![0.0; n];
@@ -80,19 +92,22 @@ pub(crate) fn initial_acceleration(
     let free = sys.dofs().free.clone();
     let mut rhs: Vec<f64> = free
         .iter()
-        .map(|&d| s.f_ext[d] - s.f_int[d] - damp_m * s.mv[d] - damp_k * kv[d])
+        .map(|&d| {
+            s.f_ext[d] - s.f_int[d] - damp_m * s.mv[d] - damp_k * kv[d]
+                + contact.map_or(0.0, |f| f[d])
+        })
         .collect();
     sys.refill(1.0, &ops.mass, &[]);
     if let Factored::NotPositiveDefinite { message, .. } = sys.factorize()? {
         return Err(Error::Solver {
             backend: sys.backend(),
-            message: format!("the mass matrix for generalized-α's initial acceleration: {message}"),
+            message: format!("the mass matrix for generalized-α's acceleration: {message}"),
         });
     }
     sys.solve(&mut rhs)?;
-    let mut a0 = vec![0.0; n];
+    let mut a = vec![0.0; n];
     for (&d, x) in free.iter().zip(rhs) {
-        a0[d] = x;
+        a[d] = x;
     }
-    Ok(a0)
+    Ok(a)
 }

@@ -14,6 +14,7 @@ mod contact3d;
 mod equilibrium;
 mod explicit;
 mod friction;
+mod impacts;
 mod modal;
 mod mortar;
 mod nonlinear_dynamics;

@@ -253,6 +253,35 @@ impl<'m> ContactCorrection<'m> {
             .collect();
         self.start.rigid.held.sort_unstable();
         self.start.rigid.held.dedup();
+        self.start.held = self.active.current.iter().map(|k| k.slave).collect();
+        self.start.held.sort_unstable();
+        self.start.held.dedup();
+    }
+
+    /// Whether the iterate holds other slaves than the step's start did: a slave
+    /// pressed that was free, or one released (multipliers above the active
+    /// threshold; slaves compared, so a slave passing from one master facet to the
+    /// next is no change). Generalized-α takes such a step by the trapezoidal rule
+    /// (`theory/trapezoidal.md`, "Impact steps").
+    pub fn held_changed(&self) -> bool {
+        let values: Vec<f64> = self.active.lambda.values().copied().collect();
+        let threshold = self.active_threshold(&values);
+        let mut now: Vec<_> = self
+            .active
+            .lambda
+            .iter()
+            .filter(|(_, l)| **l > threshold)
+            .map(|(k, _)| k.slave)
+            .collect();
+        now.sort_unstable();
+        now.dedup();
+        now != self.start.held
+    }
+
+    /// The contact forces `Gᵀλ` of the last iterate on every dof, friction
+    /// included.
+    pub fn contact_force(&self) -> &[f64] {
+        &self.active.f_c
     }
 
     /// Ends an accepted step with increment `du`: writes the contact state and returns

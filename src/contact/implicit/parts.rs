@@ -44,6 +44,9 @@ pub(super) struct StepStart {
     pub(super) lead_all: Vec<f64>,
     /// What the committed state knows of the rigid lines' slaves.
     pub(super) rigid: EdgeHistory,
+    /// The slaves held at the start of the step (multipliers above the active
+    /// threshold), sorted.
+    pub(super) held: Vec<crate::contact::state::Slave>,
 }
 
 /// The multipliers and the active set they make: what one QP hands to the next
