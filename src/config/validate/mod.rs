@@ -281,7 +281,7 @@ pub fn build(s: &Scenario, dir: &Path, opts: &LoadOptions) -> Result<Model> {
 /// Warns of a solid's mortar pair under a second-order scheme without the contact
 /// predictor: its contact phase chatters and amplifies round-off (two backends'
 /// forces part by 4 % on benchmark 1 as solids, theory/contact3d.md), unless the
-/// scheme is generalized-α and the basis dual (3e-6).
+/// scheme is generalized-α and the basis dual (7e-7).
 fn chatter_warning(model: &mut Model) {
     let t = &model.analysis.time;
     let second_order = matches!(
@@ -292,7 +292,7 @@ fn chatter_warning(model: &mut Model) {
         return;
     }
     // Generalized-α damps the chatter, and the dual basis takes the coupling of a
-    // row's slave nodes away: together their backends agree to 3e-6.
+    // row's slave nodes away: together their backends agree to 7e-7.
     let alpha = t.scheme == TimeScheme::GeneralizedAlpha;
     if let Some((i, p)) = model.contacts.iter().enumerate().find(|(_, p)| {
         p.formulation == Formulation::Mortar && !(alpha && p.mortar_basis == MortarBasis::Dual)
