@@ -401,8 +401,9 @@ impl<'m> Core<'m> {
     /// Generalized-α's impact step: the step from `s` again by the trapezoidal
     /// rule, whose energy identity holds through a change of the held slaves with
     /// the contact force at the step's end, and the acceleration the next steps
-    /// carry from the equilibrium of the new state, contact forces included
-    /// (`theory/trapezoidal.md`, "Impact steps"). The rule and its factor are
+    /// carry from the equilibrium of the new state, contact forces included (a
+    /// mass solve by conjugate gradients, no factorisation;
+    /// `theory/trapezoidal.md`, "Impact steps"). The rule and its factor are
     /// generalized-α's again afterwards, whatever the step gave.
     fn impact_step(&mut self, s: &mut State) -> Result<StepOutcome> {
         let alpha = self.ops.rule();
@@ -422,12 +423,8 @@ impl<'m> Core<'m> {
                 unreachable!("a step that may change the held slaves is committed")
             };
             if matches!(o, StepOutcome::Accepted(_)) {
-                s.a = super::step_start::acceleration(
-                    &self.ops,
-                    &mut self.sys,
-                    s,
-                    self.correction.contact_force(),
-                )?;
+                s.a =
+                    super::step_start::acceleration(&self.ops, s, self.correction.contact_force())?;
                 self.impact_steps += 1;
             }
             Ok(o)
