@@ -13,14 +13,17 @@ use crate::common::model;
 
 /// A steel block dropped at 3 m/s under gravity from 0.5 mm onto `master`: in the
 /// plane (a rigid line, or a concrete base) or as a solid (a rigid plane, or a
-/// concrete base with mortar), with `rho_inf` and `steps` (fixed, or
-/// error-controlled at tolerance 1e-3).
-fn drop(solid: bool, rigid: bool, rho_inf: f64, adaptive: bool) -> String {
-    let steps = if adaptive {
-        "adaptive = { tolerance = 1.0e-3 }"
+/// concrete base with mortar), with `rho_inf`, fixed or error-controlled steps
+/// (tolerance 1e-3), and with or without the contact predictor.
+fn drop(solid: bool, rigid: bool, rho_inf: f64, adaptive: bool, predictor: bool) -> String {
+    let mut steps = if adaptive {
+        "adaptive = { tolerance = 1.0e-3 }".to_string()
     } else {
-        ""
+        String::new()
     };
+    if predictor {
+        steps.push_str("\ncontact_predictor = \"stabilised\"");
+    }
     let (block, base, master) = match (solid, rigid) {
         (false, true) => (
             "thickness = 0.1\nmesh = { kind = \"rectangle\", origin = [0.0, 0.0005], size = [0.2, 0.2], divisions = [4, 4] }",
@@ -102,15 +105,24 @@ fn generalized_alpha_creates_no_energy_at_impacts() {
     let dir = tempfile::tempdir().unwrap();
     let mut k = 0;
     for (solid, rigid) in [(false, true), (false, false), (true, true), (true, false)] {
-        for rho_inf in [0.0, 0.5, 0.8] {
-            for adaptive in [false, true] {
-                let m = model(&drop(solid, rigid, rho_inf, adaptive));
+        // The predictor with deformable masters (its projection onto a rigid
+        // master is not what it is built for: theory/trapezoidal.md).
+        let predictors: &[bool] = if rigid { &[false] } else { &[false, true] };
+        for (rho_inf, adaptive, &predictor) in [0.0, 0.5, 0.8]
+            .into_iter()
+            .flat_map(|r| [(r, false), (r, true)])
+            .flat_map(|(r, a)| predictors.iter().map(move |p| (r, a, p)))
+        {
+            {
+                let m = model(&drop(solid, rigid, rho_inf, adaptive, predictor));
                 k += 1;
                 let out = dir.path().join(format!("run{k}"));
                 let summary =
                     rothe::run::run(&m, &rothe::run::RunOptions::new(&out, Backend::Faer)).unwrap();
-                let case =
-                    format!("solid {solid}, rigid {rigid}, rho_inf {rho_inf}, adaptive {adaptive}");
+                let case = format!(
+                    "solid {solid}, rigid {rigid}, rho_inf {rho_inf}, adaptive {adaptive}, \
+                     predictor {predictor}"
+                );
                 assert_eq!(summary.status, RunStatus::Completed, "{case}");
                 // The impact happened, and was taken as one.
                 assert!(summary.solver.impact_steps > 0, "{case}");
