@@ -37,11 +37,21 @@ impl Corrector<'_> {
         }
     }
 
-    /// Whether the converged iterate holds other slaves than the step's start.
+    /// Whether the converged iterate holds other slaves than the step's start, or
+    /// slides under friction ([`ContactCorrection::held_changed`],
+    /// [`ContactCorrection::sliding`]).
     fn held_changed(&self) -> bool {
         match self {
             Corrector::Linear(_) => false,
-            Corrector::Contact(c) => c.held_changed(),
+            Corrector::Contact(c) => c.held_changed() || c.sliding(None),
+        }
+    }
+
+    /// Whether the committed state `s` has a slave sliding under friction.
+    fn sliding_at(&self, s: &State) -> bool {
+        match self {
+            Corrector::Linear(_) => false,
+            Corrector::Contact(c) => c.sliding(Some(&s.contact)),
         }
     }
 
@@ -377,19 +387,24 @@ impl<'m> Core<'m> {
         // trapezoidal rule (theory/trapezoidal.md, "Impact steps").
         let impacts =
             matches!(self.ops.rule(), Rule::GeneralizedAlpha(_)) && !self.model.contacts.is_empty();
-        let r = match step(
-            self.model,
-            &self.ops,
-            &mut self.sys,
-            &mut self.scratch,
-            &mut self.correction,
-            self.predictor.as_mut(),
-            impacts,
-            s,
-        ) {
-            Ok(Stepped::Done(o)) => Ok(o),
-            Ok(Stepped::HeldChanged) => self.impact_step(s),
-            Err(e) => Err(e),
+        // A step that starts sliding under friction is one at once.
+        let r = if impacts && self.correction.sliding_at(s) {
+            self.impact_step(s)
+        } else {
+            match step(
+                self.model,
+                &self.ops,
+                &mut self.sys,
+                &mut self.scratch,
+                &mut self.correction,
+                self.predictor.as_mut(),
+                impacts,
+                s,
+            ) {
+                Ok(Stepped::Done(o)) => Ok(o),
+                Ok(Stepped::HeldChanged) => self.impact_step(s),
+                Err(e) => Err(e),
+            }
         };
         let after = self.sys.timing();
         self.step_other_s += t.elapsed().as_secs_f64()

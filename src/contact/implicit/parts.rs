@@ -45,8 +45,8 @@ pub(super) struct StepStart {
     /// What the committed state knows of the rigid lines' slaves.
     pub(super) rigid: EdgeHistory,
     /// The slaves held at the start of the step (multipliers above the active
-    /// threshold), sorted.
-    pub(super) held: Vec<crate::contact::state::Slave>,
+    /// threshold) and whether each sticks, sorted.
+    pub(super) held: Vec<(crate::contact::state::Slave, bool)>,
 }
 
 /// The multipliers and the active set they make: what one QP hands to the next
