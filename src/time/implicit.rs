@@ -391,16 +391,7 @@ impl<'m> Core<'m> {
         let r = if impacts && self.correction.sliding_at(s) {
             self.impact_step(s)
         } else {
-            match step(
-                self.model,
-                &self.ops,
-                &mut self.sys,
-                &mut self.scratch,
-                &mut self.correction,
-                self.predictor.as_mut(),
-                impacts,
-                s,
-            ) {
+            match self.attempt(impacts, s) {
                 Ok(Stepped::Done(o)) => Ok(o),
                 Ok(Stepped::HeldChanged) => self.impact_step(s),
                 Err(e) => Err(e),
@@ -411,6 +402,21 @@ impl<'m> Core<'m> {
             - (after.solve_s - before.solve_s)
             - (after.factorization_s - before.factorization_s);
         r
+    }
+
+    /// One step from `s` by the current rule ([`step`]; `impacts`: a change of the
+    /// held slaves is left uncommitted).
+    fn attempt(&mut self, impacts: bool, s: &mut State) -> Result<Stepped> {
+        step(
+            self.model,
+            &self.ops,
+            &mut self.sys,
+            &mut self.scratch,
+            &mut self.correction,
+            self.predictor.as_mut(),
+            impacts,
+            s,
+        )
     }
 
     /// Generalized-α's impact step: the step from `s` again by the trapezoidal
@@ -424,17 +430,7 @@ impl<'m> Core<'m> {
         let alpha = self.ops.rule();
         self.ops.set_rule(Rule::Trapezoidal);
         let outcome = self.refit().and_then(|()| {
-            let r = step(
-                self.model,
-                &self.ops,
-                &mut self.sys,
-                &mut self.scratch,
-                &mut self.correction,
-                self.predictor.as_mut(),
-                false,
-                s,
-            )?;
-            let Stepped::Done(o) = r else {
+            let Stepped::Done(o) = self.attempt(false, s)? else {
                 unreachable!("a step that may change the held slaves is committed")
             };
             if matches!(o, StepOutcome::Accepted(_)) {
