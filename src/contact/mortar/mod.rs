@@ -175,7 +175,15 @@ impl<const D: usize> Facet<D> {
         if self.covered[..k].iter().any(|&c| c <= 0.0) {
             return None;
         }
-        let g = nalgebra::DMatrix::from_fn(k, k, |i, j| self.gram[i][j]);
+        // The k × k Gram matrix in a 4 × 4 one on the stack, the identity beyond k
+        // (its determinant and its inverse's leading block are the k × k ones).
+        let g = nalgebra::Matrix4::from_fn(|i, j| {
+            if i < k && j < k {
+                self.gram[i][j]
+            } else {
+                f64::from(u8::from(i == j))
+            }
+        });
         let diagonal: f64 = (0..k).map(|i| g[(i, i)]).product();
         let det = g.determinant();
         if !(diagonal > 0.0 && det / diagonal >= DUAL_CONDITION) {
