@@ -139,12 +139,14 @@ pub fn human(bytes: u64) -> String {
 /// The memory estimate of a model (the factor's exact nonzeros when known).
 pub fn of_model(model: &Model, factor_nnz: Option<usize>) -> Estimate {
     let mut est = of_mesh(&model.mesh, &model.materials, factor_nnz);
-    // An error-controlled run keeps the factors of other rungs of its ladder.
+    // An error-controlled run keeps the factors of other rungs of its ladder, and
+    // generalized-α with contact the trapezoidal rule's of its impact steps.
     let kept = model
         .analysis
         .time
         .adaptive
-        .map_or(0, |a| a.kept_factors() as u64);
+        .map_or(0, |a| a.kept_factors() as u64)
+        + u64::from(model.takes_impact_steps());
     est.factor *= factorisations(model) + kept;
     est
 }

@@ -631,6 +631,17 @@ pub enum ViscoelasticState {
 }
 
 impl Model {
+    /// Whether the run takes generalized-α's impact steps by the trapezoidal rule
+    /// (dynamics by generalized-α with contact; `theory/trapezoidal.md`): it then
+    /// keeps the trapezoidal rule's factor beside its own (`memory::of_model`
+    /// counts it).
+    pub fn takes_impact_steps(&self) -> bool {
+        let t = &self.analysis.time;
+        t.kind == AnalysisKind::Dynamic
+            && t.scheme == TimeScheme::GeneralizedAlpha
+            && !self.contacts.is_empty()
+    }
+
     /// Initial velocity field (per dof) from the bodies' velocities.
     pub fn initial_velocity(&self) -> Vec<f64> {
         let mut v = vec![0.0; self.mesh.n_dofs()];

@@ -73,7 +73,8 @@ impl Compliance {
             let old = std::mem::replace(&mut self.now, fresh);
             if sys.keeps_factors() && !old.eqs.is_empty() && old.slot.len() == n {
                 self.kept.push(old);
-                if self.kept.len() > crate::model::KEPT_FACTORS + 1 {
+                // The ladder's, and an impact step's trapezoidal factor.
+                if self.kept.len() > crate::model::KEPT_FACTORS + 2 {
                     self.kept.remove(0);
                 }
             }

@@ -191,6 +191,13 @@ impl EffectiveSystem {
         if self.current.1 == Some(key) {
             return true;
         }
+        // The wanted factor leaves the kept ones before the current one joins them,
+        // so that two factors taken in turn at a capacity of one both stay.
+        let wanted = self
+            .kept
+            .iter()
+            .position(|k| k.key == key)
+            .map(|i| self.kept.remove(i));
         if let Some(old) = self.current.1.take() {
             if let Some(values) = self.solver.take_numeric() {
                 self.kept.push(KeptFactor {
@@ -203,9 +210,8 @@ impl EffectiveSystem {
                 }
             }
         }
-        match self.kept.iter().position(|k| k.key == key) {
-            Some(i) => {
-                let k = self.kept.remove(i);
+        match wanted {
+            Some(k) => {
                 self.solver.put_numeric(k.values);
                 self.current = (k.id, Some(key));
                 true

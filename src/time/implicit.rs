@@ -347,10 +347,13 @@ impl<'m> Core<'m> {
                 ),
             });
         }
-        if let Some(a) = &model.analysis.time.adaptive {
-            // The ladder's factors, each step size's kept for when the run returns
-            // to it (counted in the memory estimate, `memory::of_model`).
-            sys.keep_factors(a.kept_factors());
+        // The ladder's factors, each step size's kept for when the run returns to
+        // it, and generalized-α's impact steps' trapezoidal factor (counted in the
+        // memory estimate, `memory::of_model`).
+        let kept = model.analysis.time.adaptive.map_or(0, |a| a.kept_factors())
+            + usize::from(model.takes_impact_steps());
+        if kept > 0 {
+            sys.keep_factors(kept);
             sys.label_factor(ops.h().to_bits());
         }
         let predictor = (ops.dynamic().is_some()
