@@ -268,6 +268,7 @@ pub fn run_kept(model: &Model, opts: &RunOptions) -> Result<(Summary, Kept)> {
             keep_factor: a.time.scheme.is_implicit() && a.iteration.refactor_rate.is_some(),
             fallbacks: 0,
             impact_steps: 0,
+            impact_fallbacks: 0,
             iterations: 0,
             iterations_per_step: 0.0,
             max_step_iterations: 0,
@@ -385,6 +386,7 @@ fn fill<I: Integrator + ?Sized>(
     summary.solver.reused_factors = facts.reused_factors;
     summary.solver.fallbacks = facts.fallbacks;
     summary.solver.impact_steps = facts.impact_steps;
+    summary.solver.impact_fallbacks = facts.impact_fallbacks;
     summary.solver.factor_nnz = facts.factor_nnz;
 }
 

@@ -168,6 +168,9 @@ pub struct SolverSummary {
     /// Generalized-α's steps that changed which slaves are held, taken by the
     /// trapezoidal rule (impact steps, `theory/trapezoidal.md`).
     pub impact_steps: usize,
+    /// Impact steps whose trapezoidal step did not converge, taken by
+    /// generalized-α instead (`checks.no_energy_created` says what they did).
+    pub impact_fallbacks: usize,
     /// Linear solves (iterations) over the run.
     pub iterations: usize,
     /// Iterations per accepted step: mean and largest.

@@ -458,6 +458,7 @@ impl Integrator for CentralDifference<'_> {
             reused_factors: 0,
             fallbacks: 0,
             impact_steps: 0,
+            impact_fallbacks: 0,
             factor_nnz: None,
         }
     }

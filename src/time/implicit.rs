@@ -313,6 +313,8 @@ pub(crate) struct Core<'m> {
     pub step_other_s: f64,
     /// Generalized-α's steps taken by the trapezoidal rule (impact steps).
     pub impact_steps: usize,
+    /// Impact steps whose trapezoidal step failed and that generalized-α took.
+    pub impact_fallbacks: usize,
 }
 
 impl<'m> Core<'m> {
@@ -379,6 +381,7 @@ impl<'m> Core<'m> {
             assembly_s,
             step_other_s: 0.0,
             impact_steps: 0,
+            impact_fallbacks: 0,
         })
     }
 
@@ -428,7 +431,10 @@ impl<'m> Core<'m> {
     /// carry from the equilibrium of the new state, contact forces included (a
     /// mass solve by conjugate gradients, no factorisation;
     /// `theory/trapezoidal.md`, "Impact steps"). The rule and its factor are
-    /// generalized-α's again afterwards, whatever the step gave.
+    /// generalized-α's again afterwards, whatever the step gave. When the
+    /// trapezoidal step fails to converge, the step is taken by generalized-α as
+    /// it first was (`impact_fallbacks`; the run's `no_energy_created` check then
+    /// says whether it created energy) rather than cut.
     fn impact_step(&mut self, s: &mut State) -> Result<StepOutcome> {
         let alpha = self.ops.rule();
         self.ops.set_rule(Rule::Trapezoidal);
@@ -447,6 +453,12 @@ impl<'m> Core<'m> {
         let back = self.refit();
         let o = outcome?;
         back?;
+        if matches!(o, StepOutcome::Rejected(_)) {
+            if let Stepped::Done(fallback @ StepOutcome::Accepted(_)) = self.attempt(false, s)? {
+                self.impact_fallbacks += 1;
+                return Ok(fallback);
+            }
+        }
         Ok(o)
     }
 
@@ -568,6 +580,7 @@ impl<'m> Core<'m> {
             reused_factors: self.scratch.factor.reused,
             fallbacks: self.scratch.factor.fallbacks,
             impact_steps: self.impact_steps,
+            impact_fallbacks: self.impact_fallbacks,
             factor_nnz: self.sys.factor_nnz(),
         }
     }

@@ -133,6 +133,9 @@ pub struct SolverFacts {
     /// Generalized-α's steps that changed which slaves are held, taken by the
     /// trapezoidal rule (`theory/trapezoidal.md`, "Impact steps").
     pub impact_steps: usize,
+    /// Impact steps whose trapezoidal step did not converge, taken by
+    /// generalized-α instead.
+    pub impact_fallbacks: usize,
     /// Nonzeros of the factor.
     pub factor_nnz: Option<usize>,
 }
