@@ -391,8 +391,7 @@ impl<'m> Core<'m> {
         let before = self.sys.timing();
         // Generalized-α takes a step that changes which slaves are held by the
         // trapezoidal rule (theory/trapezoidal.md, "Impact steps").
-        let impacts =
-            matches!(self.ops.rule(), Rule::GeneralizedAlpha(_)) && !self.model.contacts.is_empty();
+        let impacts = self.model.takes_impact_steps();
         // A step that starts sliding under friction is one at once.
         let r = if impacts && self.correction.sliding_at(s) {
             self.impact_step(s)
@@ -496,8 +495,7 @@ impl<'m> Core<'m> {
         }
         // A size the run had before finds its factor kept (an error-controlled run's
         // ladder); the matrix is refilled all the same, so that it is the factor's.
-        let impact = self.ops.rule() == Rule::Trapezoidal
-            && self.model.analysis.time.scheme == crate::model::TimeScheme::GeneralizedAlpha;
+        let impact = self.ops.rule() == Rule::Trapezoidal && self.model.takes_impact_steps();
         let key = h.to_bits() | if impact { 1 << 63 } else { 0 };
         self.ops.refill(&mut self.sys, &self.ops.kt);
         if self.sys.switch_factor(key) {

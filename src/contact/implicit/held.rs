@@ -2,9 +2,7 @@
 //! generalized-α reads to take a step by the trapezoidal rule
 //! (`theory/trapezoidal.md`, "Impact steps").
 
-use std::collections::BTreeMap;
-
-use super::{ContactCorrection, ContactState, Key, Slave, STICK_MARGIN};
+use super::{sticks, ContactCorrection, ContactState, Slave};
 
 impl ContactCorrection<'_> {
     /// The slaves the current multipliers hold (above the active threshold), each
@@ -19,12 +17,10 @@ impl ContactCorrection<'_> {
             .filter(|(_, l)| **l > threshold)
             .map(|(k, &l)| {
                 let mu = self.setup.pairs[k.slave.pair].mu;
-                let stick = mu > 0.0
-                    && self
-                        .active
-                        .lambda_t
-                        .get(k)
-                        .is_some_and(|t| t[0].hypot(t[1]) < (1.0 - STICK_MARGIN) * mu * l);
+                // No tangential multiplier is no tangential force: sticking, as
+                // `finish` counts it.
+                let t = self.active.lambda_t.get(k).copied().unwrap_or([0.0; 2]);
+                let stick = mu > 0.0 && sticks(mu, l, t);
                 (k.slave, stick)
             })
             .collect();
@@ -56,14 +52,14 @@ impl ContactCorrection<'_> {
             Some(c) => {
                 let values: Vec<f64> = c.active.iter().map(|(_, l)| *l).collect();
                 let threshold = self.active_threshold(&values);
-                let tangential: BTreeMap<Key, [f64; 2]> = c.tangential.iter().copied().collect();
-                c.active.iter().any(|(k, l)| {
+                // Both lists are written in key order ([`ContactCorrection::finish`]).
+                c.active.iter().any(|&(k, l)| {
                     let mu = self.setup.pairs[k.slave.pair].mu;
-                    *l > threshold
-                        && mu > 0.0
-                        && tangential
-                            .get(k)
-                            .is_none_or(|t| t[0].hypot(t[1]) >= (1.0 - STICK_MARGIN) * mu * l)
+                    let t = c
+                        .tangential
+                        .binary_search_by_key(&k, |&(key, _)| key)
+                        .map_or([0.0; 2], |i| c.tangential[i].1);
+                    l > threshold && mu > 0.0 && !sticks(mu, l, t)
                 })
             }
             None => self

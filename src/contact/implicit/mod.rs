@@ -92,6 +92,12 @@ const MAX_ROW_ROUNDS: usize = 4;
 /// the cone's bound (the cone program ends within its tolerance of the bound).
 const STICK_MARGIN: f64 = 1e-6;
 
+/// Whether a pressed node of normal force `normal` and tangential force
+/// `tangential` (along its row's tangents) sticks under friction `mu`.
+fn sticks(mu: f64, normal: f64, tangential: [f64; 2]) -> bool {
+    tangential[0].hypot(tangential[1]) < (1.0 - STICK_MARGIN) * mu * normal
+}
+
 /// Time spent in the contact correction.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactStats {
@@ -312,7 +318,7 @@ impl<'m> ContactCorrection<'m> {
                     if area > 0.0 {
                         out.traction[c.slave] += signed / area;
                     }
-                    if size < (1.0 - STICK_MARGIN) * mu * l {
+                    if sticks(mu, l, lt) {
                         rec.sticking += 1;
                     } else {
                         rec.slipping += 1;
@@ -475,13 +481,11 @@ impl<'m> ContactCorrection<'m> {
                         .get(&key)
                         .copied()
                         .unwrap_or([0.0; 2]);
-                    self.sel
-                        .guess_t
-                        .push(if lt[0].hypot(lt[1]) < (1.0 - STICK_MARGIN) * mu * ln {
-                            super::coulomb::Guess::Stick
-                        } else {
-                            super::coulomb::Guess::slip_along(&lt[..tdim])
-                        });
+                    self.sel.guess_t.push(if sticks(mu, ln, lt) {
+                        super::coulomb::Guess::Stick
+                    } else {
+                        super::coulomb::Guess::slip_along(&lt[..tdim])
+                    });
                 }
             }
         }
