@@ -169,6 +169,8 @@ pub struct Ledger {
     steps: usize,
     created: f64,
     created_step: usize,
+    algorithmic_0: f64,
+    algorithmic: f64,
 }
 
 impl Ledger {
@@ -197,10 +199,7 @@ impl Ledger {
         step.mass += s.work.damping;
         step.numerical += s.scheme_loss - s.work.load_jump;
         self.dissipated += step;
-        self.residual = (self.kinetic - self.kinetic_0)
-            + (self.elastic - self.elastic_0)
-            + self.dissipated.total()
-            - self.external_work;
+        self.update_residual();
         self.scale = self
             .scale
             .max(self.kinetic.abs())
@@ -224,6 +223,43 @@ impl Ledger {
         } else {
             self.max_abs_residual.max(self.residual.abs())
         };
+    }
+
+    /// `ΔE_kin + ΔE_el + ΔE_alg + D − W_ext`.
+    fn update_residual(&mut self) {
+        self.residual = (self.kinetic - self.kinetic_0)
+            + (self.elastic - self.elastic_0)
+            + (self.algorithmic - self.algorithmic_0)
+            + self.dissipated.total()
+            - self.external_work;
+    }
+
+    /// Sets the scheme's stored energy of the start (generalized-α's `E_alg`,
+    /// `time::modified_energy`), before any step is booked.
+    pub fn start_algorithmic(&mut self, e: f64) {
+        self.algorithmic_0 = e;
+        self.algorithmic = e;
+    }
+
+    /// Books the scheme's stored energy at the end of the step just recorded: its
+    /// change leaves `D_num` (which the step's booking had charged with it), so
+    /// that `D_num` is the loss of `E_kin + E_el + E_alg`. The residual is
+    /// unchanged.
+    pub fn book_algorithmic(&mut self, e: f64) {
+        self.dissipated.numerical -= e - self.algorithmic;
+        self.algorithmic = e;
+        self.update_residual();
+    }
+
+    /// The scheme's stored energy `E_alg` (generalized-α's modified energy less
+    /// `E_kin + E_el`; zero for the other schemes).
+    pub fn algorithmic(&self) -> f64 {
+        self.algorithmic
+    }
+
+    /// `E_alg` at the start.
+    pub fn algorithmic_0(&self) -> f64 {
+        self.algorithmic_0
     }
 
     /// Kinetic energy at the start.

@@ -8,7 +8,7 @@ use crate::energy::Ledger;
 use crate::error::{Error, Result};
 
 /// The fixed ledger columns.
-pub const LEDGER_COLUMNS: [&str; 14] = [
+pub const LEDGER_COLUMNS: [&str; 15] = [
     "t",
     "E_kin",
     "E_int",
@@ -22,6 +22,7 @@ pub const LEDGER_COLUMNS: [&str; 14] = [
     "D_predictor",
     "D_mass",
     "D_num",
+    "E_alg",
     "residual",
 ];
 
@@ -134,6 +135,7 @@ impl History {
                 d.predictor,
                 d.mass,
                 d.numerical,
+                l.algorithmic(),
                 l.residual(),
                 iterations as f64,
                 nl_residual,
@@ -159,9 +161,9 @@ impl History {
             return Ok(());
         };
         let mut line = format!(
-            "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
+            "{t:.9e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.6e},{iterations},{nl_residual:.3e}",
             l.kinetic(), l.internal(), l.external_work(), l.elastic(), d.viscous, d.damage, d.plastic,
-            d.contact, d.friction, d.predictor, d.mass, d.numerical, l.residual()
+            d.contact, d.friction, d.predictor, d.mass, d.numerical, l.algorithmic(), l.residual()
         );
         for p in probes {
             for x in &p[..self.dim] {

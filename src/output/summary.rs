@@ -101,6 +101,11 @@ pub struct EnergySummary {
     pub external_work: f64,
     /// Stored elastic energy.
     pub elastic: f64,
+    /// The scheme's stored energy at the end (generalized-α's modified energy less
+    /// `E_kin + E_el`; zero for the other schemes).
+    pub algorithmic: f64,
+    /// The same at the start.
+    pub algorithmic_0: f64,
     /// Dissipation by mechanism.
     pub dissipated: crate::energy::Dissipation,
     /// Final balance residual.
@@ -117,6 +122,8 @@ impl From<&Ledger> for EnergySummary {
             internal: l.internal(),
             external_work: l.external_work(),
             elastic: l.elastic(),
+            algorithmic: l.algorithmic(),
+            algorithmic_0: l.algorithmic_0(),
             dissipated: *l.dissipated(),
             balance_residual: l.residual(),
             balance_residual_rel: l.relative_residual(),

@@ -392,6 +392,7 @@ impl<'m> Core<'m> {
         // Generalized-α takes a step that changes which slaves are held by the
         // trapezoidal rule (theory/trapezoidal.md, "Impact steps").
         let impacts = self.model.takes_impact_steps();
+        let impact_steps = self.impact_steps;
         // A step that starts sliding under friction is one at once.
         let r = if impacts && self.correction.sliding_at(s) {
             self.impact_step(s)
@@ -402,6 +403,13 @@ impl<'m> Core<'m> {
                 Err(e) => Err(e),
             }
         };
+        let by_alpha = self.impact_steps == impact_steps;
+        if let (Ok(StepOutcome::Accepted(_)), Rule::GeneralizedAlpha(a), true) =
+            (&r, self.ops.rule(), by_alpha)
+        {
+            let e = super::modified_energy::of(&self.ops, &a, s, self.correction.contact_force());
+            s.ledger.book_algorithmic(e);
+        }
         let after = self.sys.timing();
         self.step_other_s += t.elapsed().as_secs_f64()
             - (after.solve_s - before.solve_s)
@@ -670,7 +678,13 @@ impl<'m, S: ImplicitKind> Implicit<'m, S> {
     /// The state at `t = 0`: prescribed displacements, bodies' initial velocities,
     /// history materials at rest.
     pub fn initial_state(&self) -> State {
-        self.core.ops.initial_state(self.core.model)
+        let ops = &self.core.ops;
+        let mut s = ops.initial_state(self.core.model);
+        if let Rule::GeneralizedAlpha(a) = ops.rule() {
+            let e = super::modified_energy::of(ops, &a, &s, None);
+            s.ledger.start_algorithmic(e);
+        }
+        s
     }
 
     /// The elastic stiffness on the shared pattern.

@@ -21,6 +21,7 @@ mod implicit;
 mod kept_factor;
 pub mod local_error;
 pub mod march;
+mod modified_energy;
 pub mod nodal;
 mod operators;
 mod predictor;

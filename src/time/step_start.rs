@@ -90,7 +90,7 @@ pub(crate) fn initial_acceleration(
 
 /// `f_ext − f_int − C v + f_c` of the state `s` on the free dofs, zero on the
 /// constrained ones (`f_c` the contact forces when given).
-fn out_of_balance(ops: &Operators, s: &State, contact: Option<&[f64]>) -> Vec<f64> {
+pub(crate) fn out_of_balance(ops: &Operators, s: &State, contact: Option<&[f64]>) -> Vec<f64> {
     let n = s.v.len();
     let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
     let mut kv = vec![0.0; n];
@@ -112,17 +112,31 @@ pub const MASS_SOLVE_TOLERANCE: f64 = 1e-14;
 
 /// The acceleration of the state `s` from its equilibrium,
 /// `M a = f_ext − f_int − C v + f_c` on the free dofs (zero on the constrained
-/// ones), `f_c` the contact forces when given: conjugate gradients on `M`
-/// preconditioned by its row sums (the lumped mass; one iteration when the mass is
-/// lumped), to [`MASS_SOLVE_TOLERANCE`]. A consistent mass is spectrally close to its
-/// lumped form (eigenvalues of their quotient in [¼, 2] for linear elements), so a
-/// few tens of products do what a factorisation of `M` would, without one.
+/// ones), `f_c` the contact forces when given ([`mass_solve`]).
 pub(crate) fn acceleration(
     ops: &Operators,
     s: &State,
     contact: Option<&[f64]>,
 ) -> Result<Vec<f64>> {
-    let b = out_of_balance(ops, s, contact);
+    let (x, converged) = mass_solve(ops, &out_of_balance(ops, s, contact));
+    if converged {
+        Ok(x)
+    } else {
+        Err(Error::Stepping(format!(
+            "generalized-α's acceleration after an impact step: conjugate gradients on the \
+             mass matrix did not reach {MASS_SOLVE_TOLERANCE:e} in {MASS_SOLVE_ITERATIONS} \
+             iterations (a mass matrix far from its lumped form)"
+        )))
+    }
+}
+
+/// `x = M⁻¹ b` on the free dofs (`b` zero on the constrained ones): conjugate
+/// gradients on `M` preconditioned by its row sums (the lumped mass; one iteration
+/// when the mass is lumped), to [`MASS_SOLVE_TOLERANCE`], and whether they reached
+/// it (else the last iterate). A consistent mass is spectrally close to its lumped
+/// form (eigenvalues of their quotient in [¼, 2] for linear elements), so a few
+/// tens of products do what a factorisation of `M` would, without one.
+pub(crate) fn mass_solve(ops: &Operators, b: &[f64]) -> (Vec<f64>, bool) {
     let pattern = &ops.asm.pattern;
     let diag = ops.mass.row_sums(pattern);
     let n = b.len();
@@ -137,12 +151,12 @@ pub(crate) fn acceleration(
         }));
     };
     let dot = |x: &[f64], y: &[f64]| -> f64 { x.iter().zip(y).map(|(a, b)| a * b).sum() };
-    let scale = dot(&b, &b).sqrt();
+    let scale = dot(b, b).sqrt();
     let mut x = vec![0.0; n];
     if scale == 0.0 {
-        return Ok(x);
+        return (x, true);
     }
-    let mut r = b.clone();
+    let mut r = b.to_vec();
     let mut z = Vec::with_capacity(n);
     precondition(&r, &mut z);
     let mut p = z.clone();
@@ -159,7 +173,7 @@ pub(crate) fn acceleration(
             r[d] -= alpha * mp[d];
         }
         if dot(&r, &r).sqrt() <= MASS_SOLVE_TOLERANCE * scale {
-            return Ok(x);
+            return (x, true);
         }
         precondition(&r, &mut z);
         let rz_new = dot(&r, &z);
@@ -169,11 +183,7 @@ pub(crate) fn acceleration(
             p[d] = z[d] + beta * p[d];
         }
     }
-    Err(Error::Stepping(format!(
-        "generalized-α's acceleration after an impact step: conjugate gradients on the \
-         mass matrix did not reach {MASS_SOLVE_TOLERANCE:e} in {MASS_SOLVE_ITERATIONS} \
-         iterations (a mass matrix far from its lumped form)"
-    )))
+    (x, false)
 }
 
 /// The most conjugate-gradient iterations [`acceleration`] takes.
