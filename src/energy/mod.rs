@@ -301,7 +301,8 @@ impl Ledger {
     /// The largest energy created over the run: the most `E_kin + E_el` plus the
     /// physical dissipation (every line but the scheme's own) ever stood above
     /// `E_kin⁰ + E_el⁰ + W_ext`, 0 if never, and the step (counted from 1) where it
-    /// did. Equal to `residual − D_num` at that step: a scheme's negative loss, or
+    /// did. Equal to `residual − D_num − (E_alg − E_alg⁰)` at that step: a scheme's
+    /// negative loss, or
     /// a booking that does not close, shows here (theory/energy.md).
     pub fn created(&self) -> (f64, usize) {
         (self.created, self.created_step)

@@ -32,7 +32,7 @@ fn run_writes_history_summary_and_vtk() {
     let hist = std::fs::read_to_string(out.join("history.csv")).unwrap();
     let header = hist.lines().next().unwrap();
     assert!(header.starts_with(
-        "t,E_kin,E_int,W_ext,E_el,D_viscous,D_damage,D_plastic,D_contact,D_friction,D_predictor,D_mass,D_num,residual"
+        "t,E_kin,E_int,W_ext,E_el,D_viscous,D_damage,D_plastic,D_contact,D_friction,D_predictor,D_mass,D_num,E_alg,residual"
     ));
     assert!(header.ends_with("tip_ux,tip_uy"));
     assert_eq!(hist.lines().count(), 12, "header, t = 0 and 10 steps");
