@@ -262,6 +262,8 @@ impl Integrator for CentralDifference<'_> {
             f_pred_h: h,
             contact,
             nodal: Default::default(),
+            m_inv_r: Vec::new(),
+            ma: Vec::new(),
         })
     }
 

@@ -393,6 +393,8 @@ impl<'m> Core<'m> {
         // trapezoidal rule (theory/trapezoidal.md, "Impact steps").
         let impacts = self.model.takes_impact_steps();
         let impact_steps = self.impact_steps;
+        let a_n = matches!(self.ops.rule(), Rule::GeneralizedAlpha(_)).then(|| s.a.clone());
+        let in_contact_before = !s.contact.active.is_empty();
         // A step that starts sliding under friction is one at once.
         let r = if impacts && self.correction.sliding_at(s) {
             self.impact_step(s)
@@ -403,12 +405,24 @@ impl<'m> Core<'m> {
                 Err(e) => Err(e),
             }
         };
-        let by_alpha = self.impact_steps == impact_steps;
-        if let (Ok(StepOutcome::Accepted(_)), Rule::GeneralizedAlpha(a), true) =
-            (&r, self.ops.rule(), by_alpha)
+        if let (Ok(StepOutcome::Accepted(_)), Rule::GeneralizedAlpha(a), Some(a_n)) =
+            (&r, self.ops.rule(), a_n)
         {
-            let e = super::modified_energy::of(&self.ops, &a, s, self.correction.contact_force());
-            s.ledger.book_algorithmic(e);
+            if self.impact_steps == impact_steps {
+                let guess = super::modified_energy::carried(&a, &s.a, &a_n, &s.m_inv_r);
+                let contact = self.correction.contact_force();
+                let exact =
+                    !in_contact_before && contact.is_none_or(|f| f.iter().all(|x| *x == 0.0));
+                let booked = super::modified_energy::of(&self.ops, &a, s, contact, guess, exact);
+                s.ledger.book_algorithmic(booked.energy);
+                s.m_inv_r = booked.m_inv_r;
+                s.ma = booked.ma;
+            } else {
+                // An impact step carries the equilibrium acceleration: r = 0. Its
+                // E_alg line stays as it was (theory/trapezoidal.md).
+                s.m_inv_r = vec![0.0; s.a.len()];
+                s.ma.clear();
+            }
         }
         let after = self.sys.timing();
         self.step_other_s += t.elapsed().as_secs_f64()
@@ -681,8 +695,10 @@ impl<'m, S: ImplicitKind> Implicit<'m, S> {
         let ops = &self.core.ops;
         let mut s = ops.initial_state(self.core.model);
         if let Rule::GeneralizedAlpha(a) = ops.rule() {
-            let e = super::modified_energy::of(ops, &a, &s, None);
-            s.ledger.start_algorithmic(e);
+            let booked = super::modified_energy::of(ops, &a, &s, None, vec![0.0; s.a.len()], false);
+            s.ledger.start_algorithmic(booked.energy);
+            s.m_inv_r = booked.m_inv_r;
+            s.ma = booked.ma;
         }
         s
     }

@@ -76,6 +76,13 @@ pub struct State {
     /// schemes keep them there; then `points` is empty and the integrator builds
     /// the Gauss-point state for output, `Integrator::output_points`).
     pub nodal: nodal::NodalState,
+    /// Generalized-α's `M⁻¹r` of the state, `r` its out-of-balance
+    /// (`time::modified_energy`); empty for the other schemes.
+    pub m_inv_r: Vec<f64>,
+    /// Generalized-α's `M a_n`, kept from the booking of the step that made `a_n`
+    /// for the next step's start (`time::step_start::history`); empty when not
+    /// kept (then that start forms it). Whatever sets `a` empties it.
+    pub ma: Vec<f64>,
 }
 
 /// What an accepted step reports besides the new state.

@@ -424,6 +424,8 @@ impl Operators {
             f_pred_h: self.h(),
             contact,
             nodal,
+            m_inv_r: Vec::new(),
+            ma: Vec::new(),
         }
     }
 

@@ -40,8 +40,12 @@ pub(crate) fn history(ops: &Operators, a: &Alpha, s: &State, out: &mut StartVect
     let st = a.at(ops.h());
     let (_, damp_m, damp_k) = ops.dynamic().expect("generalized-α is dynamic");
     let n = s.v.len();
-    ma_n.resize(n, 0.0);
-    ops.mass.matvec(&ops.asm.pattern, &s.a, ma_n);
+    if s.ma.len() == n {
+        ma_n.clone_from(&s.ma);
+    } else {
+        ma_n.resize(n, 0.0);
+        ops.mass.matvec(&ops.asm.pattern, &s.a, ma_n);
+    }
     let (v, mv, acc, ma) = (&s.v, &s.mv, &s.a, &*ma_n);
     p.clear();
     p.extend((0..n).map(|i| st.p_v * mv[i] + st.p_a * ma[i]));
@@ -130,13 +134,26 @@ pub(crate) fn acceleration(
     }
 }
 
-/// `x = M⁻¹ b` on the free dofs (`b` zero on the constrained ones): conjugate
-/// gradients on `M` preconditioned by its row sums (the lumped mass; one iteration
-/// when the mass is lumped), to [`MASS_SOLVE_TOLERANCE`], and whether they reached
-/// it (else the last iterate). A consistent mass is spectrally close to its lumped
-/// form (eigenvalues of their quotient in [¼, 2] for linear elements), so a few
-/// tens of products do what a factorisation of `M` would, without one.
+/// `x = M⁻¹ b` on the free dofs (`b` zero on the constrained ones) from zero:
+/// [`mass_solve_from`] to [`MASS_SOLVE_TOLERANCE`] of `|b|`.
 pub(crate) fn mass_solve(ops: &Operators, b: &[f64]) -> (Vec<f64>, bool) {
+    mass_solve_from(ops, b, vec![0.0; b.len()], 0.0)
+}
+
+/// `x = M⁻¹ b` on the free dofs (`b` zero on the constrained ones) from the guess
+/// `x`: conjugate gradients on `M` preconditioned by its row sums (the lumped mass;
+/// one iteration when the mass is lumped) until the residual is below
+/// [`MASS_SOLVE_TOLERANCE`] of `|b|` or below `floor`, and whether they got there
+/// (else the last iterate). A consistent mass is spectrally close to its lumped form
+/// (eigenvalues of their quotient in [¼, 2] for linear elements), so a few tens of
+/// products do what a factorisation of `M` would, without one; a good guess needs
+/// none.
+pub(crate) fn mass_solve_from(
+    ops: &Operators,
+    b: &[f64],
+    mut x: Vec<f64>,
+    floor: f64,
+) -> (Vec<f64>, bool) {
     let pattern = &ops.asm.pattern;
     let diag = ops.mass.row_sums(pattern);
     let n = b.len();
@@ -151,17 +168,17 @@ pub(crate) fn mass_solve(ops: &Operators, b: &[f64]) -> (Vec<f64>, bool) {
         }));
     };
     let dot = |x: &[f64], y: &[f64]| -> f64 { x.iter().zip(y).map(|(a, b)| a * b).sum() };
-    let scale = dot(b, b).sqrt();
-    let mut x = vec![0.0; n];
-    if scale == 0.0 {
+    let stop = (MASS_SOLVE_TOLERANCE * dot(b, b).sqrt()).max(floor);
+    let mut mp = vec![0.0; n];
+    ops.mass.matvec(pattern, &x, &mut mp);
+    let mut r: Vec<f64> = (0..n).map(|d| b[d] - ops.free_mask[d] * mp[d]).collect();
+    if dot(&r, &r).sqrt() <= stop {
         return (x, true);
     }
-    let mut r = b.to_vec();
     let mut z = Vec::with_capacity(n);
     precondition(&r, &mut z);
     let mut p = z.clone();
     let mut rz = dot(&r, &z);
-    let mut mp = vec![0.0; n];
     for _ in 0..MASS_SOLVE_ITERATIONS {
         ops.mass.matvec(pattern, &p, &mut mp);
         for (m, f) in mp.iter_mut().zip(&ops.free_mask) {
@@ -172,7 +189,7 @@ pub(crate) fn mass_solve(ops: &Operators, b: &[f64]) -> (Vec<f64>, bool) {
             x[d] += alpha * p[d];
             r[d] -= alpha * mp[d];
         }
-        if dot(&r, &r).sqrt() <= MASS_SOLVE_TOLERANCE * scale {
+        if dot(&r, &r).sqrt() <= stop {
             return (x, true);
         }
         precondition(&r, &mut z);
