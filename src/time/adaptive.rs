@@ -227,17 +227,25 @@ where
     } else {
         level(&ladder, bottom, ladder.rung(control.h_start))
     };
-    let landing = control.land_every.map(|e| (e, (e / tick).round() as u64));
+    // Output times on the ticks' grid: every `k` ticks.
+    let landing = control
+        .land_every
+        .map(|e| (e, (e / tick).round() as u64))
+        .filter(|&(every, k)| k > 0 && ((k as f64) * tick - every).abs() <= 1e-9 * every)
+        .map(|(_, k)| k);
+    // What is left of t_end beyond the last whole bottom rung: a step of its own would
+    // be below the floor (a tenth of a nanosecond after a t_end of 0.0100000001 s),
+    // so the step that lands on the last rung takes it along (judged as any other).
+    let sliver = control.t_end - (t0 + end as f64 * tick) > 1e-9 * tick;
+    let lands = |n: u64| landing.is_some_and(|k| n % k == 0);
     let mut estimator = Estimator::default();
     let (mut n, mut hold, mut failed_in_row) = (0u64, 0usize, 0usize);
     let mut saved = s.clone();
     loop {
         // The room to the end, or to the next output time on the ticks' grid.
         let mut room = end.saturating_sub(n);
-        if let Some((every, k)) = landing {
-            if k > 0 && ((k as f64) * tick - every).abs() <= 1e-9 * every {
-                room = room.min(k - n % k);
-            }
+        if let Some(k) = landing {
+            room = room.min(k - n % k);
         }
         let h = if room == 0 {
             // What is left of t_end below the bottom rung: one step, unjudged.
@@ -265,6 +273,9 @@ where
             tick * (1u64 << j) as f64
         };
         let on_ladder = room > 0;
+        let rungs = (h / tick).round() as u64;
+        let to_end = on_ladder && sliver && n + rungs == end && !lands(end);
+        let h = if to_end { control.t_end - s.t } else { h };
         if (h - integrator.h()).abs() > 1e-12 * h {
             integrator.set_step(h)?;
         }
@@ -316,10 +327,13 @@ where
                 } else if verdict == Verdict::Floor {
                     report.steps_at_floor += 1;
                 }
-                if on_ladder {
+                if to_end {
+                    n = end;
+                    s.t = control.t_end;
+                } else if on_ladder {
                     // The time on the ladder is a count of bottom rungs: no drift
                     // from summing the steps.
-                    n += (h / tick).round() as u64;
+                    n += rungs;
                     s.t = t0 + n as f64 * tick;
                 }
                 report.steps_accepted += 1;

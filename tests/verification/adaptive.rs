@@ -591,3 +591,34 @@ fn fixed_steps_end_on_t_end_without_a_sliver_of_a_step() {
     assert_eq!(s.step, 12000);
     assert_eq!(smallest, 5e-7);
 }
+
+#[test]
+fn a_t_end_off_the_ladder_is_reached_without_a_step_below_its_bottom_rung() {
+    // t_end 1e-10 s past a multiple of the bottom rung (2.5e-4/1024 s): the step that
+    // lands on the last rung takes the sliver along, so no step is shorter than the
+    // bottom rung (a step of its own would be 1e-10 s, far below the floor), and the
+    // run ends on t_end.
+    let t_end = 4e-3 + 1e-10;
+    let extra = "adaptive = { tolerance = 1e-3, dt_max = 2.5e-4 }";
+    let m = model(&cantilever(
+        "trapezoidal",
+        2.5e-4,
+        t_end,
+        [0.0, -1.0],
+        extra,
+    ));
+    let (s, report, steps) = adaptive(&m, |_| {});
+    let smallest = steps.iter().copied().fold(f64::INFINITY, f64::min);
+    eprintln!(
+        "{} steps, smallest {smallest:e}, last {:e}, t = {:e}",
+        steps.len(),
+        steps.last().unwrap(),
+        s.t
+    );
+    assert!(
+        smallest >= report.bottom_rung * (1.0 - 1e-12),
+        "{smallest:e}"
+    );
+    assert_eq!(report.dt_min_used, smallest);
+    assert_eq!(s.t, t_end);
+}
