@@ -237,7 +237,7 @@ where
     // be below the floor (a tenth of a nanosecond after a t_end of 0.0100000001 s),
     // so the step that lands on the last rung takes it along (judged as any other).
     let sliver = control.t_end - (t0 + end as f64 * tick) > 1e-9 * tick;
-    let lands = |n: u64| landing.is_some_and(|k| n % k == 0);
+    let lands = |n: u64| landing.is_some_and(|k| n.is_multiple_of(k));
     let mut estimator = Estimator::default();
     let (mut n, mut hold, mut failed_in_row) = (0u64, 0usize, 0usize);
     let mut saved = s.clone();
