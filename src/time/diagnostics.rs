@@ -116,45 +116,65 @@ fn residuals(history: &[f64]) -> String {
     )
 }
 
-/// In statics, when the largest residual of a failed loop sits on a body that
-/// only contact holds: that body, its pairs and what the load needs.
+/// In statics, when a body that only contact holds is where a failed loop's largest
+/// residual sits (that body, its pairs and what the load needs), or shares a pair
+/// with the body where it sits (its position along the free motion is not
+/// determined, and the pair's active set moves with it).
 fn unheld_load(model: &Model, dof: usize) -> Option<String> {
     if model.analysis.time.kind != crate::model::AnalysisKind::Static {
         return None;
     }
     let mesh = &model.mesh;
-    let body = mesh.node_body[dof / mesh.dim];
-    if !super::seat::bodies_held_by_contact_only(model).contains(&body) {
-        return None;
-    }
-    let pairs: Vec<String> = model
-        .contacts
-        .iter()
-        .filter(|p| {
-            p.sides.iter().any(|s| {
-                s.slaves.iter().any(|&n| mesh.node_body[n] == body)
-                    || s.master_nodes().iter().any(|&n| mesh.node_body[n] == body)
-            })
+    let on = |p: &crate::model::ContactPair, body: usize| {
+        p.sides.iter().any(|s| {
+            s.slaves.iter().any(|&n| mesh.node_body[n] == body)
+                || s.master_nodes().iter().any(|&n| mesh.node_body[n] == body)
         })
-        .map(|p| format!("`{}`", p.name))
-        .collect();
+    };
+    let pairs_of = |body: usize| -> Vec<String> {
+        model
+            .contacts
+            .iter()
+            .filter(|p| on(p, body))
+            .map(|p| format!("`{}`", p.name))
+            .collect()
+    };
+    let residual_body = mesh.node_body[dof / mesh.dim];
+    let unheld = super::seat::bodies_held_by_contact_only(model);
     let frictionless = model.contacts.iter().all(|p| p.mu == 0.0);
+    let remedy = if frictionless {
+        "friction (`mu`), "
+    } else {
+        ""
+    };
+    if !unheld.contains(&residual_body) {
+        // A neighbour through a pair that only contact holds.
+        let body = unheld.into_iter().find(|&b| {
+            model
+                .contacts
+                .iter()
+                .any(|p| on(p, b) && on(p, residual_body))
+        })?;
+        return Some(format!(
+            "; body `{}` has a rigid motion that no support holds and is held by contact \
+             pair(s) {} alone: statics does not determine its position along that motion, \
+             and the pair's contact set moves with it. Add a support against that motion \
+             (a roller), {remedy}or run it dynamically",
+            model.bodies[body].name,
+            pairs_of(body).join(", "),
+        ));
+    }
     Some(format!(
         "; body `{}` has no support against this motion and is held by contact pair(s) {} \
          alone, which cannot carry the load on it ({}): a static load without \
-         equilibrium. Add a support, {}or run it dynamically",
-        model.bodies[body].name,
-        pairs.join(", "),
+         equilibrium. Add a support, {remedy}or run it dynamically",
+        model.bodies[residual_body].name,
+        pairs_of(residual_body).join(", "),
         if frictionless {
             "frictionless contact carries only pressure across the surface"
         } else {
             "the contact's friction cone cannot hold it, or the load pulls it off"
         },
-        if frictionless {
-            "friction (`mu`), "
-        } else {
-            ""
-        }
     ))
 }
 

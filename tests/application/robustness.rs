@@ -1634,6 +1634,31 @@ fn a_static_load_that_contact_alone_cannot_hold_names_the_body_and_the_pair() {
     }
 }
 
+#[test]
+fn a_static_body_whose_position_contact_leaves_open_is_named_when_its_neighbour_fails() {
+    // The plane patch test without its roller: the upper block's sideways position is
+    // held by nothing but the seat, the load is carried, and the contact set at the
+    // interface's end moves with the block, so the loop stalls with its largest
+    // residual on the lower body. The failure names the upper body, its pair and
+    // what to add, not only the residual's node.
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/contact/patch_test.toml"),
+    )
+    .unwrap();
+    let free = text.replace("[[supports]]\nset = \"upper.left\"\nfix = [\"x\"]\n", "");
+    assert_ne!(free, text);
+    let (ok, err, _) = run_history(&free, &[]);
+    assert!(!ok, "the patch test without its roller converged: {err}");
+    for w in [
+        "body `upper` has a rigid motion that no support holds",
+        "contact pair(s) `interface` alone",
+        "a roller",
+        "friction (`mu`)",
+    ] {
+        assert!(err.contains(w), "`{w}` not in: {err}");
+    }
+}
+
 /// A solid block (0.1 x 0.05 x 0.1 m) over a solid base, no gravity, its bottom at
 /// `y` (0.2 touches) and its velocity `v` (x, y), 200 steps of 20 µs.
 fn touching_block(y: f64, v: [f64; 2]) -> String {
