@@ -37,8 +37,9 @@ fn scaled(h: &History, name: &str, factor: f64) -> Option<Vec<f64>> {
 /// - `probe_<name>`: the probe's vertical displacement `u_y` in mm against t in ms
 ///   (in file names, characters other than ASCII letters, digits, `-`, `_` and `.`
 ///   become `_`);
-/// - `energies`: E_kin, E_el, W_ext, each dissipation line that is not identically
-///   zero and the total dissipation, in J against t in ms;
+/// - `energies`: E_kin, E_el, W_ext, generalized-α's E_alg where not identically
+///   zero, each dissipation line that is not identically zero and the total
+///   dissipation, in J against t in ms;
 /// - `dissipation`: those dissipation lines and the total over the initial kinetic
 ///   energy (skipped when that is zero or unknown);
 /// - `contact_<pair>`: the pair's total normal force in kN against t in ms, with its
@@ -93,8 +94,13 @@ pub fn plot_run(dir: &Path) -> Result<Vec<PathBuf>> {
         ("E_kin", "E_kin (kinetic)"),
         ("E_el", "E_el (stored elastic)"),
         ("W_ext", "W_ext (external work)"),
+        ("E_alg", "E_alg (generalized-α's stored)"),
     ] {
-        if let Some(v) = h.column(name) {
+        // E_alg only where the scheme stores some.
+        let column = h
+            .column(name)
+            .filter(|v| name != "E_alg" || v.iter().any(|x| *x != 0.0));
+        if let Some(v) = column {
             energies = energies.with(Series::from_xy(label, &t, &v, Style::Line));
             slots = slots.with(Series::new("", vec![], Style::Line));
         }
