@@ -7,8 +7,9 @@
 //!
 //! `ΔE_kin + ΔE_el + ΔD_viscous + ΔD_damage + ΔD_plastic + ΔD_contact + ΔD_mass + ΔD_num = ΔW_ext`
 //!
-//! (with friction `ΔD_friction`, and with the contact predictor of the second-order
-//! schemes `ΔD_predictor`, on the left too)
+//! (with friction `ΔD_friction`, with the contact predictor of the second-order
+//! schemes `ΔD_predictor`, and with generalized-α's stored energy `ΔE_alg`, on the
+//! left too)
 //!
 //! with `ΔW_ext = ½Δu·(f_ext⁰+f_ext¹)` (trapezoidal), `ΔD_mass = Δu·C v₁` and the
 //! scheme's own loss `ΔD_num = (scheme's kinetic loss) + (material algorithmic loss)
@@ -302,8 +303,8 @@ impl Ledger {
     /// physical dissipation (every line but the scheme's own) ever stood above
     /// `E_kin⁰ + E_el⁰ + W_ext`, 0 if never, and the step (counted from 1) where it
     /// did. Equal to `residual − D_num − (E_alg − E_alg⁰)` at that step: a scheme's
-    /// negative loss, or
-    /// a booking that does not close, shows here (theory/energy.md).
+    /// negative loss, or a booking that does not close, shows here
+    /// (theory/energy.md).
     pub fn created(&self) -> (f64, usize) {
         (self.created, self.created_step)
     }
