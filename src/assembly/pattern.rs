@@ -16,6 +16,11 @@ use crate::mesh::Mesh;
 /// Nodes a task of [`Pattern::matvec2`] takes.
 const FUSED_NODES: usize = 256;
 
+/// Below this many nodes a product runs on the calling thread: handing a few
+/// hundred rows to the pool costs more than the rows (the threads' wake-up and the
+/// caller's wait), measured in `theory/solves.md`.
+pub const SERIAL_NODES: usize = 1024;
+
 /// What both products of [`Pattern::matvec2`] read: `y = A x`, `z = B w` (`B` as
 /// full blocks, or one value per node pair).
 #[derive(Clone, Copy)]
@@ -125,7 +130,8 @@ impl Pattern {
     }
 
     /// `y = A x` for a matrix stored on this pattern (symmetric storage, so row
-    /// `d n + j` is column `d n + j`). Parallel over nodes, one node's rows per task.
+    /// `d n + j` is column `d n + j`). Parallel over nodes, one node's rows per task,
+    /// from [`SERIAL_NODES`] nodes on; each row is summed in the same order either way.
     pub fn matvec(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
         match self.dim {
             3 => self.matvec_d::<3>(a, x, y),
@@ -134,7 +140,7 @@ impl Pattern {
     }
 
     fn matvec_d<const D: usize>(&self, a: &[f64], x: &[f64], y: &mut [f64]) {
-        y.par_chunks_mut(D).enumerate().for_each(|(n, yn)| {
+        let row = |(n, yn): (usize, &mut [f64])| {
             let cols = self.node_columns_d::<D>(a, n);
             let mut s = [0.0; D];
             for (k, &m) in self.neighbours(n).iter().enumerate() {
@@ -144,7 +150,12 @@ impl Pattern {
                 }
             }
             yn.copy_from_slice(&s);
-        });
+        };
+        if y.len() < D * SERIAL_NODES {
+            y.chunks_mut(D).enumerate().for_each(row);
+        } else {
+            y.par_chunks_mut(D).enumerate().for_each(row);
+        }
     }
 
     /// `y = M x` for a matrix whose node blocks are all `m_nk I` (see
@@ -157,7 +168,7 @@ impl Pattern {
     }
 
     fn matvec_pairs_d<const D: usize>(&self, m: &[f64], x: &[f64], y: &mut [f64]) {
-        y.par_chunks_mut(D).enumerate().for_each(|(n, yn)| {
+        let row = |(n, yn): (usize, &mut [f64])| {
             let lo = self.adj_ptr[n];
             let mut s = [0.0; D];
             for (k, &j) in self.neighbours(n).iter().enumerate() {
@@ -167,7 +178,12 @@ impl Pattern {
                 }
             }
             yn.copy_from_slice(&s);
-        });
+        };
+        if y.len() < D * SERIAL_NODES {
+            y.chunks_mut(D).enumerate().for_each(row);
+        } else {
+            y.par_chunks_mut(D).enumerate().for_each(row);
+        }
     }
 
     /// `y = A x` and `z = B w` in one pass over the pattern (both matrices on it):
@@ -201,20 +217,28 @@ impl Pattern {
     ) {
         let ops = Operands { a, x, b, w };
         let simd = crate::simd::Simd::detected();
-        y.par_chunks_mut(D * FUSED_NODES)
-            .zip(z.par_chunks_mut(D * FUSED_NODES))
-            .enumerate()
-            .for_each(|(c, (y, z))| {
-                let first = c * FUSED_NODES;
-                match simd {
-                    #[cfg(target_arch = "x86_64")]
-                    // SAFETY: `Simd::detected` names AVX2 only where the CPU has it.
-                    crate::simd::Simd::Avx2 => unsafe {
-                        self.fused_nodes_avx2::<D, PAIRS>(first, &ops, y, z)
-                    },
-                    _ => self.fused_nodes::<D, PAIRS>(first, &ops, y, z),
-                }
-            });
+        let chunk = |(c, (y, z)): (usize, (&mut [f64], &mut [f64]))| {
+            let first = c * FUSED_NODES;
+            match simd {
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: `Simd::detected` names AVX2 only where the CPU has it.
+                crate::simd::Simd::Avx2 => unsafe {
+                    self.fused_nodes_avx2::<D, PAIRS>(first, &ops, y, z)
+                },
+                _ => self.fused_nodes::<D, PAIRS>(first, &ops, y, z),
+            }
+        };
+        if y.len() < D * SERIAL_NODES {
+            y.chunks_mut(D * FUSED_NODES)
+                .zip(z.chunks_mut(D * FUSED_NODES))
+                .enumerate()
+                .for_each(chunk);
+        } else {
+            y.par_chunks_mut(D * FUSED_NODES)
+                .zip(z.par_chunks_mut(D * FUSED_NODES))
+                .enumerate()
+                .for_each(chunk);
+        }
     }
 
     /// [`Pattern::fused_nodes`] compiled for AVX2 (the same operations in the same
